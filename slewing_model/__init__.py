@@ -1,0 +1,24 @@
+"""Four-point contact slewing bearing: load distribution and friction torque.
+
+The method is that of Heras et al., *Load distribution and friction torque in
+four-point contact slewing bearings considering manufacturing errors and ring
+flexibility* (``shared/reference``): Hertz contact springs between groove
+centres (Rigid-BIME), ring flexibility through a precomputed finite element
+superelement (Flexible-BIME), and an analytical friction torque fed by the load
+distribution.
+
+The run-time part of this package imports numpy only; building a superelement
+(:mod:`slewing_model.superelement`) needs scipy and scikit-fem.
+"""
+from .geometry import Bearing, BearingDefinitionError, RingSection, load_bearing, bearing_from_dict
+from .errors import ManufacturingErrors, RingErrorMap, synthetic_errors
+from .bime import BimeSolver, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError, solve
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",
+    "ManufacturingErrors", "RingErrorMap", "synthetic_errors",
+    "BimeSolver", "LoadCapacityError", "LoadDistribution", "Loads", "NoEquilibriumError", "solve",
+    "__version__",
+]

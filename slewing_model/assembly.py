@@ -1,0 +1,132 @@
+"""The bearing as assembled, at a rotation ``psi`` of the moving ring.
+
+Paper section 2.1 (eqs 3, 5, 10, 11) with the manufacturing errors of each
+ring read at the ball positions. As the moving ring turns by ``psi``, the
+balls (cage) orbit by ``cage_ratio * psi`` and each ring's errors stay with
+that ring, so the errors under each ball change with ``psi``:
+
+* ball ``b`` sits at ``phi_b = phi_0 + 2 pi b / B + cage_ratio * psi`` in the
+  fixed frame and keeps its own diameter;
+* the fixed ring's errors are read at ``theta = phi_b``, the moving ring's at
+  ``theta = phi_b - psi``.
+
+Everything returned is per ball and per diagonal, ready for the energy of
+:mod:`slewing_model.bime`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contact import diagonal_stiffness, houpert_stiffness
+from .geometry import DIAGONALS, RING_CONTACTS, Bearing
+
+#: for each diagonal (1, 2) the column of its outer and inner contact in (B, 4) arrays
+OUTER_OF_DIAGONAL = np.array([c - 1 for c, _ in DIAGONALS])   # contacts 1, 4
+INNER_OF_DIAGONAL = np.array([c - 1 for _, c in DIAGONALS])   # contacts 3, 2
+#: for each diagonal, the index (0 or 1) of its contact within the ring's own pair
+OUTER_SLOT = np.array([RING_CONTACTS["outer"].index(c) for c, _ in DIAGONALS])  # 0, 1
+INNER_SLOT = np.array([RING_CONTACTS["inner"].index(c) for _, c in DIAGONALS])  # 1, 0
+
+
+def cage_ratio(bearing: Bearing) -> float:
+    """Cage (ball set) rotation per rotation of the moving ring, rolling without slip.
+
+    ``(1 - gamma)/2`` when the inner ring turns, ``(1 + gamma)/2`` when the outer
+    ring turns, ``gamma = Dw cos(alpha) / dm`` (Harris & Kotzalas, ch. 8)."""
+    gamma = bearing.ball_diameter * np.cos(bearing.contact_angle) / bearing.pitch_diameter
+    return 0.5 * (1.0 - gamma) if bearing.moving_ring == "inner" else 0.5 * (1.0 + gamma)
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """Per-ball geometry of the assembled bearing (SI units).
+
+    Attributes
+    ----------
+    psi : float, rad
+        Rotation of the moving ring.
+    ball_angle : ndarray (B,), rad
+        ``phi_b`` in the fixed frame.
+    groove_centre : ndarray (B, 4, 2), m
+        (R, z) of the groove centres of contacts 1..4 before loading (eq 3).
+    groove_radius : ndarray (B, 4), m
+    ball_diameter : ndarray (B,), m
+        Including preload and the ball's own deviation (eq 5).
+    contact_stiffness : ndarray (B, 4), N/m^1.5
+        Houpert's K of each contact (eq 10).
+    stiffness : ndarray (B, 2), N/m^1.5
+        ``K_tot`` of diagonals 1 and 2 (eq 11).
+    natural_length : ndarray (B, 2), m
+        ``l_N = Rc_i + Rc_{i+2} - Dw`` of diagonals 1 and 2 (eq 5).
+    moving_sign : float
+        +1 when the inner ring moves, -1 when the outer ring moves.
+    """
+
+    psi: float
+    ball_angle: np.ndarray
+    groove_centre: np.ndarray
+    groove_radius: np.ndarray
+    ball_diameter: np.ndarray
+    contact_stiffness: np.ndarray
+    stiffness: np.ndarray
+    natural_length: np.ndarray
+    moving_sign: float
+
+    @property
+    def separation(self) -> np.ndarray:
+        """Vector from the outer to the inner groove centre of each diagonal,
+        (B, 2, 2) as (ball, diagonal, (r, z)), before loading."""
+        return self.groove_centre[:, INNER_OF_DIAGONAL] - self.groove_centre[:, OUTER_OF_DIAGONAL]
+
+    @property
+    def moving_centre(self) -> np.ndarray:
+        """(R, z) of the moving ring's groove centre of each diagonal, (B, 2, 2)."""
+        cols = INNER_OF_DIAGONAL if self.moving_sign > 0 else OUTER_OF_DIAGONAL
+        return self.groove_centre[:, cols]
+
+
+def assemble(bearing: Bearing, psi: float = 0.0) -> Assembly:
+    """Groove centres, groove radii, ball diameters and spring constants at ``psi``.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    psi : float, rad
+        Rotation of the moving ring from the reference position.
+
+    Returns
+    -------
+    Assembly
+    """
+    n = bearing.ball_count
+    phi = bearing.ball_angles + cage_ratio(bearing) * psi
+    centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()
+    radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
+    dw = np.full(n, bearing.ball_diameter + bearing.preload)
+
+    errors = bearing.errors
+    if errors is not None:
+        for ring in ("outer", "inner"):
+            error_map = getattr(errors, ring)
+            if error_map is None:
+                continue
+            theta = phi - psi if ring == bearing.moving_ring else phi
+            d_radial, d_axial, rc = error_map.at(theta)
+            cols = [c - 1 for c in RING_CONTACTS[ring]]
+            centre[:, cols, 0] += d_radial
+            centre[:, cols, 1] += d_axial
+            if rc is not None:
+                radius[:, cols] = rc
+        if errors.ball_diameter_deviation is not None:
+            dw = dw + errors.ball_diameter_deviation
+
+    k = houpert_stiffness(dw[:, None], dw[:, None] / (2.0 * radius), bearing.youngs_modulus, bearing.poisson_ratio)
+    k_tot = diagonal_stiffness(k[:, OUTER_OF_DIAGONAL], k[:, INNER_OF_DIAGONAL])
+    natural = radius[:, OUTER_OF_DIAGONAL] + radius[:, INNER_OF_DIAGONAL] - dw[:, None]
+    return Assembly(
+        psi=float(psi), ball_angle=phi, groove_centre=centre, groove_radius=radius, ball_diameter=dw,
+        contact_stiffness=k, stiffness=k_tot, natural_length=natural,
+        moving_sign=1.0 if bearing.moving_ring == "inner" else -1.0,
+    )

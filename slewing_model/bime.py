@@ -1,0 +1,645 @@
+"""BIME: load distribution by minimum total potential energy (paper eqs 1, 16, 20, 23).
+
+Unknowns
+    ``q = (X, Y, Z, rx, ry)``: the moving ring's rigid-body displacement
+    (paper eq 23, small rotations), and for flexible rings the groove-centre
+    displacements ``D_out``, ``D_in`` of both rings (eqs 3, 14).
+
+Energy (eq 20)
+    ``U = sum_b sum_diag 2/5 K_tot delta_tot^(5/2)  +  1/2 D^T K_ring D  -  F . q``
+    with ``delta_tot = |e| - l_N`` the elongation of the spring between the two
+    groove centres of a diagonal (eqs 6-7), traction only, and
+    ``e = O_in - O_out`` the vector between them.
+
+Solver
+    Newton's method with the analytic gradient and Hessian and a backtracking
+    line search on ``U`` (it is convex: a convex increasing function of the
+    lengths ``|e|``, which are convex in the unknowns, plus a quadratic).
+
+    For flexible rings the rings are linear, so their displacements are
+    eliminated exactly in every Newton step: with ``G`` the compliance of each
+    ring at its groove centres (the pseudo-inverse of the superelement matrix,
+    block-circulant) and ``M = P_in G_in P_in^T + P_out G_out P_out^T`` the
+    combined compliance seen by the contacts, the Newton system reduces to the
+    *active* contacts only:
+
+    ``[(A^-1 + M)_aa  -S J_a] [y_a]   [A_a^-1 f_a + (M y)_a]``
+    ``[-S J_a^T          0  ] [dq ] = [-F                  ]``
+
+    where ``A`` are the 2x2 contact stiffness blocks, ``f`` the contact forces
+    and ``y`` the contact forces after the step (``D_in = -G_in P_in^T y``,
+    ``D_out = G_out P_out^T y``). Its size is twice the number of loaded
+    diagonals instead of ``5 + 8B``; rigid rings are the case ``M = 0``, where
+    it collapses to the 5x5 system ``(sum J^T A J) dq = -grad``.
+
+Stopping rule
+    Force and moment residuals on the moving ring below ``rtol`` times the load
+    scale ``max(|F|, |M|/(dm/2), max contact load)``, and, for flexible
+    rings, the contact forces felt by the rings equal the Hertz forces to the
+    same tolerance.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
+from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
+from .geometry import RING_CONTACTS, Bearing
+
+LOAD_FIELDS = ("Fx", "Fy", "Fz", "Mx", "My")
+DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
+
+
+class NoEquilibriumError(RuntimeError):
+    """No equilibrium exists for the load (or the solver could not find one)."""
+
+
+class LoadCapacityError(NoEquilibriumError):
+    """The load is beyond what the raceways can carry (truncated contact ellipse)."""
+
+
+@dataclass(frozen=True)
+class Loads:
+    """External load on the moving ring, fixed frame, SI units.
+
+    Attributes
+    ----------
+    Fx, Fy, Fz : float, N
+        Force; ``Fz > 0`` pushes the moving (inner) ring towards +z and loads
+        diagonal 1 (contacts 1 and 3).
+    Mx, My : float, N m
+        Tilting moment about the x and y axes (right hand).
+    """
+
+    Fx: float = 0.0
+    Fy: float = 0.0
+    Fz: float = 0.0
+    Mx: float = 0.0
+    My: float = 0.0
+
+    def __post_init__(self):
+        for name in LOAD_FIELDS:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ValueError(f"load {name} = {value!r}: must be a number")
+            if not math.isfinite(value):
+                raise ValueError(f"load {name} = {value!r}: must be finite (not NaN or infinite)")
+
+    @classmethod
+    def from_paper(cls, axial: float = 0.0, radial: float = 0.0, tilting_moment: float = 0.0,
+                   direction: float = 0.0) -> "Loads":
+        """The paper's load set (eqs 19, 22): axial ``Fa`` (N, along +z), radial
+        ``Fr`` (N) in the direction ``phi_r`` (rad) and tilting moment ``Mt``
+        (N m) about the axis perpendicular to it, ``(-sin phi_r, cos phi_r)``."""
+        c, s = math.cos(direction), math.sin(direction)
+        return cls(radial * c, radial * s, axial, -tilting_moment * s, tilting_moment * c)
+
+    @classmethod
+    def from_array(cls, values) -> "Loads":
+        return cls(*[float(v) for v in values])
+
+    def as_array(self) -> np.ndarray:
+        return np.array([self.Fx, self.Fy, self.Fz, self.Mx, self.My])
+
+    def rotated(self, angle: float) -> "Loads":
+        """The same load turned by ``angle`` (rad) about z (e.g. from the
+        moving ring's own frame to the fixed frame)."""
+        c, s = math.cos(angle), math.sin(angle)
+        return Loads(c * self.Fx - s * self.Fy, s * self.Fx + c * self.Fy, self.Fz,
+                     c * self.Mx - s * self.My, s * self.Mx + c * self.My)
+
+
+@dataclass(frozen=True)
+class LoadDistribution:
+    """Result of a BIME solve. Arrays are per ball (axis 0) and per contact 1..4
+    or per diagonal 1, 2 (axis 1). SI units.
+
+    Attributes
+    ----------
+    model : str
+        ``"rigid"`` or ``"flexible"``.
+    loads : Loads
+    displacement : ndarray (5,)
+        Moving ring (X, Y, Z in m; rx, ry in rad).
+    ball_angle : ndarray (B,), rad
+    contact_load : ndarray (B, 4), N
+        ``Q`` of contacts 1..4 (``Q1 = Q3``, ``Q2 = Q4``).
+    contact_angle : ndarray (B, 4), rad
+        Loaded contact angle of each contact (that of its diagonal).
+    interference : ndarray (B, 2), m
+        ``delta_tot`` of diagonals 1 and 2 (negative: a gap).
+    contact_deflection : ndarray (B, 4), m
+        Share ``delta_i = (Q/K_i)^(2/3)`` of each contact.
+    ring_displacement : ndarray (B, 4, 2) or None, m
+        (R, z) displacement of the groove centre of contacts 1..4 by ring
+        deformation (flexible model).
+    semi_axis_a, semi_axis_b : ndarray (B, 4), m
+        Hertz ellipse across the groove and along the rolling direction.
+    contact_pressure : ndarray (B, 4), Pa
+        Maximum Hertz pressure of each contact.
+    energy : float, J
+        Total potential energy (eq 20).
+    iterations : int
+    residual : float
+        Largest force residual at the end, relative to the load scale.
+    state : ndarray
+        Solver unknowns, for a warm start (:meth:`BimeSolver.solve` ``initial``).
+    """
+
+    model: str
+    loads: Loads
+    displacement: np.ndarray
+    ball_angle: np.ndarray
+    contact_load: np.ndarray
+    contact_angle: np.ndarray
+    interference: np.ndarray
+    contact_deflection: np.ndarray
+    ring_displacement: np.ndarray | None
+    semi_axis_a: np.ndarray
+    semi_axis_b: np.ndarray
+    contact_pressure: np.ndarray
+    energy: float
+    iterations: int
+    residual: float
+    state: np.ndarray = field(repr=False)
+
+    @property
+    def max_ball_load(self) -> float:
+        """Largest contact load, N."""
+        return float(self.contact_load.max())
+
+    @property
+    def max_contact_pressure(self) -> float:
+        """Largest Hertz pressure, Pa."""
+        return float(self.contact_pressure.max())
+
+    @property
+    def static_safety_factor(self) -> float:
+        """ISO 76 static safety factor ``(4200 MPa / p_max)^3`` (load ratio, as
+        ``C0 / P0``: Hertz pressure grows with the cube root of the load);
+        infinite for an unloaded bearing."""
+        p = self.max_contact_pressure
+        return math.inf if p <= 0.0 else (ISO76_PRESSURE_LIMIT / p) ** 3
+
+    @property
+    def balls_in_four_point_contact(self) -> int:
+        """Number of balls whose both diagonals carry load."""
+        return int(np.count_nonzero(np.all(self.interference > 0.0, axis=1)))
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready data (the ``slewing solve --json`` object)."""
+        d = {
+            "model": self.model,
+            "loads": {k: getattr(self.loads, k) for k in LOAD_FIELDS},
+            "displacement": dict(zip(DISPLACEMENT_FIELDS, map(float, self.displacement))),
+            "Q": self.contact_load.tolist(),
+            "contact_angle": self.contact_angle.tolist(),
+            "interference": self.interference.tolist(),
+            "ball_angle": self.ball_angle.tolist(),
+            "contact_pressure": self.contact_pressure.tolist(),
+            "max_ball_load": self.max_ball_load,
+            "max_contact_pressure": self.max_contact_pressure,
+            "static_safety_factor": self.static_safety_factor,
+            "balls_in_four_point_contact": self.balls_in_four_point_contact,
+            "energy": self.energy,
+            "iterations": self.iterations,
+        }
+        if self.ring_displacement is not None:
+            d["ring_displacement"] = self.ring_displacement.tolist()
+        return d
+
+
+def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
+    """Pseudo-inverse of a symmetric block-circulant matrix given by its first
+    block row (B, m, m), returned dense. Inverts block by block in the harmonic
+    (DFT) basis, dropping the null space (a free ring's rigid-body modes)."""
+    n, m, _ = first_row.shape
+    blocks = np.fft.fft(first_row, axis=0)  # block j = sum_k C_k exp(-2 pi i j k / B)
+    top = max(np.abs(np.linalg.eigvalsh(0.5 * (b + b.conj().T))).max() for b in blocks)
+    inv = np.empty_like(blocks)
+    for j, b in enumerate(blocks):
+        w, v = np.linalg.eigh(0.5 * (b + b.conj().T))
+        keep = np.abs(w) > rcond * top
+        inv[j] = (v[:, keep] / w[keep]) @ v[:, keep].conj().T
+    row = np.fft.ifft(inv, axis=0).real  # first block row of the pseudo-inverse
+    k = (np.arange(n)[None, :] - np.arange(n)[:, None]) % n
+    return row[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
+
+
+def contact_compliance(superelement) -> np.ndarray:
+    """``M`` (4B, 4B): the combined compliance of both rings seen by the contacts,
+    ordered like the relative vectors ``e`` (ball, diagonal, (r, z)).
+
+    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` each ring's
+    compliance at its groove centres (pseudo-inverse of its superelement)."""
+    n = superelement.outer.ball_count
+    total = 0.0
+    for ring, slots in ((superelement.outer, OUTER_SLOT), (superelement.inner, INNER_SLOT)):
+        g = _pseudo_inverse_circulant(np.asarray(ring.first_row, dtype=float))
+        index = _ring_index(n, slots)
+        total = total + g[np.ix_(index, index)]
+    return total
+
+
+class BimeSolver:
+    """Rigid- or Flexible-BIME solver for one bearing at one rotation ``psi``.
+
+    Keep one solver for a sequence of solves (warm starts, FMU steps); use
+    :func:`solve` for a single case.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    superelement : Superelement, optional
+        Both rings' condensed stiffness (:mod:`slewing_model.ring_stiffness`);
+        None for rigid rings.
+    psi : float, rad
+        Rotation of the moving ring.
+    rtol : float
+        Relative tolerance of the stopping rule.
+    max_iterations : int
+    """
+
+    def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, rtol: float = 1e-10,
+                 max_iterations: int = 200, compliance: np.ndarray | None = None):
+        if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
+            raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
+                             f"the bearing ball_count = {bearing.ball_count}")
+        self.bearing = bearing
+        self.superelement = superelement
+        self.model = "rigid" if superelement is None else "flexible"
+        self.rtol = rtol
+        self.max_iterations = max_iterations
+        self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
+        self.compliance = compliance if compliance is not None else (
+            None if superelement is None else contact_compliance(superelement))
+        # groove edge angles of contacts 1..4 (truncation check)
+        self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
+        self.set_rotation(psi)
+
+    # ---- set-up -------------------------------------------------------------------
+    def set_rotation(self, psi: float) -> None:
+        """Re-assemble at another rotation of the moving ring (errors move with the rings)."""
+        self.assembly: Assembly = assemble(self.bearing, psi)
+        a = self.assembly
+        phi = a.ball_angle[:, None]
+        r, z = a.moving_centre[..., 0], a.moving_centre[..., 1]
+        c, s = np.cos(phi), np.sin(phi)
+        zero, one = np.zeros_like(r), np.ones_like(r)
+        L = self.length
+        # d(R, z of the moving groove centre)/d(X, Y, Z, L rx, L ry), eq 23: (B, 2 diag, 2 comp, 5)
+        jr = np.stack([c * one, s * one, zero, -z * s / L, z * c / L], axis=-1)
+        jz = np.stack([zero, zero, one, r * s / L, -r * c / L], axis=-1)
+        self.jacobian = a.moving_sign * np.stack([jr, jz], axis=2)
+        k_mean = float(a.stiffness.mean())
+        self.reference_stiffness = a.stiffness.size * k_mean * math.sqrt(1e-4 * self.bearing.ball_diameter)
+
+    def _scaled_load(self, loads: Loads) -> np.ndarray:
+        f = loads.as_array()
+        f[3:] /= self.length
+        return f
+
+    # ---- energy -------------------------------------------------------------------
+    def _contacts(self, e: np.ndarray):
+        """Spring terms for relative vectors ``e`` (B, 2, 2): elongation, force
+        vectors dPhi/de, contact energy and the 2x2 Hessian blocks."""
+        a = self.assembly
+        length = np.sqrt(e[..., 0] ** 2 + e[..., 1] ** 2)
+        n = e / length[..., None]
+        delta = length - a.natural_length                                   # eq 7
+        dpos = np.maximum(delta, 0.0)
+        q = a.stiffness * dpos**1.5                                         # eq 8
+        energy = 0.4 * float(np.sum(a.stiffness * dpos**2.5))               # eq 1
+        force = q[..., None] * n
+        k_normal = 1.5 * a.stiffness * np.sqrt(dpos)
+        nn = n[..., :, None] * n[..., None, :]
+        eye = np.eye(2)
+        hess = k_normal[..., None, None] * nn + (q / length)[..., None, None] * (eye - nn)
+        return delta, q, force, energy, hess, n, length
+
+    def energy_terms(self, x: np.ndarray, loads: Loads | None = None):
+        """Total potential energy (eq 20), its gradient and Hessian in the
+        paper's unknowns, SI units.
+
+        Parameters
+        ----------
+        x : ndarray (5,) for rigid rings, (5 + 8B,) for flexible rings
+            ``(X, Y, Z, rx, ry)``, then ``D_out`` and ``D_in`` (4B each, ordered
+            as paper eq 14: per ball ``R, z`` of the ring's two groove centres).
+        loads : Loads, optional
+
+        Returns
+        -------
+        energy : float, J
+        gradient : ndarray like ``x``
+        hessian : ndarray (len(x), len(x))
+        """
+        loads = Loads() if loads is None else loads
+        n = self.bearing.ball_count
+        f_ext = loads.as_array()
+        scale = np.array([1.0, 1.0, 1.0, self.length, self.length])
+        jac = self.jacobian * scale  # d e / d(X, Y, Z, rx, ry), physical units
+        q = np.asarray(x[:5], float)
+        e = self.assembly.separation + jac @ q
+        flexible = self.superelement is not None
+        if flexible:
+            d_out, d_in = np.asarray(x[5:5 + 4 * n]), np.asarray(x[5 + 4 * n:])
+            # relative vector of diagonal k: + inner groove centre - outer groove centre
+            p_out = _ring_selector(n, OUTER_SLOT)
+            p_in = _ring_selector(n, INNER_SLOT)
+            e = e + (p_in @ d_in - p_out @ d_out).reshape(e.shape)
+            jac_full = np.concatenate([jac.reshape(-1, 5), -p_out, p_in], axis=1)
+        else:
+            jac_full = jac.reshape(-1, 5)
+        _, _, force, energy, hess, _, _ = self._contacts(e)
+        grad = jac_full.T @ force.ravel()
+        blocks = np.zeros((force.size, force.size))
+        for i in range(force.size // 2):
+            blocks[2 * i:2 * i + 2, 2 * i:2 * i + 2] = hess.reshape(-1, 2, 2)[i]
+        hessian = jac_full.T @ blocks @ jac_full
+        grad[:5] -= f_ext
+        energy -= float(f_ext @ q)
+        if flexible:
+            k_out, k_in = self.superelement.outer.dense(), self.superelement.inner.dense()
+            energy += 0.5 * float(d_out @ k_out @ d_out + d_in @ k_in @ d_in)   # eq 15
+            grad[5:5 + 4 * n] += k_out @ d_out
+            grad[5 + 4 * n:] += k_in @ d_in
+            hessian[5:5 + 4 * n, 5:5 + 4 * n] += k_out
+            hessian[5 + 4 * n:, 5 + 4 * n:] += k_in
+        return energy, grad, hessian
+
+    def _energy(self, qs, y, e0, f_scaled):
+        e = e0 + self.jacobian @ qs if self.compliance is None else \
+            e0 + self.jacobian @ qs - (self.compliance @ y).reshape(e0.shape)
+        *_, energy, _, _, _ = self._contacts(e)
+        ring = 0.0 if self.compliance is None else 0.5 * float(y @ (self.compliance @ y))
+        return energy + ring - float(f_scaled @ qs)
+
+    # ---- solve --------------------------------------------------------------------
+    def solve(self, loads: Loads | None = None, initial: "LoadDistribution | np.ndarray | None" = None
+              ) -> LoadDistribution:
+        """Equilibrium under ``loads``.
+
+        Parameters
+        ----------
+        loads : Loads, optional
+            None: idling (preload and errors only).
+        initial : LoadDistribution or ndarray, optional
+            Warm start: a previous result of this solver (or its ``state``).
+
+        Raises
+        ------
+        NoEquilibriumError
+            The load has no equilibrium within the bearing (a direction no
+            contact resists, or no convergence).
+        LoadCapacityError
+            A contact ellipse runs over the groove edge: the load is beyond what
+            the raceways can carry.
+        """
+        loads = Loads() if loads is None else loads
+        f_scaled = self._scaled_load(loads)
+        flexible = self.compliance is not None
+        n_balls = self.bearing.ball_count
+        e0 = self.assembly.separation
+        jac = self.jacobian
+        dw = self.bearing.ball_diameter
+
+        qs = np.zeros(5)
+        y = np.zeros(4 * n_balls) if flexible else np.zeros(0)
+        if initial is not None:
+            state = initial.state if isinstance(initial, LoadDistribution) else np.asarray(initial, float)
+            qs = state[:5].copy()
+            if flexible and state.size == 5 + 4 * n_balls:
+                y = state[5:].copy()
+        elif flexible:
+            # start from the rigid solution: contact forces felt by the rings
+            rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, rtol=1e-6,
+                               max_iterations=self.max_iterations)
+            rigid.edge_angle = np.full(4, np.pi)  # no truncation check on the starting guess
+            start = rigid.solve(loads)
+            qs = start.state[:5].copy()
+            e_start = e0 + jac @ qs
+            y = rigid._contacts(e_start)[2].ravel()
+
+        trust = 0.02 * dw
+        mu = 1e-12 * self.reference_stiffness
+        iterations = 0
+        residual = math.inf
+        while True:
+            e = e0 + jac @ qs
+            if flexible:
+                e = e - (self.compliance @ y).reshape(e0.shape)
+            delta, q, force, energy, hess, n, length = self._contacts(e)
+            f = force.ravel()
+            grad_q = np.einsum("bkcj,bkc->j", jac, force) - f_scaled
+            scale = max(float(np.abs(f_scaled).max()), float(q.max()), 1e-300)
+            residual = float(np.abs(grad_q).max())
+            if flexible:
+                residual = max(residual, float(np.abs(f - y).max()))
+            residual /= scale
+            if residual <= self.rtol or (not np.any(q > 0) and not np.any(f_scaled)):
+                break
+            if iterations >= self.max_iterations:
+                raise NoEquilibriumError(
+                    f"no convergence after {iterations} Newton iterations (relative residual {residual:.2e}) "
+                    f"for loads {loads}")
+            iterations += 1
+
+            # ---- Newton direction ----
+            if not flexible:
+                h = np.einsum("bkci,bkcd,bkdj->ij", jac, hess, jac)
+                dq = np.linalg.solve(h + mu * np.eye(5), -grad_q)
+                dy = y  # empty: no ring unknowns
+            else:
+                active = (delta > 1e-15 * dw).ravel()
+                idx = np.flatnonzero(np.repeat(active, 2))
+                nn = n[..., :, None] * n[..., None, :]
+                k_normal = 1.5 * self.assembly.stiffness * np.sqrt(np.maximum(delta, 0.0))
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    a_inv = (nn / k_normal[..., None, None]
+                             + (length / q)[..., None, None] * (np.eye(2) - nn))  # A^-1, active blocks
+                a_inv = a_inv.reshape(-1, 2, 2)[active]
+                na = idx.size
+                w_mat = self.compliance[np.ix_(idx, idx)].copy()
+                blocks = np.arange(0, na, 2)
+                for r_ in range(2):
+                    for c_ in range(2):
+                        w_mat[blocks + r_, blocks + c_] += a_inv[:, r_, c_]
+                my = self.compliance @ y
+                rhs = np.einsum("aij,aj->ai", a_inv, f[idx].reshape(-1, 2)).ravel() + my[idx]
+                ja = jac.reshape(-1, 5)[idx] if na else np.zeros((0, 5))
+                if na:
+                    chol = np.linalg.cholesky(w_mat)
+                    z_mat = _cho_solve(chol, ja)
+                    w_vec = _cho_solve(chol, rhs)
+                    schur = ja.T @ z_mat
+                    dq = np.linalg.solve(schur + mu * np.eye(5), f_scaled - ja.T @ w_vec)
+                    y_new = np.zeros_like(y)
+                    y_new[idx] = w_vec + z_mat @ dq
+                else:
+                    dq = np.linalg.solve(mu * np.eye(5), f_scaled)
+                    y_new = np.zeros_like(y)
+                dy = y_new - y
+            norm = float(np.linalg.norm(dq))
+            if norm > trust:
+                dq = dq * (trust / norm)
+                if flexible:
+                    dy = dy * (trust / norm)
+
+            # ---- backtracking line search on the energy ----
+            u0 = energy + (0.5 * float(y @ (self.compliance @ y)) if flexible else 0.0) - float(f_scaled @ qs)
+            slope = float(grad_q @ dq)
+            if flexible:
+                slope -= float((self.compliance @ (f - y)) @ dy)
+            t = 1.0
+            for _ in range(60):
+                u = self._energy(qs + t * dq, y + t * dy if flexible else y, e0, f_scaled)
+                if u <= u0 + 1e-4 * t * min(slope, 0.0) + 1e-13 * abs(u0):
+                    break
+                t *= 0.5
+            else:
+                raise NoEquilibriumError(f"line search failed (relative residual {residual:.2e}) for loads {loads}")
+            qs = qs + t * dq
+            if flexible:
+                y = y + t * dy
+            if np.linalg.norm(qs) > dw:
+                raise NoEquilibriumError(
+                    f"no equilibrium for loads {loads}: the moving ring would move {np.linalg.norm(qs) * 1e3:.3g} mm, "
+                    f"beyond the ball diameter ({dw * 1e3:g} mm); no contact resists this load")
+
+        return self._result(loads, qs, y, e, delta, q, energy, iterations, residual, f_scaled)
+
+    def _result(self, loads, qs, y, e, delta, q, energy, iterations, residual, f_scaled) -> LoadDistribution:
+        a = self.assembly
+        b = self.bearing
+        flexible = self.compliance is not None
+        # per contact 1..4 from the diagonals: contacts (1,3) <- diagonal 1, (2,4) <- diagonal 2
+        per_contact = np.array([0, 1, 0, 1])
+        contact_load = q[:, per_contact]
+        alpha_diag = np.stack([np.arctan2(e[:, 0, 1], e[:, 0, 0]), np.arctan2(-e[:, 1, 1], e[:, 1, 0])], axis=1)
+        contact_angle = alpha_diag[:, per_contact]
+        deflection = contact_deflection(contact_load, a.contact_stiffness)
+        ring_disp = None
+        if flexible:
+            ring_disp = self._ring_displacement(y)
+        semi_a = np.empty_like(contact_load)
+        semi_b = np.empty_like(contact_load)
+        pressure = np.empty_like(contact_load)
+        for ring, contacts in RING_CONTACTS.items():
+            cols = [c - 1 for c in contacts]
+            ell = hertz_ellipse(contact_load[:, cols], a.ball_diameter[:, None], a.groove_radius[:, cols],
+                                contact_angle[:, cols], b.pitch_diameter, ring, b.youngs_modulus, b.poisson_ratio)
+            semi_a[:, cols], semi_b[:, cols], pressure[:, cols] = ell.a, ell.b, ell.max_pressure
+        # truncation: the ellipse must stay on the raceway (below the groove edge)
+        reach = contact_angle + semi_a / a.groove_radius
+        over = (contact_load > 0.0) & (reach >= self.edge_angle[None, :])
+        if np.any(over):
+            ball, contact = map(int, np.argwhere(over)[0])
+            raise LoadCapacityError(
+                f"loads {loads} are beyond what the bearing can carry: at ball {ball + 1} the contact ellipse of "
+                f"contact {contact + 1} (contact angle {math.degrees(contact_angle[ball, contact]):.1f} deg, half-width "
+                f"{math.degrees(semi_a[ball, contact] / a.groove_radius[ball, contact]):.1f} deg, load "
+                f"{contact_load[ball, contact]:.4g} N) runs over the groove edge at "
+                f"{math.degrees(self.edge_angle[contact]):.1f} deg")
+        displacement = qs.copy()
+        displacement[3:] /= self.length
+        ring_energy = 0.5 * float(y @ (self.compliance @ y)) if flexible else 0.0
+        total = energy + ring_energy - float(f_scaled @ qs)
+        return LoadDistribution(
+            model=self.model, loads=loads, displacement=displacement, ball_angle=a.ball_angle.copy(),
+            contact_load=contact_load, contact_angle=contact_angle, interference=delta.copy(),
+            contact_deflection=deflection, ring_displacement=ring_disp, semi_axis_a=semi_a, semi_axis_b=semi_b,
+            contact_pressure=pressure, energy=total, iterations=iterations, residual=residual,
+            state=np.concatenate([qs, y]),
+        )
+
+    def _ring_displacement(self, y: np.ndarray) -> np.ndarray:
+        """(B, 4, 2) groove-centre displacements of contacts 1..4 from the forces ``y``:
+        ``D_in = -G_in P_in^T y``, ``D_out = G_out P_out^T y``."""
+        n = self.bearing.ball_count
+        forces = y.reshape(n, 2, 2)
+        out = np.zeros((n, 4, 2))
+        for ring, slots, sign in (("outer", OUTER_SLOT, 1.0), ("inner", INNER_SLOT, -1.0)):
+            g = self._ring_compliance(ring)
+            load = np.zeros((n, 2, 2))
+            load[:, slots] = forces
+            d = (g @ load.ravel()).reshape(n, 2, 2) * sign
+            cols = [c - 1 for c in RING_CONTACTS[ring]]
+            out[:, cols] = d
+        return out
+
+    def _ring_compliance(self, ring: str) -> np.ndarray:
+        cache = self.__dict__.setdefault("_g_cache", {})
+        if ring not in cache:
+            cache[ring] = _pseudo_inverse_circulant(np.asarray(getattr(self.superelement, ring).first_row, float))
+        return cache[ring]
+
+
+def _ring_index(n: int, slots: np.ndarray) -> np.ndarray:
+    """Ring DOF (paper eq 14 order) of every entry of the relative vectors
+    ``e`` in (ball, diagonal, (r, z)) order; ``slots`` is the ring's contact
+    slot of diagonals 1 and 2."""
+    return (4 * np.arange(n)[:, None, None] + 2 * slots[None, :, None] + np.arange(2)[None, None, :]).ravel()
+
+
+def _ring_selector(n: int, slots: np.ndarray) -> np.ndarray:
+    """(4B, 4B) 0/1 matrix taking a ring's DOFs to the order of ``e``."""
+    p = np.zeros((4 * n, 4 * n))
+    p[np.arange(4 * n), _ring_index(n, slots)] = 1.0
+    return p
+
+
+def _cho_solve(chol: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve ``L L^T x = rhs`` with numpy only (the FMU has no scipy)."""
+    z = np.linalg.solve(chol, rhs)
+    return np.linalg.solve(chol.T, z)
+
+
+def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid", superelement=None,
+          bc: str = "free", mesh: str = "coarse", psi: float = 0.0, initial=None, rtol: float = 1e-10
+          ) -> LoadDistribution:
+    """Load distribution of ``bearing`` under ``loads``: the one obvious entry point.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    loads : Loads, optional
+        External load on the moving ring (fixed frame); None for idling.
+    model : {"rigid", "flexible"}
+        Rigid rings (Rigid-BIME) or flexible rings (Flexible-BIME).
+    superelement : Superelement, optional
+        For ``model="flexible"``; built (or read from the cache) with ``bc``
+        and ``mesh`` when not given.
+    bc : {"free", "clamped", "frictionless"}
+        Ring support for a superelement built here.
+    mesh : {"coarse", "fine"}
+    psi : float, rad
+        Rotation of the moving ring.
+    initial : LoadDistribution, optional
+        Warm start.
+    rtol : float
+        Relative tolerance of the force residuals.
+
+    Returns
+    -------
+    LoadDistribution
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing, solve, Loads
+    >>> b = load_bearing("examples/bearings/table1.toml")
+    >>> r = solve(b, Loads(Fz=500e3))
+    >>> bool(abs(r.contact_load[:, 0].sum() * 0 + r.contact_load[:, 0].std()) < 1e-6 * r.max_ball_load)
+    True
+    """
+    if model not in ("rigid", "flexible"):
+        raise ValueError(f"model = {model!r}: must be 'rigid' or 'flexible'")
+    if model == "flexible" and superelement is None:
+        from .superelement import build_superelement
+
+        superelement = build_superelement(bearing, mesh=mesh, bc=bc)
+    solver = BimeSolver(bearing, superelement if model == "flexible" else None, psi=psi, rtol=rtol)
+    return solver.solve(loads, initial=initial)

@@ -1,0 +1,100 @@
+"""The ``slewing`` command line.
+
+``slewing solve BEARING.toml [--fx N] [--fy N] [--fz N] [--mx Nm] [--my Nm] [--model rigid|flexible] [--json]``
+``slewing superelement BEARING.toml [--mesh coarse|fine] [--bc free|clamped|frictionless] -o FILE``
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+import numpy as np
+
+from .bime import LOAD_FIELDS, Loads, NoEquilibriumError, solve
+from .geometry import BearingDefinitionError, load_bearing
+
+
+def _finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} must be finite")
+    return value
+
+
+def _add_solve(sub) -> None:
+    p = sub.add_parser("solve", help="load distribution of a bearing under a load")
+    p.add_argument("bearing", help="bearing definition (TOML)")
+    for name, unit in zip(LOAD_FIELDS, ("N", "N", "N", "Nm", "Nm")):
+        p.add_argument(f"--{name.lower()}", type=_finite_float, default=0.0, metavar=unit,
+                       help=f"{name} on the moving ring, {unit} (fixed frame)")
+    p.add_argument("--model", choices=("rigid", "flexible"), default="rigid")
+    p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free",
+                   help="ring support of the flexible model's superelement")
+    p.add_argument("--mesh", choices=("coarse", "fine"), default="coarse")
+    p.add_argument("--preload", type=_finite_float, default=None, metavar="m",
+                   help="ball preload (oversize), m, overriding the bearing file")
+    p.add_argument("--psi", type=_finite_float, default=0.0, metavar="rad", help="rotation of the moving ring")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_run_solve)
+
+
+def _run_solve(args) -> int:
+    bearing = load_bearing(args.bearing)
+    if args.preload is not None:
+        bearing = bearing.with_preload(args.preload)
+    loads = Loads(args.fx, args.fy, args.fz, args.mx, args.my)
+    result = solve(bearing, loads, model=args.model, bc=args.bc, mesh=args.mesh, psi=args.psi)
+    if args.json:
+        print(json.dumps(result.to_dict()))
+        return 0
+    print(f"{bearing.name}: {args.model} rings, {bearing.ball_count} balls, {result.iterations} Newton iterations")
+    d = result.displacement
+    print(f"displacement  x {d[0] * 1e6:9.3f} um  y {d[1] * 1e6:9.3f} um  z {d[2] * 1e6:9.3f} um  "
+          f"rx {d[3] * 1e6:9.3f} urad  ry {d[4] * 1e6:9.3f} urad")
+    print(f"max ball load {result.max_ball_load / 1e3:.3f} kN, max contact pressure "
+          f"{result.max_contact_pressure / 1e6:.0f} MPa, static safety factor {result.static_safety_factor:.3g}, "
+          f"{result.balls_in_four_point_contact} balls in four-point contact")
+    print(f"{'ball':>4} {'phi deg':>8} {'Q1 kN':>8} {'Q2 kN':>8} {'Q3 kN':>8} {'Q4 kN':>8} "
+          f"{'a13 deg':>8} {'a24 deg':>8} {'d13 um':>8} {'d24 um':>8}")
+    for b in range(bearing.ball_count):
+        q = result.contact_load[b] / 1e3
+        a = np.degrees(result.contact_angle[b])
+        i = result.interference[b] * 1e6
+        print(f"{b + 1:4d} {math.degrees(result.ball_angle[b]):8.2f} {q[0]:8.3f} {q[1]:8.3f} {q[2]:8.3f} {q[3]:8.3f} "
+              f"{a[0]:8.3f} {a[1]:8.3f} {i[0]:8.3f} {i[1]:8.3f}")
+    return 0
+
+
+def _add_superelement(sub) -> None:
+    try:
+        from .superelement import command
+    except ImportError as exc:  # build-time dependencies missing
+        p = sub.add_parser("superelement", help=f"unavailable: {exc}")
+        p.set_defaults(func=lambda args: (print(f"slewing superelement needs scipy and scikit-fem: {exc}",
+                                                 file=sys.stderr), 2)[1])
+        return
+    p = sub.add_parser("superelement", help="build a ring superelement (scikit-fem)")
+    command.add_arguments(p)
+    p.set_defaults(func=command.run)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
+    sub = parser.add_subparsers(dest="command", required=True)
+    _add_solve(sub)
+    _add_superelement(sub)
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (BearingDefinitionError, NoEquilibriumError, ValueError) as exc:
+        print(f"slewing {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
