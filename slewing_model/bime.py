@@ -50,6 +50,8 @@ from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .geometry import RING_CONTACTS, Bearing
 
 LOAD_FIELDS = ("Fx", "Fy", "Fz", "Mx", "My")
+#: the ring of contacts 1..4
+CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
 DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
 
 
@@ -303,9 +305,9 @@ class BimeSolver:
         return f
 
     # ---- energy -------------------------------------------------------------------
-    def _contacts(self, e: np.ndarray):
+    def _contacts(self, e: np.ndarray, hessian: bool = True):
         """Spring terms for relative vectors ``e`` (B, 2, 2): elongation, force
-        vectors dPhi/de, contact energy and the 2x2 Hessian blocks."""
+        vectors dPhi/de, contact energy and (if asked) the 2x2 Hessian blocks."""
         a = self.assembly
         length = np.sqrt(e[..., 0] ** 2 + e[..., 1] ** 2)
         n = e / length[..., None]
@@ -314,6 +316,8 @@ class BimeSolver:
         q = a.stiffness * dpos**1.5                                         # eq 8
         energy = 0.4 * float(np.sum(a.stiffness * dpos**2.5))               # eq 1
         force = q[..., None] * n
+        if not hessian:
+            return delta, q, force, energy, None, n, length
         k_normal = 1.5 * a.stiffness * np.sqrt(dpos)
         nn = n[..., :, None] * n[..., None, :]
         eye = np.eye(2)
@@ -371,12 +375,13 @@ class BimeSolver:
             hessian[5 + 4 * n:, 5 + 4 * n:] += k_in
         return energy, grad, hessian
 
-    def _energy(self, qs, y, e0, f_scaled):
-        e = e0 + self.jacobian @ qs if self.compliance is None else \
-            e0 + self.jacobian @ qs - (self.compliance @ y).reshape(e0.shape)
-        *_, energy, _, _, _ = self._contacts(e)
-        ring = 0.0 if self.compliance is None else 0.5 * float(y @ (self.compliance @ y))
-        return energy + ring - float(f_scaled @ qs)
+    def potential_energy(self, x: np.ndarray, loads: Loads | None = None) -> float:
+        """Total potential energy (eq 20) of the rigid model at ``x = (X, Y, Z, rx, ry)``, J
+        (energy only: for comparisons with derivative-free minimisers)."""
+        loads = Loads() if loads is None else loads
+        x = np.asarray(x, dtype=float)
+        e = self.assembly.separation + self.jacobian @ (x * [1.0, 1.0, 1.0, self.length, self.length])
+        return self._contacts(e, hessian=False)[3] - float(loads.as_array() @ x)
 
     # ---- solve --------------------------------------------------------------------
     def solve(self, loads: Loads | None = None, initial: "LoadDistribution | np.ndarray | None" = None
@@ -403,8 +408,6 @@ class BimeSolver:
         f_scaled = self._scaled_load(loads)
         flexible = self.compliance is not None
         n_balls = self.bearing.ball_count
-        e0 = self.assembly.separation
-        jac = self.jacobian
         dw = self.bearing.ball_diameter
 
         qs = np.zeros(5)
@@ -415,32 +418,27 @@ class BimeSolver:
             if flexible and state.size == 5 + 4 * n_balls:
                 y = state[5:].copy()
         elif flexible:
-            # start from the rigid solution: contact forces felt by the rings
+            # start from the rigid solution: the rings feel its contact forces
             rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, rtol=1e-6,
                                max_iterations=self.max_iterations)
             rigid.edge_angle = np.full(4, np.pi)  # no truncation check on the starting guess
             start = rigid.solve(loads)
             qs = start.state[:5].copy()
-            e_start = e0 + jac @ qs
-            y = rigid._contacts(e_start)[2].ravel()
+            y = rigid._evaluate(qs, y, f_scaled).force.ravel()
 
         trust = 0.02 * dw
         mu = 1e-12 * self.reference_stiffness
         iterations = 0
-        residual = math.inf
+        point = self._evaluate(qs, y, f_scaled)
         while True:
-            e = e0 + jac @ qs
-            if flexible:
-                e = e - (self.compliance @ y).reshape(e0.shape)
-            delta, q, force, energy, hess, n, length = self._contacts(e)
-            f = force.ravel()
-            grad_q = np.einsum("bkcj,bkc->j", jac, force) - f_scaled
-            scale = max(float(np.abs(f_scaled).max()), float(q.max()), 1e-300)
+            f = point.force.ravel()
+            grad_q = self.jacobian.reshape(-1, 5).T @ f - f_scaled
+            scale = max(float(np.abs(f_scaled).max()), float(point.q.max()), 1e-300)
             residual = float(np.abs(grad_q).max())
             if flexible:
-                residual = max(residual, float(np.abs(f - y).max()))
+                residual = max(residual, float(np.abs(f - point.y).max()))
             residual /= scale
-            if residual <= self.rtol or (not np.any(q > 0) and not np.any(f_scaled)):
+            if residual <= self.rtol or (not np.any(point.q > 0) and not np.any(f_scaled)):
                 break
             if iterations >= self.max_iterations:
                 raise NoEquilibriumError(
@@ -448,72 +446,84 @@ class BimeSolver:
                     f"for loads {loads}")
             iterations += 1
 
-            # ---- Newton direction ----
-            if not flexible:
-                h = np.einsum("bkci,bkcd,bkdj->ij", jac, hess, jac)
-                dq = np.linalg.solve(h + mu * np.eye(5), -grad_q)
-                dy = y  # empty: no ring unknowns
-            else:
-                active = (delta > 1e-15 * dw).ravel()
-                idx = np.flatnonzero(np.repeat(active, 2))
-                nn = n[..., :, None] * n[..., None, :]
-                k_normal = 1.5 * self.assembly.stiffness * np.sqrt(np.maximum(delta, 0.0))
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    a_inv = (nn / k_normal[..., None, None]
-                             + (length / q)[..., None, None] * (np.eye(2) - nn))  # A^-1, active blocks
-                a_inv = a_inv.reshape(-1, 2, 2)[active]
-                na = idx.size
-                w_mat = self.compliance[np.ix_(idx, idx)].copy()
-                blocks = np.arange(0, na, 2)
-                for r_ in range(2):
-                    for c_ in range(2):
-                        w_mat[blocks + r_, blocks + c_] += a_inv[:, r_, c_]
-                my = self.compliance @ y
-                rhs = np.einsum("aij,aj->ai", a_inv, f[idx].reshape(-1, 2)).ravel() + my[idx]
-                ja = jac.reshape(-1, 5)[idx] if na else np.zeros((0, 5))
-                if na:
-                    chol = np.linalg.cholesky(w_mat)
-                    z_mat = _cho_solve(chol, ja)
-                    w_vec = _cho_solve(chol, rhs)
-                    schur = ja.T @ z_mat
-                    dq = np.linalg.solve(schur + mu * np.eye(5), f_scaled - ja.T @ w_vec)
-                    y_new = np.zeros_like(y)
-                    y_new[idx] = w_vec + z_mat @ dq
-                else:
-                    dq = np.linalg.solve(mu * np.eye(5), f_scaled)
-                    y_new = np.zeros_like(y)
-                dy = y_new - y
-            norm = float(np.linalg.norm(dq))
-            if norm > trust:
-                dq = dq * (trust / norm)
-                if flexible:
-                    dy = dy * (trust / norm)
-
-            # ---- backtracking line search on the energy ----
-            u0 = energy + (0.5 * float(y @ (self.compliance @ y)) if flexible else 0.0) - float(f_scaled @ qs)
-            slope = float(grad_q @ dq)
             if flexible:
-                slope -= float((self.compliance @ (f - y)) @ dy)
+                dq, dy = self._flexible_direction(point, f_scaled, mu)
+                slope = float(grad_q @ dq) - float((self.compliance @ (f - point.y)) @ dy)
+            else:
+                dq, dy = self._rigid_direction(point, grad_q, mu), point.y
+                slope = float(grad_q @ dq)
+            norm = float(np.linalg.norm(dq))
+            if norm > trust:  # a step across a clearance is limited, then checked by the energy
+                dq, dy = dq * (trust / norm), dy * (trust / norm)
+                slope *= trust / norm
+
+            # backtracking line search on the total energy (convex)
             t = 1.0
             for _ in range(60):
-                u = self._energy(qs + t * dq, y + t * dy if flexible else y, e0, f_scaled)
-                if u <= u0 + 1e-4 * t * min(slope, 0.0) + 1e-13 * abs(u0):
+                trial = self._evaluate(point.qs + t * dq, point.y + t * dy if flexible else point.y, f_scaled)
+                if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + 1e-13 * abs(point.total):
                     break
                 t *= 0.5
             else:
                 raise NoEquilibriumError(f"line search failed (relative residual {residual:.2e}) for loads {loads}")
-            qs = qs + t * dq
-            if flexible:
-                y = y + t * dy
-            if np.linalg.norm(qs) > dw:
+            point = trial
+            if np.linalg.norm(point.qs) > dw:
                 raise NoEquilibriumError(
-                    f"no equilibrium for loads {loads}: the moving ring would move {np.linalg.norm(qs) * 1e3:.3g} mm, "
-                    f"beyond the ball diameter ({dw * 1e3:g} mm); no contact resists this load")
+                    f"no equilibrium for loads {loads}: the moving ring would move "
+                    f"{np.linalg.norm(point.qs) * 1e3:.3g} mm, beyond the ball diameter ({dw * 1e3:g} mm); "
+                    f"no contact resists this load")
 
-        return self._result(loads, qs, y, e, delta, q, energy, iterations, residual, f_scaled)
+        return self._result(loads, point, iterations, residual)
 
-    def _result(self, loads, qs, y, e, delta, q, energy, iterations, residual, f_scaled) -> LoadDistribution:
+    def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray) -> "_Point":
+        """Contact terms and total energy at the unknowns ``(qs, y)``."""
+        e = self.assembly.separation + self.jacobian @ qs
+        ring = 0.0
+        if self.compliance is not None:
+            my = self.compliance @ y
+            e = e - my.reshape(e.shape)       # e_D = -M y: groove centres moved by ring deformation
+            ring = 0.5 * float(y @ my)        # eq 15
+        delta, q, force, energy, hess, n, length = self._contacts(e)
+        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - float(f_scaled @ qs), energy)
+
+    def _rigid_direction(self, p: "_Point", grad_q: np.ndarray, mu: float) -> np.ndarray:
+        """Newton step of the rigid model: ``(sum J^T A J) dq = -grad``."""
+        jac = self.jacobian
+        h = jac.reshape(-1, 5).T @ (p.hess.reshape(-1, 2, 2) @ jac.reshape(-1, 2, 5)).reshape(-1, 5)
+        return np.linalg.solve(h + mu * np.eye(5), -grad_q)
+
+    def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float):
+        """Newton step of the flexible model, reduced to the active contacts
+        (module docstring): returns the increments of ``qs`` and ``y``."""
+        dw = self.bearing.ball_diameter
+        active = (p.delta > 1e-15 * dw).ravel()
+        idx = np.flatnonzero(np.repeat(active, 2))
+        y_new = np.zeros_like(p.y)
+        if idx.size == 0:
+            return np.linalg.solve(mu * np.eye(5), f_scaled), y_new - p.y
+        nn = p.n[..., :, None] * p.n[..., None, :]
+        k_normal = 1.5 * self.assembly.stiffness * np.sqrt(np.maximum(p.delta, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a_inv = nn / k_normal[..., None, None] + (p.length / p.q)[..., None, None] * (np.eye(2) - nn)
+        a_inv = a_inv.reshape(-1, 2, 2)[active]           # A^-1 of the active diagonals
+        w_mat = self.compliance[np.ix_(idx, idx)]         # (A^-1 + M)_aa
+        blocks = np.arange(0, idx.size, 2)
+        for r in range(2):
+            for c in range(2):
+                w_mat[blocks + r, blocks + c] += a_inv[:, r, c]
+        rhs = (a_inv @ p.force.reshape(-1, 2)[active][..., None]).ravel() + (self.compliance[idx] @ p.y)
+        ja = self.jacobian.reshape(-1, 5)[idx]
+        chol = np.linalg.cholesky(w_mat)
+        z_mat = _cho_solve(chol, ja)
+        w_vec = _cho_solve(chol, rhs)
+        dq = np.linalg.solve(ja.T @ z_mat + mu * np.eye(5), f_scaled - ja.T @ w_vec)
+        y_new[idx] = w_vec + z_mat @ dq
+        return dq, y_new - p.y
+
+
+    def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float) -> LoadDistribution:
         a = self.assembly
+        qs, y, e, delta, q = p.qs, p.y, p.e, p.delta, p.q
         b = self.bearing
         flexible = self.compliance is not None
         # per contact 1..4 from the diagonals: contacts (1,3) <- diagonal 1, (2,4) <- diagonal 2
@@ -525,14 +535,9 @@ class BimeSolver:
         ring_disp = None
         if flexible:
             ring_disp = self._ring_displacement(y)
-        semi_a = np.empty_like(contact_load)
-        semi_b = np.empty_like(contact_load)
-        pressure = np.empty_like(contact_load)
-        for ring, contacts in RING_CONTACTS.items():
-            cols = [c - 1 for c in contacts]
-            ell = hertz_ellipse(contact_load[:, cols], a.ball_diameter[:, None], a.groove_radius[:, cols],
-                                contact_angle[:, cols], b.pitch_diameter, ring, b.youngs_modulus, b.poisson_ratio)
-            semi_a[:, cols], semi_b[:, cols], pressure[:, cols] = ell.a, ell.b, ell.max_pressure
+        ell = hertz_ellipse(contact_load, a.ball_diameter[:, None], a.groove_radius, contact_angle,
+                            b.pitch_diameter, CONTACT_RING, b.youngs_modulus, b.poisson_ratio)
+        semi_a, semi_b, pressure = ell.a, ell.b, ell.max_pressure
         # truncation: the ellipse must stay on the raceway (below the groove edge)
         reach = contact_angle + semi_a / a.groove_radius
         over = (contact_load > 0.0) & (reach >= self.edge_angle[None, :])
@@ -546,13 +551,11 @@ class BimeSolver:
                 f"{math.degrees(self.edge_angle[contact]):.1f} deg")
         displacement = qs.copy()
         displacement[3:] /= self.length
-        ring_energy = 0.5 * float(y @ (self.compliance @ y)) if flexible else 0.0
-        total = energy + ring_energy - float(f_scaled @ qs)
         return LoadDistribution(
             model=self.model, loads=loads, displacement=displacement, ball_angle=a.ball_angle.copy(),
             contact_load=contact_load, contact_angle=contact_angle, interference=delta.copy(),
             contact_deflection=deflection, ring_displacement=ring_disp, semi_axis_a=semi_a, semi_axis_b=semi_b,
-            contact_pressure=pressure, energy=total, iterations=iterations, residual=residual,
+            contact_pressure=pressure, energy=p.total, iterations=iterations, residual=residual,
             state=np.concatenate([qs, y]),
         )
 
@@ -576,6 +579,23 @@ class BimeSolver:
         if ring not in cache:
             cache[ring] = _pseudo_inverse_circulant(np.asarray(getattr(self.superelement, ring).first_row, float))
         return cache[ring]
+
+
+@dataclass
+class _Point:
+    """Unknowns and the contact terms evaluated there (one Newton iterate)."""
+
+    qs: np.ndarray
+    y: np.ndarray
+    e: np.ndarray
+    delta: np.ndarray
+    q: np.ndarray
+    force: np.ndarray
+    hess: np.ndarray
+    n: np.ndarray
+    length: np.ndarray
+    total: float
+    contact_energy: float
 
 
 def _ring_index(n: int, slots: np.ndarray) -> np.ndarray:

@@ -107,9 +107,11 @@ def _curvature_difference(kappa):
     return ((kappa**2 + 1.0) * e - 2.0 * k) / ((kappa**2 - 1.0) * e)
 
 
-# Table of F(rho) against log(kappa), built once: inverting it by interpolation
-# costs microseconds per call instead of an iteration per contact.
+# Table of F(rho), K and E against log(kappa), built once: inverting it by
+# interpolation costs microseconds per call instead of an iteration per contact
+# (checked against an independent exact solution in tests/test_contact.py).
 _LOG_KAPPA = np.linspace(1e-6, math.log(200.0), 6001)
+_K_TABLE, _E_TABLE = elliptic_integrals(1.0 - np.exp(-2.0 * _LOG_KAPPA))
 _F_TABLE = _curvature_difference(np.exp(_LOG_KAPPA))
 
 
@@ -147,7 +149,8 @@ def raceway_curvatures(ball_diameter, groove_radius, contact_angle, pitch_diamet
     """
     dw = np.asarray(ball_diameter, dtype=float)
     gamma = dw * np.cos(contact_angle) / pitch_diameter
-    rolling = 2.0 / dw * gamma / (1.0 - gamma) if ring == "inner" else -2.0 / dw * gamma / (1.0 + gamma)
+    inner = np.asarray(ring) == "inner"
+    rolling = np.where(inner, 2.0 / dw * gamma / (1.0 - gamma), -2.0 / dw * gamma / (1.0 + gamma))
     transverse = -1.0 / np.asarray(groove_radius, dtype=float)
     rho_ball = 2.0 / dw
     sum_rho = 2.0 * rho_ball + rolling + transverse
@@ -166,8 +169,9 @@ def hertz_ellipse(load, ball_diameter, groove_radius, contact_angle, pitch_diame
     ball_diameter, groove_radius : float or array, m
     contact_angle : float or array, rad
     pitch_diameter : float, m
-    ring : str
-        ``"inner"`` or ``"outer"`` (sign of the rolling-direction curvature).
+    ring : str or array of str
+        ``"inner"`` or ``"outer"`` (sign of the rolling-direction curvature),
+        per contact if an array.
     youngs_modulus : float, Pa
     poisson_ratio : float
 
@@ -182,8 +186,10 @@ def hertz_ellipse(load, ball_diameter, groove_radius, contact_angle, pitch_diame
     """
     q = np.maximum(np.asarray(load, dtype=float), 0.0)
     sum_rho, f_rho = raceway_curvatures(ball_diameter, groove_radius, contact_angle, pitch_diameter, ring)
-    kappa = ellipticity(f_rho)
-    k_int, e_int = elliptic_integrals(1.0 - 1.0 / kappa**2)
+    log_kappa = np.interp(f_rho, _F_TABLE, _LOG_KAPPA, left=0.0)
+    kappa = np.exp(log_kappa)
+    k_int = np.interp(log_kappa, _LOG_KAPPA, _K_TABLE)
+    e_int = np.interp(log_kappa, _LOG_KAPPA, _E_TABLE)
     e_eff = effective_modulus(youngs_modulus, poisson_ratio)
     base = 3.0 * q / (sum_rho * e_eff)
     a = (2.0 * kappa**2 * e_int / np.pi * base) ** (1.0 / 3.0)
