@@ -47,6 +47,8 @@ class Assembly:
     ----------
     psi : float, rad
         Rotation of the moving ring.
+    cage_angle : float, rad
+        Rotation of the ball set.
     ball_angle : ndarray (B,), rad
         ``phi_b`` in the fixed frame.
     groove_centre : ndarray (B, 4, 2), m
@@ -65,6 +67,7 @@ class Assembly:
     """
 
     psi: float
+    cage_angle: float
     ball_angle: np.ndarray
     groove_centre: np.ndarray
     groove_radius: np.ndarray
@@ -87,7 +90,7 @@ class Assembly:
         return self.groove_centre[:, cols]
 
 
-def assemble(bearing: Bearing, psi: float = 0.0) -> Assembly:
+def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None) -> Assembly:
     """Groove centres, groove radii, ball diameters and spring constants at ``psi``.
 
     Parameters
@@ -95,13 +98,17 @@ def assemble(bearing: Bearing, psi: float = 0.0) -> Assembly:
     bearing : Bearing
     psi : float, rad
         Rotation of the moving ring from the reference position.
+    cage_angle : float, rad, optional
+        Rotation of the ball set (cage); default ``cage_ratio(bearing) * psi``
+        (rolling without slip).
 
     Returns
     -------
     Assembly
     """
     n = bearing.ball_count
-    phi = bearing.ball_angles + cage_ratio(bearing) * psi
+    cage = cage_ratio(bearing) * psi if cage_angle is None else cage_angle
+    phi = bearing.ball_angles + cage
     centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()
     radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
     dw = np.full(n, bearing.ball_diameter + bearing.preload)
@@ -126,7 +133,7 @@ def assemble(bearing: Bearing, psi: float = 0.0) -> Assembly:
     k_tot = diagonal_stiffness(k[:, OUTER_OF_DIAGONAL], k[:, INNER_OF_DIAGONAL])
     natural = radius[:, OUTER_OF_DIAGONAL] + radius[:, INNER_OF_DIAGONAL] - dw[:, None]
     return Assembly(
-        psi=float(psi), ball_angle=phi, groove_centre=centre, groove_radius=radius, ball_diameter=dw,
+        psi=float(psi), cage_angle=float(cage), ball_angle=phi, groove_centre=centre, groove_radius=radius, ball_diameter=dw,
         contact_stiffness=k, stiffness=k_tot, natural_length=natural,
         moving_sign=1.0 if bearing.moving_ring == "inner" else -1.0,
     )

@@ -260,13 +260,18 @@ class BimeSolver:
         None for rigid rings.
     psi : float, rad
         Rotation of the moving ring.
+    cage_angle : float, rad, optional
+        Rotation of the ball set; default: rolling without slip from ``psi``.
     rtol : float
         Relative tolerance of the stopping rule.
     max_iterations : int
+    compliance : ndarray, optional
+        Precomputed :func:`contact_compliance` of ``superelement`` (shared
+        between solvers of the same bearing).
     """
 
-    def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, rtol: float = 1e-10,
-                 max_iterations: int = 200, compliance: np.ndarray | None = None):
+    def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
+                 rtol: float = 1e-10, max_iterations: int = 200, compliance: np.ndarray | None = None):
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
             raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
                              f"the bearing ball_count = {bearing.ball_count}")
@@ -280,12 +285,13 @@ class BimeSolver:
             None if superelement is None else contact_compliance(superelement))
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
-        self.set_rotation(psi)
+        self.set_rotation(psi, cage_angle)
 
     # ---- set-up -------------------------------------------------------------------
-    def set_rotation(self, psi: float) -> None:
-        """Re-assemble at another rotation of the moving ring (errors move with the rings)."""
-        self.assembly: Assembly = assemble(self.bearing, psi)
+    def set_rotation(self, psi: float, cage_angle: float | None = None) -> None:
+        """Re-assemble at another rotation of the moving ring (errors move with
+        the rings; the ring matrices do not change: the rings are axisymmetric)."""
+        self.assembly: Assembly = assemble(self.bearing, psi, cage_angle)
         a = self.assembly
         phi = a.ball_angle[:, None]
         r, z = a.moving_centre[..., 0], a.moving_centre[..., 1]
@@ -419,7 +425,7 @@ class BimeSolver:
                 y = state[5:].copy()
         elif flexible:
             # start from the rigid solution: the rings feel its contact forces
-            rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, rtol=1e-6,
+            rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, cage_angle=self.assembly.cage_angle, rtol=1e-6,
                                max_iterations=self.max_iterations)
             rigid.edge_angle = np.full(4, np.pi)  # no truncation check on the starting guess
             start = rigid.solve(loads)
@@ -619,8 +625,8 @@ def _cho_solve(chol: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 
 def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid", superelement=None,
-          bc: str = "free", mesh: str = "coarse", psi: float = 0.0, initial=None, rtol: float = 1e-10
-          ) -> LoadDistribution:
+          bc: str = "free", mesh: str = "coarse", psi: float = 0.0, cage_angle: float | None = None,
+          initial=None, rtol: float = 1e-10) -> LoadDistribution:
     """Load distribution of ``bearing`` under ``loads``: the one obvious entry point.
 
     Parameters
@@ -638,6 +644,8 @@ def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid",
     mesh : {"coarse", "fine"}
     psi : float, rad
         Rotation of the moving ring.
+    cage_angle : float, rad, optional
+        Rotation of the ball set; default: rolling without slip from ``psi``.
     initial : LoadDistribution, optional
         Warm start.
     rtol : float
@@ -661,5 +669,6 @@ def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid",
         from .superelement import build_superelement
 
         superelement = build_superelement(bearing, mesh=mesh, bc=bc)
-    solver = BimeSolver(bearing, superelement if model == "flexible" else None, psi=psi, rtol=rtol)
+    solver = BimeSolver(bearing, superelement if model == "flexible" else None, psi=psi, cage_angle=cage_angle,
+                        rtol=rtol)
     return solver.solve(loads, initial=initial)
