@@ -672,3 +672,55 @@ def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid",
     solver = BimeSolver(bearing, superelement if model == "flexible" else None, psi=psi, cage_angle=cage_angle,
                         rtol=rtol)
     return solver.solve(loads, initial=initial)
+
+
+def solve_dense_newton(solver: BimeSolver, loads: Loads | None = None, *, rtol: float = 1e-10,
+                       max_iterations: int = 100) -> tuple[np.ndarray, int]:
+    """Reference solver: plain Newton on all ``5 + 8B`` unknowns of eq 20 with a
+    dense factorisation of the full Hessian (:meth:`BimeSolver.energy_terms`).
+
+    The baseline the structured solver is measured against, and an independent
+    check of it. A free ring's rigid-body modes are fixed by a penalty on the
+    ring's null space (they are redundant with the moving ring's ``q``; the
+    minimum is the same).
+
+    Returns
+    -------
+    x : ndarray (5 + 8B,)
+        ``(X, Y, Z, rx, ry, D_out, D_in)``.
+    iterations : int
+    """
+    loads = Loads() if loads is None else loads
+    n = solver.bearing.ball_count
+    se = solver.superelement
+    x = np.zeros(5 + 8 * n)
+    start = BimeSolver(solver.bearing, None, psi=solver.assembly.psi, cage_angle=solver.assembly.cage_angle)
+    start.edge_angle = np.full(4, np.pi)
+    x[:5] = start.solve(loads).displacement
+    gauge = np.zeros((8 * n, 8 * n))
+    for k, ring in enumerate((se.outer, se.inner)):
+        dense = ring.dense()
+        w, v = np.linalg.eigh(dense)
+        null = v[:, np.abs(w) <= 1e-9 * np.abs(w).max()]
+        sl = slice(4 * n * k, 4 * n * (k + 1))
+        gauge[sl, sl] = np.abs(w).max() * null @ null.T
+    units = np.ones(5 + 8 * n)
+    units[3:5] = 1.0 / solver.length  # moments as forces at the pitch radius
+
+    def objective(x):
+        u, g, h = solver.energy_terms(x, loads)
+        return u + 0.5 * x[5:] @ gauge @ x[5:], np.concatenate([g[:5], g[5:] + gauge @ x[5:]]), h
+
+    for iteration in range(max_iterations + 1):
+        u, g, h = objective(x)
+        if iteration:
+            force_scale = max(float(np.abs(loads.as_array() * units[:5]).max()), 1.0)
+            if np.abs(g * units).max() <= rtol * force_scale:
+                return x, iteration
+        h[5:, 5:] += gauge
+        step = np.linalg.solve(h, -g)
+        t = 1.0
+        while objective(x + t * step)[0] > u + 1e-4 * t * (g @ step) + 1e-13 * abs(u) and t > 1e-12:
+            t *= 0.5
+        x = x + t * step
+    raise NoEquilibriumError(f"dense Newton: no convergence after {max_iterations} iterations")

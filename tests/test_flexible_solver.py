@@ -1,0 +1,71 @@
+"""The structured Flexible-BIME Newton solver (paper eq 20) on a ring model with a known
+stiffness matrix: against the dense Newton on all 5 + 8B unknowns, statics, limits."""
+import numpy as np
+import pytest
+
+from slewing_model import BimeSolver, Loads, solve
+from slewing_model.bime import solve_dense_newton
+from synthetic_rings import synthetic_superelement
+
+LOADS = [Loads(), Loads(Fx=2e4, Fz=5e4, My=1e4), Loads(Fy=-3e4, Mx=-2e4, My=1.5e4)]
+
+
+@pytest.fixture(scope="module")
+def bearing(table3):
+    return table3.with_preload(20e-6)
+
+
+@pytest.mark.parametrize("loads", LOADS)
+def test_structured_newton_equals_dense_newton(bearing, loads):
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    r = solver.solve(loads)
+    x, _ = solve_dense_newton(solver, loads)
+    n = bearing.ball_count
+    assert np.allclose(r.displacement, x[:5], rtol=1e-8, atol=1e-12)
+    d = r.ring_displacement
+    assert np.allclose(d[:, [0, 3]].ravel(), x[5:5 + 4 * n], atol=1e-12)   # outer ring: contacts 1, 4
+    assert np.allclose(d[:, [1, 2]].ravel(), x[5 + 4 * n:], atol=1e-12)   # inner ring: contacts 2, 3
+
+
+def _contact_force_vectors(r):
+    """(B, 2, 2) force of the outer ring on the inner ring's groove centre, per diagonal, (r, z)."""
+    alpha1, alpha2 = r.contact_angle[:, 0], r.contact_angle[:, 1]
+    n1 = np.stack([np.cos(alpha1), np.sin(alpha1)], axis=1)
+    n2 = np.stack([np.cos(alpha2), -np.sin(alpha2)], axis=1)
+    return -np.stack([r.contact_load[:, 0:1] * n1, r.contact_load[:, 1:2] * n2], axis=1)
+
+
+@pytest.mark.parametrize("loads", LOADS)
+def test_each_ring_balances_its_contact_forces(bearing, loads):
+    se = synthetic_superelement(bearing.ball_count)
+    r = solve(bearing, loads, model="flexible", superelement=se)
+    f = _contact_force_vectors(r)                      # on the inner ring; the outer ring gets -f
+    d = r.ring_displacement
+    on_inner = np.stack([f[:, 1], f[:, 0]], axis=1)    # inner DOF order: contact 2 (diag 2), 3 (diag 1)
+    on_outer = -f                                      # outer DOF order: contact 1 (diag 1), 4 (diag 2)
+    scale = r.max_ball_load
+    assert np.allclose(se.inner.dense() @ d[:, [1, 2]].ravel(), on_inner.ravel(), atol=1e-7 * scale)
+    assert np.allclose(se.outer.dense() @ d[:, [0, 3]].ravel(), on_outer.ravel(), atol=1e-7 * scale)
+
+
+def test_very_stiff_rings_give_the_rigid_result(bearing):
+    loads = LOADS[1]
+    stiff = solve(bearing, loads, model="flexible", superelement=synthetic_superelement(bearing.ball_count, 1e6))
+    rigid = solve(bearing, loads)
+    assert np.allclose(stiff.contact_load, rigid.contact_load, rtol=1e-3, atol=1e-3 * rigid.max_ball_load)
+
+
+def test_flexible_rings_lower_the_preload_interference(bearing):
+    # the preload compresses the rings too, so the contacts keep less than the ball oversize
+    r = solve(bearing, model="flexible", superelement=synthetic_superelement(bearing.ball_count))
+    assert np.all(r.interference < 20e-6) and np.all(r.interference > 0)
+
+
+def test_warm_start_after_small_load_change(bearing):
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    first = solver.solve(LOADS[1])
+    changed = Loads(*(1.01 * LOADS[1].as_array()))
+    warm = solver.solve(changed, initial=first)
+    cold = solver.solve(changed)
+    assert warm.iterations <= 3 < cold.iterations + 1
+    assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
