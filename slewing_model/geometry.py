@@ -24,11 +24,6 @@ from typing import Any, Mapping
 
 import numpy as np
 
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
-
 #: contact numbers in array order: column ``i`` of every (B, 4) array is contact ``i + 1``
 CONTACTS = (1, 2, 3, 4)
 #: the two diagonals as (outer-ring contact, inner-ring contact), 1-based
@@ -417,6 +412,11 @@ def load_bearing(path: str | os.PathLike) -> Bearing:
     >>> round(b.pitch_diameter, 3), b.ball_count
     (1.5, 100)
     """
+    try:  # Python >= 3.11; imported here so that the FMU's run time needs no TOML reader
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+
     path = os.fspath(path)
     try:
         with open(path, "rb") as fh:

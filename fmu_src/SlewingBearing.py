@@ -1,0 +1,262 @@
+"""FMI 2.0 co-simulation slave of a four-point contact slewing bearing (pythonfmu).
+
+A thin wrapper: it maps FMI variables onto :class:`slewing_model.simulator.BearingSimulator`
+and holds no physics. ``build_fmu.py`` packages it with the run-time part of
+``slewing_model``, the bearing definition (``bearing.json``) and the ring
+superelement (``superelement.npz``) in the FMU's resources.
+
+What pythonfmu 0.7.0 does not write, :meth:`SlewingBearing.to_xml` adds:
+units and ``UnitDefinitions``, ``ModelStructure/Outputs`` dependencies and
+``InitialUnknowns``. The FMU state (``canGetAndSetFMUstate``) holds the
+registered variables and the solver's warm start.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import traceback
+from xml.etree.ElementTree import Element, SubElement
+
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
+from pythonfmu.enums import Fmi2Initial, Fmi2Status
+from pythonfmu.default_experiment import DefaultExperiment
+
+
+from slewing_model import Bearing, Loads, NoEquilibriumError
+from slewing_model.simulator import BearingSimulator, SimulatorSettings
+
+#: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
+UNITS = {
+    "N": (1, 1, -2, 0),
+    "N.m": (1, 2, -2, 0),
+    "m": (0, 1, 0, 0),
+    "rad": (0, 0, 0, 1),
+    "rad/s": (0, 0, -1, 1),
+    "Pa": (1, -1, -2, 0),
+    "1": (0, 0, 0, 0),
+}
+
+INPUTS = [  # name, unit, description
+    ("Fx", "N", "force on the moving ring along x"),
+    ("Fy", "N", "force on the moving ring along y"),
+    ("Fz", "N", "axial force on the moving ring, > 0 pushes the inner ring towards +z (loads contacts 1 and 3)"),
+    ("Mx", "N.m", "tilting moment on the moving ring about x"),
+    ("My", "N.m", "tilting moment on the moving ring about y"),
+    ("psi", "rad", "rotation angle of the moving ring"),
+    ("omega", "rad/s", "rotation speed of the moving ring"),
+]
+
+OUTPUTS = [  # name, unit, description
+    ("x", "m", "displacement of the moving ring along x"),
+    ("y", "m", "displacement of the moving ring along y"),
+    ("z", "m", "axial displacement of the moving ring"),
+    ("rx", "rad", "tilt of the moving ring about x"),
+    ("ry", "rad", "tilt of the moving ring about y"),
+    ("friction_torque", "N.m", "friction torque on the moving ring about z, opposing omega"),
+    ("friction_torque_magnitude", "N.m", "magnitude of the friction torque at full sliding"),
+    ("max_ball_load", "N", "largest ball-raceway contact load"),
+    ("max_contact_pressure", "Pa", "largest Hertz contact pressure"),
+    ("static_safety_factor", "1", "ISO 76 static safety factor (4200 MPa / p_max)^3"),
+]
+
+RING_MODELS = {1: "rigid", 2: "flexible"}
+MOVING_RINGS = {1: "inner", 2: "outer"}
+LOAD_FRAMES = {1: "fixed", 2: "rotating"}
+
+
+class SlewingBearing(Fmi2Slave):
+    author = "slewing_model"
+    description = "Four-point contact slewing bearing: load distribution (Flexible-BIME) and friction torque"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        resources = self.resources or os.path.dirname(os.path.abspath(__file__))
+        with open(os.path.join(resources, "bearing.json")) as fh:
+            self.bearing = Bearing.from_si_dict(json.load(fh))
+        self.superelement_path = os.path.join(resources, "superelement.npz")
+        self.default_experiment = DefaultExperiment(start_time=0.0, stop_time=10.0, step_size=0.01)
+        self.modelName = "SlewingBearing"
+        self._units: dict[str, str] = {}
+        n = self.bearing.ball_count
+
+        # inputs
+        for name, unit, text in INPUTS:
+            setattr(self, name, 0.0)
+            self._real(name, unit, text, Fmi2Causality.input, Fmi2Variability.continuous)
+        # parameters
+        self.preload = self.bearing.preload
+        self.friction_coefficient = 0.1
+        self.seal_torque = 0.0
+        self.tolerance = 1e-9
+        self.ring_model = 2
+        self.moving_ring = 1 if self.bearing.moving_ring == "inner" else 2
+        self.load_frame = 1
+        self._real("preload", "m", "ball preload (oversize; < 0 for clearance)", Fmi2Causality.parameter,
+                   Fmi2Variability.fixed)
+        self._real("friction_coefficient", "1", "Coulomb friction coefficient of the raceway contacts (0: off)",
+                   Fmi2Causality.parameter, Fmi2Variability.tunable)
+        self._real("seal_torque", "N.m", "load-independent friction torque (seals, grease)",
+                   Fmi2Causality.parameter, Fmi2Variability.tunable)
+        self._real("tolerance", "1", "relative tolerance of the load distribution solver",
+                   Fmi2Causality.parameter, Fmi2Variability.fixed)
+        for name, choices, text in (("ring_model", RING_MODELS, "ring model"),
+                                    ("moving_ring", MOVING_RINGS, "ring the loads act on and that turns"),
+                                    ("load_frame", LOAD_FRAMES, "frame of the input loads")):
+            listing = ", ".join(f"{k} = {v}" for k, v in choices.items())
+            self.register_variable(Integer(name, causality=Fmi2Causality.parameter,
+                                           variability=Fmi2Variability.fixed, initial=Fmi2Initial.exact,
+                                           description=f"{text}: {listing}"), nested=False)
+        # outputs
+        for name, unit, text in OUTPUTS:
+            setattr(self, name, 0.0)
+            self._real(name, unit, text, Fmi2Causality.output, Fmi2Variability.continuous)
+        self.balls_in_four_point_contact = 0
+        self.register_variable(Integer("balls_in_four_point_contact", causality=Fmi2Causality.output,
+                                       variability=Fmi2Variability.discrete, initial=Fmi2Initial.calculated,
+                                       description="number of balls loaded on both diagonals"), nested=False)
+        self._q = [[0.0] * 4 for _ in range(n)]
+        self._alpha = [[0.0, 0.0] for _ in range(n)]
+        for i in range(1, n + 1):
+            for c in range(4):
+                self._real(f"ball[{i}].Q{c + 1}", "N", f"contact load of ball {i}, contact {c + 1}",
+                           Fmi2Causality.output, Fmi2Variability.continuous,
+                           getter=lambda i=i, c=c: self._q[i - 1][c])
+            for k, label in enumerate(("alpha13", "alpha24")):
+                self._real(f"ball[{i}].{label}", "rad",
+                           f"loaded contact angle of ball {i}, diagonal {label[-2]}-{label[-1]}",
+                           Fmi2Causality.output, Fmi2Variability.continuous,
+                           getter=lambda i=i, k=k: self._alpha[i - 1][k])
+        self.simulator: BearingSimulator | None = None
+
+    # ---- variables ------------------------------------------------------------------
+    def _real(self, name, unit, description, causality, variability, getter=None):
+        initial = None
+        if causality == Fmi2Causality.parameter:
+            initial = Fmi2Initial.exact
+        elif causality == Fmi2Causality.output:
+            initial = Fmi2Initial.calculated
+        self._units[name] = unit
+        self.register_variable(Real(name, causality=causality, variability=variability, initial=initial,
+                                    description=description, getter=getter), nested=False)
+
+    def to_xml(self, model_options=dict()) -> Element:
+        """pythonfmu's model description plus units, dependencies and initial unknowns."""
+        root = super().to_xml(model_options)
+        definitions = Element("UnitDefinitions")
+        for name, (kg, m, s, rad) in UNITS.items():
+            unit = SubElement(definitions, "Unit", name=name)
+            exponents = {k: str(v) for k, v in (("kg", kg), ("m", m), ("s", s), ("rad", rad)) if v}
+            SubElement(unit, "BaseUnit", exponents)
+        children = list(root)
+        root.insert(children.index(root.find("CoSimulation")) + 1, definitions)
+        index = {}
+        for i, sv in enumerate(root.find("ModelVariables"), start=1):
+            index[sv.get("name")] = i
+            real = sv.find("Real")
+            if real is not None and sv.get("name") in self._units:
+                real.set("unit", self._units[sv.get("name")])
+        inputs = " ".join(str(index[name]) for name, _, _ in INPUTS)
+        parameters = " ".join(str(index[v.name]) for v in self.vars.values() if v.causality == Fmi2Causality.parameter)
+        structure = root.find("ModelStructure")
+        for child in list(structure):
+            structure.remove(child)
+        outputs = SubElement(structure, "Outputs")
+        initial = SubElement(structure, "InitialUnknowns")
+        for v in self.vars.values():
+            if v.causality == Fmi2Causality.output:
+                SubElement(outputs, "Unknown", index=str(index[v.name]), dependencies=inputs)
+                SubElement(initial, "Unknown", index=str(index[v.name]), dependencies=f"{inputs} {parameters}")
+        return root
+
+    # ---- life cycle -----------------------------------------------------------------
+    # No exception may leave a slave method: an exception that reaches pythonfmu's C++
+    # layer leaves a C host's Python state broken (seen with ecos). Errors are logged
+    # and reported through the status of do_step instead.
+    def exit_initialization_mode(self):
+        if self._build_simulator():
+            self._update()
+
+    def _build_simulator(self) -> bool:
+        """Create the simulator from the parameters; log why not and return False."""
+        self.simulator = None
+        try:
+            for name, choices in (("ring_model", RING_MODELS), ("moving_ring", MOVING_RINGS),
+                                  ("load_frame", LOAD_FRAMES)):
+                value = getattr(self, name)
+                if value not in choices:
+                    raise ValueError(f"parameter {name} = {value}: must be one of "
+                                     + ", ".join(f"{k} ({v})" for k, v in choices.items()))
+            settings = SimulatorSettings(
+                ring_model=RING_MODELS[self.ring_model], moving_ring=MOVING_RINGS[self.moving_ring],
+                load_frame=LOAD_FRAMES[self.load_frame], preload=float(self.preload),
+                friction_coefficient=float(self.friction_coefficient), seal_torque=float(self.seal_torque),
+                tolerance=float(self.tolerance))
+            superelement = None
+            if settings.ring_model == "flexible":
+                from slewing_model.ring_stiffness import Superelement
+
+                superelement = Superelement.load(self.superelement_path, self.bearing)
+            self.simulator = BearingSimulator(self.bearing, superelement, settings)
+            return True
+        except ValueError as exc:
+            self.log(f"{self.instance_name}: {exc}", Fmi2Status.error)
+        except Exception:
+            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
+        return False
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self.simulator is None and not self._build_simulator():
+            return False
+        return self._update()
+
+    def _update(self) -> bool:
+        """Solve for the current inputs; on bad input log why and return False (fmi2Discard)."""
+        try:
+            for name, _, _ in INPUTS:
+                value = getattr(self, name)
+                if not math.isfinite(value):
+                    raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
+            sim = self.simulator
+            if (self.friction_coefficient, self.seal_torque) != (sim.settings.friction_coefficient,
+                                                                 sim.settings.seal_torque):
+                sim.tune(friction_coefficient=float(self.friction_coefficient), seal_torque=float(self.seal_torque))
+            result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
+        except (ValueError, NoEquilibriumError) as exc:
+            self.log(f"{self.instance_name}: step refused: {exc}", Fmi2Status.error)
+            return False
+        except Exception:  # never let a bug crash the host: report it
+            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
+            return False
+        d = result.distribution
+        self.x, self.y, self.z, self.rx, self.ry = map(float, d.displacement)
+        self.friction_torque = result.friction_torque
+        self.friction_torque_magnitude = result.friction_torque_magnitude
+        self.max_ball_load = d.max_ball_load
+        self.max_contact_pressure = d.max_contact_pressure
+        self.static_safety_factor = min(d.static_safety_factor, 1e300)
+        self.balls_in_four_point_contact = d.balls_in_four_point_contact
+        self._q = d.contact_load.tolist()
+        self._alpha = d.contact_angle[:, :2].tolist()
+        return True
+
+    # ---- FMU state -------------------------------------------------------------------
+    def _get_fmu_state(self):
+        state = {v.name: v.getter() for v in self.vars.values() if not v.name.startswith("ball[")}
+        state["_q"], state["_alpha"] = self._q, self._alpha
+        state["_simulator"] = None if self.simulator is None else self.simulator.get_state()
+        return state
+
+    def _set_fmu_state(self, state):
+        state = dict(state)
+        self._q, self._alpha = state.pop("_q"), state.pop("_alpha")
+        simulator = state.pop("_simulator")
+        for v in self.vars.values():
+            if v.name in state and v.setter is not None:
+                v.setter(state[v.name])
+            elif v.name in state:
+                setattr(self, v.name, state[v.name])
+        if simulator is not None:
+            if self.simulator is None:
+                self._build_simulator()
+            self.simulator.set_state(simulator)

@@ -1,0 +1,191 @@
+"""Time stepping of one bearing: what a co-simulation step asks of the library.
+
+:class:`BearingSimulator` holds a bearing, its (optional) superelement and the
+solver's warm start, and answers each step with the load distribution and the
+friction torque for the loads, the rotation ``psi`` and the speed ``omega`` of
+the moving ring. It knows nothing of FMI: the FMU in ``fmu_src/`` maps its
+variables onto this class, and scripts can use it directly.
+
+Its whole state is :meth:`BearingSimulator.get_state` (plain JSON data), so a
+step can be rolled back and repeated exactly.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .bime import BimeSolver, LoadDistribution, Loads, contact_compliance
+from .geometry import Bearing
+
+RING_MODELS = ("rigid", "flexible")
+LOAD_FRAMES = ("fixed", "rotating")
+
+
+@dataclass(frozen=True)
+class SimulatorSettings:
+    """Options of a :class:`BearingSimulator` (SI units).
+
+    Attributes
+    ----------
+    ring_model : {"rigid", "flexible"}
+    moving_ring : {"inner", "outer"}
+    load_frame : {"fixed", "rotating"}
+        Frame the loads are given in: the fixed ring's, or the moving ring's
+        (turned by ``psi``; e.g. blade root loads of a pitch bearing).
+    preload : float or None, m
+        Ball preload overriding the bearing definition.
+    friction_coefficient : float
+        Coulomb coefficient ``mu`` of the raceway contacts; 0 switches the
+        contact friction off.
+    seal_torque : float, N m
+        Load-independent friction torque (seals, grease).
+    tolerance : float
+        Relative tolerance of the load distribution solver.
+    """
+
+    ring_model: str = "flexible"
+    moving_ring: str = "inner"
+    load_frame: str = "fixed"
+    preload: float | None = None
+    friction_coefficient: float = 0.1
+    seal_torque: float = 0.0
+    tolerance: float = 1e-9
+
+    def __post_init__(self):
+        _choice("ring_model", self.ring_model, RING_MODELS)
+        _choice("moving_ring", self.moving_ring, ("inner", "outer"))
+        _choice("load_frame", self.load_frame, LOAD_FRAMES)
+        for name in ("friction_coefficient", "seal_torque", "tolerance"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ValueError(f"{name} = {value!r}: must be a finite number >= 0")
+        if not 0 < self.tolerance < 1e-2:
+            raise ValueError(f"tolerance = {self.tolerance!r}: must lie in (0, 0.01)")
+        if self.preload is not None and not math.isfinite(self.preload):
+            raise ValueError(f"preload = {self.preload!r}: must be finite")
+
+
+def _choice(name, value, allowed):
+    if value not in allowed:
+        raise ValueError(f"{name} = {value!r}: must be one of {', '.join(map(repr, allowed))}")
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What one step answers (SI units).
+
+    Attributes
+    ----------
+    distribution : LoadDistribution
+    friction_torque : float, N m
+        Signed: opposes ``omega`` (torque of the bearing on the moving ring).
+    friction_torque_magnitude : float, N m
+        At full sliding, whatever ``omega``.
+    """
+
+    distribution: LoadDistribution
+    friction_torque: float
+    friction_torque_magnitude: float
+
+
+@dataclass
+class BearingSimulator:
+    """Load distribution and friction torque, step after step, warm-started.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    superelement : Superelement, optional
+        Needed for ``settings.ring_model == "flexible"``.
+    settings : SimulatorSettings
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing, Loads
+    >>> from slewing_model.simulator import BearingSimulator, SimulatorSettings
+    >>> sim = BearingSimulator(load_bearing("examples/bearings/table3.toml"),
+    ...                        settings=SimulatorSettings(ring_model="rigid", friction_coefficient=0.0))
+    >>> r = sim.step(Loads(Fz=5e4), psi=0.0, omega=0.1)
+    >>> r.distribution.displacement[2] > 0
+    True
+    """
+
+    bearing: Bearing
+    superelement: object = None
+    settings: SimulatorSettings = field(default_factory=SimulatorSettings)
+
+    def __post_init__(self):
+        s = self.settings
+        if s.ring_model == "flexible" and self.superelement is None:
+            raise ValueError("ring_model = 'flexible' needs a superelement")
+        bearing = replace(self.bearing, moving_ring=s.moving_ring)
+        if s.preload is not None:
+            bearing = bearing.with_preload(s.preload)
+        self.bearing = bearing
+        compliance = contact_compliance(self.superelement) if s.ring_model == "flexible" else None
+        self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
+                                 rtol=s.tolerance, compliance=compliance)
+        self._warm: np.ndarray | None = None
+        self._psi = 0.0
+        self.last: StepResult | None = None
+
+    def tune(self, **changes) -> None:
+        """Change the tunable settings (``friction_coefficient``, ``seal_torque``)
+        between steps; the others need a new simulator."""
+        for name in changes:
+            if name not in ("friction_coefficient", "seal_torque"):
+                raise ValueError(f"{name} is not tunable: build a new simulator")
+        self.settings = replace(self.settings, **changes)
+
+    def step(self, loads: Loads, psi: float, omega: float) -> StepResult:
+        """Solve the step: load distribution at rotation ``psi`` (warm-started
+        from the previous step), then the friction torque at speed ``omega``.
+
+        Raises
+        ------
+        ValueError
+            A non-finite input, naming it.
+        NoEquilibriumError, LoadCapacityError
+            The load cannot be carried (state unchanged).
+        """
+        for name, value in (("psi", psi), ("omega", omega)):
+            if not math.isfinite(value):
+                raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
+        if self.settings.load_frame == "rotating":
+            loads = loads.rotated(psi)
+        if psi != self._psi or self._warm is None:
+            self.solver.set_rotation(psi)
+        distribution = self.solver.solve(loads, initial=self._warm)
+        magnitude = self.settings.seal_torque
+        if self.settings.friction_coefficient > 0.0:
+            from .friction import friction_torque
+
+            magnitude = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                        omega=1.0, seal_torque=self.settings.seal_torque).magnitude
+        signed = -magnitude * _regularised_sign(omega)
+        self._warm = distribution.state
+        self._psi = psi
+        self.last = StepResult(distribution, signed, magnitude)
+        return self.last
+
+    # ---- state -------------------------------------------------------------------
+    def get_state(self) -> dict:
+        """Everything that affects the next step, as plain JSON data."""
+        return {"warm": None if self._warm is None else self._warm.tolist(), "psi": self._psi}
+
+    def set_state(self, state: dict) -> None:
+        """Restore :meth:`get_state`."""
+        self._warm = None if state["warm"] is None else np.asarray(state["warm"], dtype=float)
+        self._psi = float(state["psi"])
+        self.solver.set_rotation(self._psi)
+
+
+#: speed (rad/s) below which the friction torque is scaled down linearly (see _regularised_sign)
+OMEGA_REGULARISATION = 1e-4
+
+
+def _regularised_sign(omega: float, width: float = OMEGA_REGULARISATION) -> float:
+    """``sign(omega)`` smoothed over ``|omega| < width``: ``omega / width`` there."""
+    return max(-1.0, min(1.0, omega / width))
