@@ -8,6 +8,12 @@ STAMP  := $(VENV)/.installed
 .PHONY: demo test bench clean
 
 $(STAMP): pyproject.toml
+	@# Debian packages: libtbb12 for the ecos C++ co-simulation host of the FMU tests
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libtbb.so.12 '; then \
+	  if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -qq && apt-get install -y -qq libtbb12 >/dev/null; \
+	  else echo "note: libtbb12 is missing and cannot be installed here (not root): the ecos host test will be skipped"; fi; \
+	fi
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[all]"

@@ -13,7 +13,9 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
+import site
 import sys
+import sysconfig
 import tempfile
 from pathlib import Path
 
@@ -54,23 +56,43 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="coarse", progress=F
             if source.exists():
                 shutil.copy2(source, package / source.name)
         (tmp / "bearing.json").write_text(json.dumps(bearing.to_dict()))
+        # where numpy lives in the building environment: the FMU's fallback when its host lacks numpy
+        (tmp / "python_paths.json").write_text(json.dumps(sorted(set(site.getsitepackages()))))
         superelement.save(tmp / "superelement.npz")
         built = FmuBuilder.build_FMU(
             ROOT / "fmu_src" / "SlewingBearing.py", dest=output,
-            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz"],
+            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz", tmp / "python_paths.json"],
             canGetAndSetFMUstate=True, canSerializeFMUstate=True,
             needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
         )
     return Path(built)
 
 
+def host_environment() -> dict[str, str]:
+    """Environment a C or C++ host on Linux needs to run the FMU.
+
+    pythonfmu's binary is not linked to libpython, and numpy's C extensions need
+    libpython's symbols loaded globally; nothing inside the FMU can do that (even
+    ``ctypes`` is such an extension), so the host process must preload it."""
+    libpython = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("INSTSONAME")
+    return {"LD_PRELOAD": str(libpython)}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("bearing", help="bearing definition (TOML)")
+    parser.add_argument("bearing", nargs="?", help="bearing definition (TOML)")
     parser.add_argument("-o", "--output", help="FMU file to write")
     parser.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free")
     parser.add_argument("--mesh", choices=("coarse", "fine"), default="coarse")
+    parser.add_argument("--host-env", action="store_true",
+                        help="only print the environment a C/C++ host on Linux needs (LD_PRELOAD of libpython)")
     args = parser.parse_args(argv)
+    if args.host_env:
+        for key, value in host_environment().items():
+            print(f"export {key}={value}")
+        return 0
+    if args.bearing is None:
+        parser.error("the bearing definition is required")
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True)
     print(f"wrote {path}")
     return 0

@@ -15,7 +15,30 @@ from __future__ import annotations
 import json
 import math
 import os
+import sys
 import traceback
+
+
+def _find_numpy() -> None:
+    """The FMU runs in its host's Python: if numpy is not there, try the
+    site-packages of the environment that built the FMU (python_paths.json)."""
+    try:
+        import numpy  # noqa: F401
+        return
+    except ImportError:
+        pass
+    here = os.path.dirname(os.path.abspath(__file__))
+    try:
+        with open(os.path.join(here, "python_paths.json")) as fh:
+            sys.path.extend(p for p in json.load(fh) if p not in sys.path)
+        import numpy  # noqa: F401
+    except (OSError, ImportError) as exc:
+        raise ImportError(
+            f"the slewing bearing FMU needs numpy in the Python {sys.version.split()[0]} that runs it "
+            f"({sys.executable}): install it there or add its site-packages to PYTHONPATH ({exc})") from None
+
+
+_find_numpy()
 from xml.etree.ElementTree import Element, SubElement
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
