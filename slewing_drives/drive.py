@@ -131,6 +131,8 @@ class DriveState:
     angle: float = 0.0          # rad
     speed: float = 0.0          # rad/s
     motor_torque: float = 0.0   # N m, per motor
+    mean_motor_torque: float = 0.0  # N m, per motor, averaged over the last step
+    motor_energy: float = 0.0   # J, mechanical energy delivered by the motors (positive work)
     position_integral: float = 0.0
     speed_integral: float = 0.0
     stuck: bool = True
@@ -168,6 +170,7 @@ class ElectricDrive:
         h = dt / self.substeps
         lag = math.exp(-h / p.torque_time_constant)
         friction = abs(friction_torque)
+        torque_sum = 0.0
         for _ in range(self.substeps):
             # position loop -> speed reference (rate limited, integrator clamped at the limit)
             error = command - s.angle
@@ -184,7 +187,12 @@ class ElectricDrive:
                 s.speed_integral += speed_error * h
             # motor torque: first-order lag, exact for a torque reference held over h
             s.motor_torque = torque_ref + (s.motor_torque - torque_ref) * lag
+            angle = s.angle
             self._mechanics(h, p.torque_gain * s.motor_torque - load_torque, friction)
+            torque_sum += s.motor_torque
+            # motor shaft power = torque x motor speed (N x ring speed); motors count work they deliver
+            s.motor_energy += max(p.motor_count * s.motor_torque * p.gear_ratio * (s.angle - angle), 0.0)
+        s.mean_motor_torque = torque_sum / self.substeps
         return s
 
     def _mechanics(self, h: float, drive_torque: float, friction: float) -> None:

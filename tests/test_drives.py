@@ -18,7 +18,7 @@ def _simulate(params, command, t_end, dt, load=0.0, friction=0.0):
         s = drive.step(command(tk), dt, load, friction)
         angle.append(s.angle)
         speed.append(s.speed)
-        torque.append(s.motor_torque)
+        torque.append(s.mean_motor_torque)
     return t + dt, np.array(angle), np.array(speed), np.array(torque)
 
 
