@@ -1,0 +1,197 @@
+"""Co-simulation of a slewing drive with the bearing FMU (fmpy, FMU2Slave step loop).
+
+Every communication step ``dt``:
+
+1. the bearing FMU gets the loads of the time series and the ring's angle
+   ``psi`` and speed ``omega`` from the drive, and steps;
+2. the drive gets the bearing's friction torque (held over the step, applied as
+   Coulomb friction with stick-slip, see :mod:`slewing_drives.drive`) and the
+   load moment ``Mz`` of the series, and steps.
+
+:func:`run_manoeuvre` returns the time histories as numpy arrays.
+"""
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass
+
+import numpy as np
+
+from .drive import DriveParameters, ElectricDrive
+from .load_series import LoadSeries
+
+INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
+OUTPUTS = ("friction_torque", "friction_torque_magnitude", "max_ball_load", "max_contact_pressure",
+           "static_safety_factor", "z", "rx", "ry")
+
+
+@dataclass
+class ManoeuvreResult:
+    """Time histories of a co-simulated manoeuvre (SI units, angles in rad)."""
+
+    time: np.ndarray
+    command: np.ndarray
+    angle: np.ndarray
+    speed: np.ndarray
+    motor_torque: np.ndarray           # per motor, averaged over each step
+    ring_torque: np.ndarray            # all motors, at the ring
+    load_moment: np.ndarray            # Mz of the series
+    outputs: dict                      # FMU outputs by name
+    motor_energy: float                # J
+    params: DriveParameters
+
+    @property
+    def friction_torque(self) -> np.ndarray:
+        return self.outputs["friction_torque_magnitude"]
+
+    def summary(self) -> dict:
+        """Figures a drive engineer reads first."""
+        error = np.degrees(self.command - self.angle)
+        return {
+            "peak motor torque [N m]": float(np.abs(self.motor_torque).max()),
+            "motor torque limit [N m]": self.params.torque_limit,
+            "motor energy [kJ]": self.motor_energy / 1e3,
+            "max tracking error [deg]": float(np.abs(error).max()),
+            "rms tracking error [deg]": float(np.sqrt(np.mean(error**2))),
+            "peak friction torque [kN m]": float(self.friction_torque.max() / 1e3),
+            "max ball load [kN]": float(self.outputs["max_ball_load"].max() / 1e3),
+            "min static safety factor": float(self.outputs["static_safety_factor"].min()),
+        }
+
+
+def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, *, t_end: float, dt: float,
+                  start_values: dict | None = None, friction: bool = True, progress: bool = False,
+                  logger=None) -> ManoeuvreResult:
+    """Co-simulate ``drive`` with the bearing FMU under ``loads`` following ``command(t)`` (rad).
+
+    Parameters
+    ----------
+    fmu_path : path
+        The bearing FMU (``build_fmu.py``).
+    drive : DriveParameters
+    loads : LoadSeries
+    command : callable
+        Angle command of the ring, rad, as a function of time, s.
+    t_end, dt : float, s
+        Stop time and communication step.
+    start_values : dict, optional
+        FMU parameters (``ring_model``, ``load_frame``, ``friction_coefficient`` ...).
+    friction : bool
+        False sets the FMU's friction coefficient and seal torque to zero: the
+        same manoeuvre without bearing friction.
+    progress : bool
+        Show a progress bar (tqdm).
+    logger : callable, optional
+        FMU log messages ``logger(message)``; by default errors raise.
+
+    Returns
+    -------
+    ManoeuvreResult
+    """
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(fmu_path)
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    types = {v.name: v.type for v in md.modelVariables}
+    unzipped = extract(fmu_path)
+    messages = []
+
+    def log(component, instance, status, category, message):
+        messages.append(message.decode(errors="replace"))
+
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="bearing")
+    steps = int(round(t_end / dt))
+    time = np.arange(steps) * dt
+    out = {name: np.empty(steps) for name in OUTPUTS}
+    angle, speed, motor, ring, mz, cmd = (np.empty(steps) for _ in range(6))
+    values = dict(start_values or {})
+    if not friction:
+        values.update(friction_coefficient=0.0, seal_torque=0.0)
+    sim = ElectricDrive(drive)
+    k = 0
+    try:
+        fmu.instantiate(loggingOn=True, callbacks=None)
+        fmu.setupExperiment(startTime=0.0)
+        for name, value in values.items():
+            (fmu.setInteger if types[name] == "Integer" else fmu.setReal)([refs[name]], [value])
+        fmu.enterInitializationMode()
+        _set_inputs(fmu, refs, loads.at(0.0), sim.state.angle, sim.state.speed)
+        fmu.exitInitializationMode()
+        iterator = range(steps)
+        if progress:
+            from tqdm import tqdm
+
+            iterator = tqdm(iterator, desc=f"{drive.name}", unit="step", leave=False)
+        out_refs = [refs[n] for n in OUTPUTS]
+        for k in iterator:
+            t = time[k]
+            load = loads.at(t)
+            _set_inputs(fmu, refs, load, sim.state.angle, sim.state.speed)
+            status = fmu.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
+            for name, value in zip(OUTPUTS, fmu.getReal(out_refs)):
+                out[name][k] = value
+            cmd[k] = command(t)
+            s = sim.step(cmd[k], dt, load_torque=load[5], friction_torque=out["friction_torque_magnitude"][k])
+            angle[k], speed[k], motor[k], ring[k], mz[k] = (s.angle, s.speed, s.mean_motor_torque,
+                                                           drive.torque_gain * s.mean_motor_torque, load[5])
+        fmu.terminate()
+    except Exception as exc:
+        detail = "\n".join(messages[-5:])
+        raise RuntimeError(f"co-simulation failed at t = {time[k]:.3f} s: {exc}\n"
+                           f"FMU log:\n{detail}") from None
+    finally:
+        fmu.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+    return ManoeuvreResult(time + dt, cmd, angle, speed, motor, ring, mz, out, sim.state.motor_energy, drive)
+
+
+def _set_inputs(fmu, refs, load, psi, omega):
+    fmu.setReal([refs[n] for n in INPUTS], [*map(float, load[:5]), float(psi), float(omega)])
+
+
+def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: ManoeuvreResult | None = None,
+                   title: str = "") -> None:
+    """Four panels: angle and command, motor torque and its limit, bearing friction torque and
+    its share of the drive torque, maximum ball load and static safety factor."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    r = result
+    fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
+    ax[0].plot(r.time, np.degrees(r.command), "k--", label="command")
+    ax[0].plot(r.time, np.degrees(r.angle), label="angle, with bearing friction")
+    if without_friction is not None:
+        ax[0].plot(without_friction.time, np.degrees(without_friction.angle), ":", label="angle, friction off")
+    ax[0].set_ylabel("angle [deg]")
+    ax[0].legend(loc="best")
+    ax[1].plot(r.time, r.motor_torque, label="motor torque")
+    if without_friction is not None:
+        ax[1].plot(without_friction.time, without_friction.motor_torque, ":", label="motor torque, friction off")
+    for sign in (1, -1):
+        ax[1].axhline(sign * r.params.torque_limit, color="r", lw=0.8, label="torque limit" if sign > 0 else None)
+    ax[1].set_ylabel("motor torque [N m]")
+    ax[1].legend(loc="best")
+    ax[2].plot(r.time, r.friction_torque / 1e3, label="bearing friction torque (full sliding)")
+    ax[2].set_ylabel("friction [kN m]")
+    share = ax[2].twinx()
+    moving = np.abs(r.speed) > 1e-3 * r.params.rate_limit
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(moving, 100 * r.friction_torque / np.maximum(np.abs(r.ring_torque), 1e-9), np.nan)
+    share.plot(r.time, ratio, "g", lw=0.8, label="share of the drive torque (moving)")
+    share.set_ylabel("share [%]", color="g")
+    share.set_ylim(0, 150)
+    ax[2].legend(loc="upper left")
+    ax[3].plot(r.time, r.outputs["max_ball_load"] / 1e3, label="max ball load")
+    ax[3].set_ylabel("max ball load [kN]")
+    sf = ax[3].twinx()
+    sf.plot(r.time, r.outputs["static_safety_factor"], "m", lw=0.8)
+    sf.set_ylabel("static safety factor", color="m")
+    ax[3].set_xlabel("time [s]")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
