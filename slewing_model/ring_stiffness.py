@@ -189,12 +189,12 @@ class Superelement:
         path = os.fspath(path)
         meta = dict(self.metadata)
         meta["format_version"] = FORMAT_VERSION
-        meta["rings"] = {r.ring: {"ball_count": r.ball_count, "removed_modes": list(r.removed_modes),
+        meta["ring_stiffness"] = {r.ring: {"ball_count": r.ball_count, "removed_modes": list(r.removed_modes),
                                   "boundary_condition": r.boundary_condition}
                          for r in (self.outer, self.inner)}
         tmp = path + ".tmp.npz"
         np.savez(tmp, outer_first_row=self.outer.first_row, inner_first_row=self.inner.first_row,
-                 metadata=np.array(json.dumps(meta, sort_keys=True)))
+                 metadata=np.array(json.dumps(meta, sort_keys=True, default=_json_default)))
         os.replace(tmp, path)
 
     @classmethod
@@ -227,9 +227,9 @@ class Superelement:
                              f"this software reads version {FORMAT_VERSION}: rebuild it")
         if bearing is not None:
             check_bearing(meta, bearing, path)
-        rings = {r: RingStiffness(r, int(meta["rings"][r]["ball_count"]), rows[r],
-                                  tuple(meta["rings"][r]["removed_modes"]),
-                                  meta["rings"][r]["boundary_condition"]) for r in ("outer", "inner")}
+        info = meta["ring_stiffness"]
+        rings = {r: RingStiffness(r, int(info[r]["ball_count"]), rows[r], tuple(info[r]["removed_modes"]),
+                                  info[r]["boundary_condition"]) for r in ("outer", "inner")}
         return cls(rings["outer"], rings["inner"], meta)
 
     def scaled(self, factor: float) -> "Superelement":
@@ -241,6 +241,15 @@ class Superelement:
     def check(self, bearing) -> None:
         """Raise :class:`SuperelementMismatchError` unless built for ``bearing``."""
         check_bearing(self.metadata, bearing, "superelement")
+
+
+def _json_default(value):
+    """numpy scalars and arrays in the metadata, as plain JSON."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"metadata value of type {type(value).__name__} is not JSON-serialisable")
 
 
 def _differences(stored, actual, prefix=""):

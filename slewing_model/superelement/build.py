@@ -165,7 +165,7 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=sum(harmonics.values()) + 2, desc="superelement harmonics", unit="harmonic")
+        bar = tqdm(total=sum(harmonics.values()) + 4, desc="superelement harmonics", unit="harmonic")
     rings, ring_meta = {}, {}
     try:
         for ring in ("outer", "inner"):
@@ -235,7 +235,7 @@ def _build_ring(bearing, ring, size, bc, n_max, opts, progress):
         "boundary_condition": bc,
         "removed_modes": list(NULL_SPACE[bc]),
         "support_removes": SUPPORT_REMOVES[bc],
-        "mesh": {**sm.info, "dofs": model.ndofs},
+        "mesh": {**sm.info, "dofs": int(model.ndofs)},
         "harmonics": n_max,
         "patch_semi_axes_m": [list(s) for s in sizes],
         "compliance_floor_m_per_N": floor.tolist(),
