@@ -46,7 +46,7 @@ def lame(youngs_modulus: float, poisson_ratio: float) -> tuple[float, float]:
 def _strains(w, r):
     """(B0 w, B1 w): the n-independent part and the coefficient of n of the six strains
     [eps_r, eps_t, eps_z, gam_rz, gam_rt, gam_tz] of field ``w`` (U, V, W)."""
-    (U, V, W), (dU, dV, dW) = w.value, w.grad
+    (U, V, W), (dU, dV, dW) = w, w.grad
     zero = 0.0 * U
     b0 = (dU[0], U / r, dW[1], dU[1] + dW[0], dV[0] - V / r, dV[1])
     b1 = (zero, V / r, zero, zero, -U / r, -W / r)
@@ -158,7 +158,7 @@ class HarmonicRingModel:
         def form(v, w):
             r, z = w.x
             t = traction(r, z)
-            return (t[0] * v.value[0] + t[1] * v.value[1] + t[2] * v.value[2]) * r
+            return (t[0] * v[0] + t[1] * v[1] + t[2] * v[2]) * r
 
         return asm(form, fb)
 
@@ -169,7 +169,7 @@ class HarmonicRingModel:
         def form(v, w):
             r, z = w.x
             f = force(r, z)
-            return (f[0] * v.value[0] + f[1] * v.value[1] + f[2] * v.value[2]) * r
+            return (f[0] * v[0] + f[1] * v[1] + f[2] * v[2]) * r
 
         return asm(form, self.basis)
 

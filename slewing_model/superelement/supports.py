@@ -60,7 +60,7 @@ class Support:
 
             @LinearForm
             def mean_translation(v, w):       # int (U - V) r ds: in-plane x-translation at n = 1
-                return (v.value[0] - v.value[1]) * w.x[0]
+                return (v[0] - v[1]) * w.x[0]
 
             self._centring = asm(mean_translation, fb)[:, None]
         else:
