@@ -17,7 +17,7 @@ import json
 import math
 import os
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -198,7 +198,24 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
     return se
 
 
-def _build_ring(bearing, ring, size, bc, n_max, opts, progress):
+@dataclass
+class RingHarmonics:
+    """Intermediate result of one ring: the per-harmonic FE compliances and what the
+    condensation needs (for studies that condense the same solves with several settings)."""
+
+    ring: str
+    bc: str
+    patches: tuple
+    lams: list
+    c_fe: np.ndarray          # (N + 1, 4, 4), m/N per unit of the theta integral
+    c_hs: np.ndarray          # (N + 1, 4, 4), flat half-space part
+    floor: np.ndarray         # (4, 4), m/N
+    info: dict
+
+
+def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: int, opts: dict,
+                   progress=None) -> RingHarmonics:
+    """Mesh, assemble and solve harmonics 0..n_max of one ring."""
     t0 = time.perf_counter()
     e, nu = bearing.youngs_modulus, bearing.poisson_ratio
     profile = ring_profile(bearing, ring)
@@ -212,36 +229,50 @@ def _build_ring(bearing, ring, size, bc, n_max, opts, progress):
     if progress is not None:
         progress(1)
     t1 = time.perf_counter()
-
     c_fe = cd.harmonic_compliances(model, loads, range(n_max + 1), support, progress)
     t2 = time.perf_counter()
-    free = support.free
     c_hs = cd.halfspace_blocks(patches, lams, range(n_max + 1), e, nu)
-    c, ring_report = cd.ring_part(c_fe, c_hs if opts["subtract_halfspace"] else 0 * c_hs, patches, free)
     floor = _floor(patches, lams, opts["compliance_floor"], e, nu)
-    B = bearing.ball_count
-    k_hat, report = cd.stiffness_blocks(cd.ball_blocks(c, patches, B), patches, free, floor)
+    info = {"mesh": {**sm.info, "dofs": int(model.ndofs)}, "patch_semi_axes_m": [list(s) for s in sizes],
+            "seconds": {"setup": t1 - t0, "harmonics": t2 - t1}}
+    return RingHarmonics(ring, bc, patches, lams, c_fe, c_hs, floor, info)
+
+
+def condense_ring(h: RingHarmonics, ball_count: int, n_max: int | None = None,
+                  subtract_halfspace: bool = True) -> tuple[RingStiffness, dict]:
+    """Condense harmonics 0..n_max (default all) of ``h`` to ``ball_count`` balls."""
+    t0 = time.perf_counter()
+    n = h.c_fe.shape[0] - 1 if n_max is None else n_max
+    free = h.bc == "free"
+    c_hs = h.c_hs[:n + 1] if subtract_halfspace else 0.0 * h.c_hs[:n + 1]
+    c, ring_report = cd.ring_part(h.c_fe[:n + 1], c_hs, h.patches, free)
+    k_hat, report = cd.stiffness_blocks(cd.ball_blocks(c, h.patches, ball_count), h.patches, free, h.floor)
     row = cd.first_row(k_hat)
     # harmonic truncation figure: the same with 3/4 of the harmonics
-    n34 = max(2, (3 * n_max) // 4)
-    k34, _ = cd.stiffness_blocks(cd.ball_blocks(c[:n34 + 1], patches, B), patches, free, floor)
-    row34 = cd.first_row(k34)
-    diag, diag34 = np.diag(row[0]), np.diag(row34[0])
+    n34 = max(2, (3 * n) // 4)
+    k34, _ = cd.stiffness_blocks(cd.ball_blocks(c[:n34 + 1], h.patches, ball_count), h.patches, free, h.floor)
+    diag, diag34 = np.diag(row[0]), np.diag(cd.first_row(k34)[0])
     trunc = float(np.max(np.abs(diag - diag34) / np.abs(diag)))
-    stiff = RingStiffness(ring, B, 0.5 * (row + row[(-np.arange(B)) % B].transpose(0, 2, 1)),
-                          NULL_SPACE[bc], bc)
+    B = ball_count
+    stiff = RingStiffness(h.ring, B, 0.5 * (row + row[(-np.arange(B)) % B].transpose(0, 2, 1)),
+                          NULL_SPACE[h.bc], h.bc)
     meta = {
-        "contacts": list(RING_CONTACTS[ring]),
-        "boundary_condition": bc,
-        "removed_modes": list(NULL_SPACE[bc]),
-        "support_removes": SUPPORT_REMOVES[bc],
-        "mesh": {**sm.info, "dofs": int(model.ndofs)},
-        "harmonics": n_max,
-        "patch_semi_axes_m": [list(s) for s in sizes],
-        "compliance_floor_m_per_N": floor.tolist(),
+        "contacts": list(RING_CONTACTS[h.ring]),
+        "boundary_condition": h.bc,
+        "removed_modes": list(NULL_SPACE[h.bc]),
+        "support_removes": SUPPORT_REMOVES[h.bc],
+        "mesh": h.info["mesh"],
+        "harmonics": n,
+        "patch_semi_axes_m": h.info["patch_semi_axes_m"],
+        "compliance_floor_m_per_N": h.floor.tolist(),
         "projection": {"per_harmonic": ring_report, "ball_harmonics": report},
         "truncation_change": trunc,
         "diagonal_N_per_m": [float(x) for x in diag],
-        "seconds": {"setup": t1 - t0, "harmonics": t2 - t1, "condensation": time.perf_counter() - t2},
+        "seconds": {**h.info["seconds"], "condensation": time.perf_counter() - t0},
     }
     return stiff, meta
+
+
+def _build_ring(bearing, ring, size, bc, n_max, opts, progress):
+    h = ring_harmonics(bearing, ring, size, bc, n_max, opts, progress)
+    return condense_ring(h, bearing.ball_count, subtract_halfspace=opts["subtract_halfspace"])

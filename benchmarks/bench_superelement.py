@@ -1,0 +1,179 @@
+"""Speed and memory of the ring superelement build (issue 3), and the convergence studies of
+docs/superelement.md.
+
+    .venv/bin/python benchmarks/bench_superelement.py             # benchmark table (~1.5 min)
+    .venv/bin/python benchmarks/bench_superelement.py --study     # + convergence and patch tables (~4 min)
+
+Benchmark: table1.toml (100 balls), both rings, free, no cache. Each build runs in a fresh
+process (so that its peak resident memory, ru_maxrss, is its own); the table gives the median
+of ``--repeat`` runs and the ratio to the coarse build measured in the same run. Goals on a
+2-core machine: fine < 60 s, coarse < 10 s, peak memory < 4 GB.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE1 = ROOT / "examples" / "bearings" / "table1.toml"
+GOALS = {"coarse": 10.0, "fine": 60.0}
+MEMORY_GOAL_GB = 4.0
+
+
+def child(mesh: str) -> None:
+    """One build in this process; prints JSON (time, peak memory, figures)."""
+    import resource
+
+    from slewing_model.geometry import load_bearing
+    from slewing_model.superelement import build_superelement
+
+    bearing = load_bearing(TABLE1)
+    t0 = time.perf_counter()
+    se = build_superelement(bearing, mesh, "free", cache=False)
+    seconds = time.perf_counter() - t0
+    peak_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss        # KiB on Linux
+    rings = se.metadata["rings"]
+    print(json.dumps({"seconds": seconds, "peak_gb": peak_kib / 1024**2,
+                      "dofs": [rings[r]["mesh"]["dofs"] for r in ("outer", "inner")],
+                      "harmonics": [rings[r]["harmonics"] for r in ("outer", "inner")],
+                      "diag": rings["outer"]["diagonal_N_per_m"][:2]}))
+
+
+def run_child(mesh: str) -> dict:
+    out = subprocess.run([sys.executable, __file__, "--child", mesh], capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def cache_hit_seconds() -> float:
+    import tempfile
+
+    from slewing_model.geometry import load_bearing
+    from slewing_model.superelement import build_superelement
+
+    bearing = load_bearing(TABLE1)
+    with tempfile.TemporaryDirectory() as d:
+        build_superelement(bearing, "coarse", "free", cache_dir=d)
+        t0 = time.perf_counter()
+        build_superelement(bearing, "coarse", "free", cache_dir=d)
+        return time.perf_counter() - t0
+
+
+def benchmark(repeat: int) -> None:
+    print(f"# Superelement build, table1.toml (B = 100), both rings, free; median of {repeat} runs")
+    print(f"# {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}")
+    results = {}
+    for mesh in ("coarse", "fine"):
+        runs = [run_child(mesh) for _ in range(repeat)]
+        results[mesh] = {"seconds": statistics.median(r["seconds"] for r in runs),
+                         "peak_gb": max(r["peak_gb"] for r in runs), "dofs": runs[0]["dofs"],
+                         "harmonics": runs[0]["harmonics"]}
+    base = results["coarse"]["seconds"]
+    print()
+    print("| mesh | DOFs per ring (outer, inner) | harmonics | median time [s] | x coarse | peak memory [GB] | goal |")
+    print("|---|---|---|---|---|---|---|")
+    for mesh, r in results.items():
+        ok = r["seconds"] < GOALS[mesh] and r["peak_gb"] < MEMORY_GOAL_GB
+        print(f"| {mesh} | {r['dofs'][0]}, {r['dofs'][1]} | {r['harmonics'][0]}, {r['harmonics'][1]} "
+              f"| {r['seconds']:.2f} | {r['seconds'] / base:.2f} | {r['peak_gb']:.2f} "
+              f"| < {GOALS[mesh]:.0f} s, < {MEMORY_GOAL_GB:.0f} GB: {'met' if ok else 'MISSED'} |")
+    print(f"| coarse, cache hit | | | {cache_hit_seconds():.3f} | | | |")
+    print()
+    print("Paper (ANSYS, 14 cores): coarse 10 s, fine 5 min.")
+
+
+# ---- studies -------------------------------------------------------------------------------------
+
+def _entries(stiff) -> dict:
+    """A few condensed stiffness entries (GN/m) and a global compliance of the outer ring."""
+    c = stiff.first_row
+    blocks = stiff.harmonic_blocks().real
+    n1 = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0])     # contact-1 normal
+    q = np.linalg.qr(np.stack([n1, [0, 0, 1, 0], [0, 0, 0, 1], [-n1[1], n1[0], 0, 0]], 1))[0]
+    g2 = q.T @ np.linalg.inv(blocks[2]) @ q
+    return {"C0[R1,R1]": c[0][0, 0] / 1e9, "C0[z1,z1]": c[0][1, 1] / 1e9, "C0[R1,z1]": c[0][0, 1] / 1e9,
+            "C0[R1,R4]": c[0][0, 2] / 1e9, "C1[R1,R1]": c[1][0, 0] / 1e9,
+            "g2 normal [nm/N]": abs(g2[0, 0]) * 1e9}
+
+
+def _row(label, entries, ref=None):
+    cells = []
+    for k, v in entries.items():
+        if ref is None:
+            cells.append(f"{v:.4f}")
+        else:
+            cells.append(f"{v:.4f} ({100 * (v / ref[k] - 1):+.2f} %)")
+    return f"| {label} | " + " | ".join(cells) + " |"
+
+
+def study() -> None:
+    from slewing_model.geometry import load_bearing
+    from slewing_model.superelement.build import DEFAULT_OPTIONS, auto_harmonics, condense_ring, ring_harmonics
+    from slewing_model.superelement.section import MESH_PRESETS
+
+    bearing = load_bearing(TABLE1)
+    ring, B = "outer", bearing.ball_count
+    factors = (4, 8, 12, 16, 24)
+    ns = [auto_harmonics(bearing, ring, f) for f in factors]
+    print("\n## Convergence, table1.toml, outer ring, free (entries in GN/m; g2: compliance of harmonic 2 "
+          "along the contact-1 normal)\n")
+    harm = {}
+    for mesh in ("coarse", "fine", "finer"):
+        t0 = time.perf_counter()
+        harm[mesh] = ring_harmonics(bearing, ring, MESH_PRESETS[mesh], "free", max(ns), dict(DEFAULT_OPTIONS))
+        print(f"<!-- {mesh}: {harm[mesh].info['mesh']} solved {max(ns) + 1} harmonics in "
+              f"{time.perf_counter() - t0:.1f} s -->")
+    ref = _entries(condense_ring(harm["finer"], B, max(ns))[0])
+    keys = list(ref)
+    print("| mesh, harmonics N | " + " | ".join(keys) + " |")
+    print("|---|" + "---|" * len(keys))
+    for mesh in ("coarse", "fine", "finer"):
+        for f, n in zip(factors, ns):
+            label = f"{mesh}, N = {n} ({f} r/w)" + (" **default**" if f == 12 else "")
+            print(_row(label, _entries(condense_ring(harm[mesh], B, n)[0]), ref))
+    print(f"\nPercentages: against finer, N = {max(ns)}.")
+
+    print("\n## Patch size and the Hertz part, table1.toml, outer ring, free, fine mesh\n")
+    print("| patch (x Hertz ellipse at 2.5 GPa) | half-space part | N | " + " | ".join(keys) + " |")
+    print("|---|---|---|" + "---|" * len(keys))
+    base = None
+    for scale in (1.0, 0.5, 2.0):
+        opts = dict(DEFAULT_OPTIONS, patch_scale=scale)
+        h = ring_harmonics(bearing, ring, MESH_PRESETS["fine"], "free", 2 * ns[2], opts)
+        for subtract in (True, False):
+            for n in (ns[2], 2 * ns[2]):
+                e = _entries(condense_ring(h, B, n, subtract_halfspace=subtract)[0])
+                if base is None:
+                    base = e
+                cells = " | ".join(f"{v:.4f} ({100 * (v / base[k] - 1):+.1f} %)" for k, v in e.items())
+                print(f"| {scale} | {'removed' if subtract else 'kept'} | {n} | {cells} |")
+    print("\nPercentages: against patch 1.0, half-space part removed, N = "
+          f"{ns[2]} (the default).")
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--repeat", type=int, default=3, help="runs per mesh (median), default 3")
+    p.add_argument("--study", action="store_true", help="also print the convergence and patch-size tables")
+    p.add_argument("--no-bench", action="store_true", help="skip the timing table")
+    p.add_argument("--child", help=argparse.SUPPRESS)
+    args = p.parse_args()
+    if args.child:
+        child(args.child)
+        return
+    if not args.no_bench:
+        benchmark(args.repeat)
+    if args.study:
+        study()
+
+
+if __name__ == "__main__":
+    main()
