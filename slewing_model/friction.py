@@ -1,0 +1,1121 @@
+"""Friction torque of the bearing: an analytical model fed by the load distribution.
+
+The paper (section 3 and its conclusion) computes the friction torque with a
+finite element contact model (hours per case) and proposes to feed the
+Flexible-BIME results to an analytical model instead. This module is that
+model, in the line of Jones (paper ref. [19]), Leblanc & Nelias (refs. [17,
+18]) and Joshi et al. (ref. [20]): slow speed, no inertia, full-sliding
+Coulomb friction in every ball-raceway contact. ``docs/friction.md`` gives the
+derivation, the convergence studies and the limits (full sliding, ref. [21]).
+
+1. **Contact** (:func:`ellipse_friction`): Hertz pressure
+   ``p = p0 sqrt(1 - (eta/a)^2 - (xi/b)^2)`` over the contact ellipse (semi-axes
+   from :func:`slewing_model.contact.hertz_ellipse`, carried by the
+   :class:`~slewing_model.bime.LoadDistribution`). The contact surface is bent
+   across the groove with the radius ``R_d = 2 r_b R_c / (r_b + R_c)``
+   (:func:`conformity_radius`), which gives the differential sliding across the
+   ellipse. Coulomb traction ``mu p`` opposes the local sliding velocity
+   (rolling, spin and differential sliding together), integrated with a product
+   Gauss rule exact for the Hertz weight (:func:`ellipse_quadrature`).
+2. **Ball kinematics** (:func:`friction_torque`): per ball the unknowns are its
+   angular velocity (3 components) and its orbital speed about the bearing
+   axis; the equations are the three friction moments on the ball and its
+   friction force along the rolling direction. For Coulomb friction at given
+   normal loads these are the stationarity conditions of the dissipated power
+   ``D = sum integral mu p |v_s| dA``, a convex function of the unknowns: the
+   ball moves so as to dissipate the least power. All balls are solved at once
+   (batched Newton / Weiszfeld iterations on ``D``); two and four loaded
+   contacts are the same equations.
+3. **Bearing torque**: the dissipated power over the ring speed, plus a
+   load-independent seal part. It equals the moment about z of the friction
+   tractions on the moving ring's contacts at the ball equilibrium (reported
+   too, and checked by the tests); the power is preferred because it is
+   stationary there, hence insensitive to what remains of the ball residuals.
+4. **Sign and slow speed**: :attr:`FrictionTorque.torque` acts on the moving
+   ring about +z and opposes ``omega``: ``-magnitude * tanh(omega / omega_reg)``
+   (:func:`regularised_torque`).
+5. **Catalogue formula** (:func:`catalogue_torque`) and **rotation**
+   (:func:`torque_ripple`, :func:`preload_sweep`).
+
+Everything is SI. Run-time module: numpy and the standard library only.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import threading
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .geometry import RING_CONTACTS, Bearing
+
+#: Default Coulomb coefficient of the ball-raceway contacts. Slewing bearings
+#: turn so slowly (entrainment speeds of mm/s) that no lubricant film separates
+#: the surfaces: grease-lubricated steel on steel is in boundary lubrication,
+#: where friction coefficients of about 0.08-0.12 are usual. 0.1 is the middle
+#: of that range; calibrate it against a measured running torque where one exists.
+DEFAULT_MU = 0.1
+#: Catalogue start-up friction coefficient of four-point contact slewing bearings
+CATALOGUE_MU = 0.006
+#: Default quadrature on which the power (torque) is integrated: points across
+#: the groove x along the rolling direction (convergence table in docs/friction.md)
+DEFAULT_QUADRATURE = (20, 4)
+#: Default rule on which the ball equilibrium is solved. The power is stationary
+#: at the equilibrium: integrated on the fine rule at the equilibrium of this
+#: cheaper one, it is within 1e-3 of the fully consistent value (docs/friction.md).
+#: ``solve_quadrature=None`` solves on the fine rule itself.
+DEFAULT_SOLVE_QUADRATURE = (12, 2)
+#: Sliding-velocity regularisation ``eps``, as a fraction of ``|omega| a`` (the
+#: sliding speed at the ellipse edge of a spin as fast as the ring); the
+#: spin of a two-contact ball is about ``0.35 |omega|``, so eps is ~0.3 % of it
+DEFAULT_SLIDING_REGULARISATION = 1e-3
+#: Default speed scale of the regularised Coulomb law near omega = 0, rad/s
+DEFAULT_OMEGA_REGULARISATION = 1e-4
+#: Regularisation continuation of a cold start (multiples of the final eps)
+SOLVE_LEVELS = (100.0, 10.0)
+
+#: sign of the (r, z) components of the contact normals of contacts 1..4
+#: (as :attr:`slewing_model.geometry.Bearing.contact_normals`)
+_NORMAL_SIGN_R = np.array([1.0, -1.0, -1.0, 1.0])
+_NORMAL_SIGN_Z = np.array([1.0, 1.0, -1.0, -1.0])
+#: for each possible moving ring, which of contacts 1..4 turn with it
+_IS_MOVING = {ring: np.isin(np.arange(4), [c - 1 for c in RING_CONTACTS[ring]]) for ring in ("inner", "outer")}
+#: damping schedule of the Newton / Weiszfeld blend (see _minimise)
+_THETA_DOWN, _THETA_UP, _THETA_MIN_UP = 0.2, 10.0, 0.1
+
+
+# ---- quadrature over the Hertz ellipse -------------------------------------------------
+
+@dataclass(frozen=True)
+class EllipseQuadrature:
+    """Product rule over a Hertz contact ellipse, weights including the pressure.
+
+    The ellipse is mapped to the square ``(u, t)`` in ``[-1, 1]^2`` by
+    ``eta = a u`` (across the groove) and ``xi = b sqrt(1 - u^2) t`` (rolling
+    direction), where ``p dA = 3 Q / (2 pi) (1 - u^2) sqrt(1 - t^2) du dt``:
+    Gauss-Jacobi nodes ``u`` (weight ``1 - u^2``) and Gauss-Chebyshev nodes of
+    the second kind ``t`` (weight ``sqrt(1 - t^2)``) integrate the Hertz weight
+    exactly. Point ``k`` sits at ``eta = a * across[k]``, ``xi = b * along[k]``
+    and carries the share ``weight[k]`` of the contact load (``sum = 1``):
+    ``integral f p dA ~= Q * sum(weight * f(points))``.
+
+    Attributes
+    ----------
+    n_across, n_along : int
+    across, along : ndarray (n_across * n_along,)
+        Point coordinates over the semi-axes (``along`` includes ``sqrt(1 - u^2)``).
+    weight : ndarray (n_across * n_along,)
+    across_nodes : ndarray (n_across,)
+        ``u``.
+    along_nodes : ndarray (n_along,)
+        ``t``.
+    """
+
+    n_across: int
+    n_along: int
+    across: np.ndarray
+    along: np.ndarray
+    weight: np.ndarray
+    across_nodes: np.ndarray
+    along_nodes: np.ndarray
+
+    @property
+    def size(self) -> int:
+        return self.across.size
+
+
+def _gauss_jacobi_11(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss rule for the weight ``1 - x^2`` on [-1, 1] (Golub-Welsch): Gegenbauer
+    ``lambda = 3/2``, monic recurrence ``beta_k = k (k + 2) / ((2k + 1)(2k + 3))``,
+    ``integral (1 - x^2) dx = 4/3``."""
+    k = np.arange(1, n, dtype=float)
+    off = np.sqrt(k * (k + 2.0) / ((2.0 * k + 1.0) * (2.0 * k + 3.0)))
+    nodes, vectors = np.linalg.eigh(np.diag(off, 1) + np.diag(off, -1))
+    return nodes, 4.0 / 3.0 * vectors[0] ** 2
+
+
+@functools.lru_cache(maxsize=32)
+def ellipse_quadrature(n_across: int = DEFAULT_QUADRATURE[0], n_along: int = DEFAULT_QUADRATURE[1]
+                       ) -> EllipseQuadrature:
+    """The :class:`EllipseQuadrature` with ``n_across x n_along`` points (cached)."""
+    n_across, n_along = int(n_across), int(n_along)
+    if n_across < 1 or n_along < 1:
+        raise ValueError(f"quadrature = ({n_across}, {n_along}): both sizes must be >= 1")
+    u, wu = _gauss_jacobi_11(n_across)
+    j = np.arange(1, n_along + 1)
+    t = np.cos(j * np.pi / (n_along + 1))
+    wt = np.pi / (n_along + 1) * np.sin(j * np.pi / (n_along + 1)) ** 2
+    across = np.repeat(u, n_along)
+    along = np.sqrt(1.0 - across**2) * np.tile(t, n_across)
+    weight = 1.5 / np.pi * np.outer(wu, wt).ravel()
+    for arr in (across, along, weight, u, t):
+        arr.setflags(write=False)
+    return EllipseQuadrature(n_across, n_along, across, along, weight, u, t)
+
+
+def _quadrature(quadrature) -> EllipseQuadrature:
+    if isinstance(quadrature, EllipseQuadrature):
+        return quadrature
+    if isinstance(quadrature, (int, np.integer)):
+        return ellipse_quadrature(int(quadrature), int(quadrature))
+    try:
+        n_across, n_along = quadrature
+    except (TypeError, ValueError):
+        raise ValueError(f"quadrature = {quadrature!r}: an int or a pair (n_across, n_along)") from None
+    return ellipse_quadrature(int(n_across), int(n_along))
+
+
+def conformity_radius(ball_radius, groove_radius):
+    """Radius ``R_d`` of the deformed contact surface across the groove, m.
+
+    Harmonic mean of the ball and groove radii, ``2 r_b R_c / (r_b + R_c)``
+    (Harris & Kotzalas, *Rolling Bearing Analysis*: the pressure surface of a
+    ball in a conforming groove lies between the two)."""
+    rb = np.asarray(ball_radius, dtype=float)
+    rc = np.asarray(groove_radius, dtype=float)
+    return 2.0 * rb * rc / (rb + rc)
+
+
+# ---- one contact ------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class EllipseFriction:
+    """Friction integrated over one contact ellipse, in the contact's frame
+    (t: rolling direction, g: across the groove, n: normal out of the ball).
+
+    Attributes
+    ----------
+    force : ndarray (..., 3), N
+        Friction force on the ball, components along (t, g, n).
+    moment : ndarray (..., 3), N m
+        Its moment about the centre of the ellipse.
+    power : ndarray (...), W
+        Dissipated power ``integral tau . v_s dA`` (>= 0).
+    """
+
+    force: np.ndarray
+    moment: np.ndarray
+    power: np.ndarray
+
+
+def ellipse_friction(load, a, b, mu, *, sliding_velocity=(0.0, 0.0), relative_rotation=(0.0, 0.0, 0.0),
+                     conformity_radius=np.inf, quadrature=DEFAULT_QUADRATURE, regularisation=0.0
+                     ) -> EllipseFriction:
+    """Coulomb friction on one Hertz contact ellipse for a rigid relative motion.
+
+    The raceway moves relative to the ball with the velocity ``v0 + w x (x - x0)``
+    (``x0`` the centre of the ellipse). The friction traction on the ball is
+    ``mu p v_s / |v_s|``, ``v_s`` the tangential part of that velocity on the
+    contact surface: it drags the ball along with the raceway. This is the
+    integration used by :func:`friction_torque`, for one contact.
+
+    Parameters
+    ----------
+    load : float or array, N
+        Contact load ``Q``.
+    a, b : float or array, m
+        Semi-axes across the groove (``g``) and along the rolling direction (``t``).
+    mu : float
+        Coulomb coefficient.
+    sliding_velocity : (2,) array_like, m/s
+        ``v0`` along (t, g).
+    relative_rotation : (3,) array_like, rad/s
+        ``w`` along (t, g, n); ``(0, 0, w_n)`` is a pure spin (pivoting).
+    conformity_radius : float, m
+        ``R_d`` of the contact surface across the groove; ``inf``: a flat ellipse.
+    quadrature : int, (int, int) or EllipseQuadrature
+    regularisation : float, m/s
+        ``|v_s|`` becomes ``sqrt(|v_s|^2 + regularisation^2)``.
+
+    Returns
+    -------
+    EllipseFriction
+
+    Examples
+    --------
+    Pivoting moment of a circular contact, ``3 pi / 16 mu Q a``:
+
+    >>> f = ellipse_friction(1000.0, 1e-3, 1e-3, 0.1, relative_rotation=(0, 0, 1.0), quadrature=40)
+    >>> round(float(f.moment[2] / (3 * math.pi / 16 * 0.1 * 1000.0 * 1e-3)), 3)
+    1.0
+    """
+    quad = _quadrature(quadrature)
+    q = np.asarray(load, dtype=float)
+    a = np.asarray(a, dtype=float)[..., None]
+    b = np.asarray(b, dtype=float)[..., None]
+    radius = float(conformity_radius)
+    eta, xi = a * quad.across, b * quad.along
+    if math.isinf(radius):
+        sin_t, cos_t = np.zeros_like(eta), np.ones_like(eta)
+        rg, rn = eta, np.zeros_like(eta)
+    else:
+        theta = eta / radius
+        sin_t, cos_t = np.sin(theta), np.cos(theta)
+        rg, rn = radius * sin_t, radius * (cos_t - 1.0)        # bent surface, centre of curvature on -n
+    rt = xi
+    v0 = np.asarray(sliding_velocity, dtype=float)
+    w = np.asarray(relative_rotation, dtype=float)
+    vt = v0[..., 0, None] + w[..., 1, None] * rn - w[..., 2, None] * rg     # v = v0 + w x r
+    vg = v0[..., 1, None] + w[..., 2, None] * rt - w[..., 0, None] * rn
+    vn = w[..., 0, None] * rg - w[..., 1, None] * rt
+    s1, s2 = vt, cos_t * vg - sin_t * vn                      # along t and along the bent g
+    speed = np.sqrt(s1**2 + s2**2 + float(regularisation) ** 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where(speed > 0.0, (mu * q)[..., None] * quad.weight / speed, 0.0)
+    ft, fb = scale * s1, scale * s2
+    fg, fn = fb * cos_t, -fb * sin_t
+    force = np.stack([ft.sum(-1), fg.sum(-1), fn.sum(-1)], axis=-1)
+    moment = np.stack([(rg * fn - rn * fg).sum(-1), (rn * ft - rt * fn).sum(-1), (rt * fg - rg * ft).sum(-1)],
+                      axis=-1)
+    power = (scale * (s1**2 + s2**2)).sum(-1)
+    return EllipseFriction(force, moment, power)
+
+
+# ---- result and slow-speed laws -----------------------------------------------------------
+
+@dataclass(frozen=True)
+class FrictionTorque:
+    """Friction torque of the bearing, SI units.
+
+    Sign convention: ``torque`` is the friction torque **acting on the moving
+    ring**, about the bearing axis +z, when the moving ring turns at ``omega``
+    (rad/s, about +z) relative to the fixed ring. It opposes ``omega``:
+    negative for ``omega > 0``. The actuator must supply ``-torque`` to keep
+    the speed; the fixed ring feels ``-torque``.
+
+    Attributes
+    ----------
+    torque : float, N m
+        ``-magnitude * tanh(omega / omega_regularisation)``
+        (:func:`regularised_torque`), or ``-magnitude * sign(omega)`` when
+        ``omega_regularisation = 0``.
+    magnitude : float, N m
+        ``contact_part + seal_part``, at full sliding (>= 0); also the
+        break-away level of a stick-slip law (:func:`stick_slip_torque`).
+    contact_part : float, N m
+        From the ball-raceway contacts: dissipated power over ``|kinematics_speed|``.
+    contact_part_moments : float, N m
+        The same from the moments about z of the friction tractions on the
+        moving ring's contacts. Equal to ``contact_part`` at the ball
+        equilibrium on one rule (``solve_quadrature=None``); with the default
+        split rules it differs by the fine rule's residual (< 1e-2).
+    seal_part : float, N m
+        Load-independent part (seals, lubricant).
+    per_ball : ndarray (B,), N m
+        Contribution of each ball to ``contact_part``.
+    omega : float, rad/s
+        The speed asked for.
+    kinematics_speed : float, rad/s
+        Speed at which the ball motion below is given: ``omega``, or 1 rad/s when
+        ``omega = 0`` (at full sliding the motion is proportional to the speed).
+    ball_angular_velocity : ndarray (B, 3), rad/s
+        Angular velocity of each ball (absolute), along its (radial,
+        tangential, axial) directions.
+    orbital_speed : ndarray (B,), rad/s
+        Speed of each ball's centre about the bearing axis.
+    spin_roll_ratio : ndarray (B, 4)
+        At the centre of each contact, relative rotation (raceway minus ball)
+        about the contact normal over that about the across-groove axis; 0 for
+        unloaded contacts.
+    contact_power : ndarray (B, 4), W
+        Power dissipated in each contact at ``kinematics_speed``.
+    contact_count : ndarray (B,)
+        Loaded contacts of each ball (0, 2 or 4).
+    power : float, W
+        Total dissipated power at ``kinematics_speed``.
+    mu : float
+    iterations : int
+        Iterations of the ball equilibrium.
+    residual : float
+        Largest friction force or moment (over ``Dw/2``) left on a ball at the
+        last evaluated iterate, relative to ``mu`` times its largest contact load.
+    converged : bool
+    state : ndarray (B, 4)
+        Ball unknowns per unit of speed: pass as ``initial`` for a warm start.
+    """
+
+    torque: float
+    magnitude: float
+    contact_part: float
+    contact_part_moments: float
+    seal_part: float
+    per_ball: np.ndarray
+    omega: float
+    kinematics_speed: float
+    ball_angular_velocity: np.ndarray
+    orbital_speed: np.ndarray
+    spin_roll_ratio: np.ndarray
+    contact_power: np.ndarray
+    contact_count: np.ndarray
+    power: float
+    mu: float
+    iterations: int
+    residual: float
+    converged: bool
+    state: np.ndarray = field(repr=False)
+
+    @property
+    def balls_in_four_point_contact(self) -> int:
+        return int(np.count_nonzero(self.contact_count == 4))
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready data (N m, rad/s)."""
+        return {
+            "torque": self.torque,
+            "magnitude": self.magnitude,
+            "contact_part": self.contact_part,
+            "seal_part": self.seal_part,
+            "per_ball": self.per_ball.tolist(),
+            "omega": self.omega,
+            "mu": self.mu,
+            "balls_in_four_point_contact": self.balls_in_four_point_contact,
+            "converged": self.converged,
+        }
+
+
+def regularised_torque(magnitude: float, omega: float,
+                       omega_regularisation: float = DEFAULT_OMEGA_REGULARISATION) -> float:
+    """Friction torque on the moving ring for a full-sliding level ``magnitude``, N m.
+
+    ``-magnitude * tanh(omega / omega_regularisation)``: the Coulomb law made
+    continuous near ``omega = 0``. Odd, bounded by ``magnitude``, slope
+    ``magnitude / omega_regularisation`` at rest, within 1 % of the
+    full-sliding level for ``|omega| > 2.65 omega_regularisation``. It needs
+    only the speed, which is what a co-simulation step hands over; with an
+    explicit coupling the step stays stable when
+    ``omega_regularisation >= magnitude * step / inertia``
+    (:func:`omega_regularisation_for_step`). ``omega_regularisation = 0`` gives
+    the discontinuous ``-magnitude * sign(omega)``.
+    """
+    if not math.isfinite(omega_regularisation) or omega_regularisation < 0.0:
+        raise ValueError(f"omega_regularisation = {omega_regularisation!r}: must be finite and >= 0 (rad/s)")
+    if omega_regularisation == 0.0:
+        return -magnitude * float(np.sign(omega))
+    return -magnitude * math.tanh(omega / omega_regularisation)
+
+
+def omega_regularisation_for_step(magnitude: float, inertia: float, step: float) -> float:
+    """Smallest regularisation speed (rad/s) an explicit co-simulation step resolves.
+
+    Near rest the regularised law acts on the driven inertia (kg m^2, all that
+    the actuator drives, seen at the bearing) as a damper
+    ``magnitude / omega_regularisation``; a forward-Euler (explicit) coupling
+    with step ``step`` (s) is stable and does not chatter in sign when
+    ``step * magnitude / (omega_regularisation * inertia) <= 1``."""
+    if inertia <= 0.0 or step <= 0.0:
+        raise ValueError(f"inertia = {inertia!r}, step = {step!r}: both must be > 0")
+    return magnitude * step / inertia
+
+
+def stick_slip_torque(magnitude: float, omega: float, driving_torque: float, omega_stick: float) -> float:
+    """Karnopp's stick-slip friction, for a model that knows its net driving torque, N m.
+
+    Below ``omega_stick`` (rad/s) the bearing sticks: the friction balances the
+    driving torque (N m, about +z on the moving ring) up to the break-away
+    level ``magnitude``; above, full sliding ``-magnitude sign(omega)``. It
+    needs the driving torque as an input, so it belongs inside the actuator's
+    own model (with ``FrictionTorque.magnitude`` as its parameter)."""
+    if abs(omega) > omega_stick:
+        return -magnitude * math.copysign(1.0, omega)
+    return -max(-magnitude, min(magnitude, driving_torque))
+
+
+def seal_torque_of(bearing: Bearing, seal_torque: float = 0.0, seal_torque_per_length: float = 0.0,
+                   seal_length: float | None = None) -> float:
+    """Load-independent torque ``seal_torque + seal_torque_per_length * seal_length``, N m.
+
+    ``seal_torque_per_length`` in N m per m of seal; ``seal_length`` (m)
+    defaults to two seals (upper and lower) on the pitch circle, ``2 pi dm``."""
+    for name, value in (("seal_torque", seal_torque), ("seal_torque_per_length", seal_torque_per_length)):
+        if not isinstance(value, (int, float, np.floating)) or not math.isfinite(value) or value < 0.0:
+            raise ValueError(f"{name} = {value!r}: must be a finite number >= 0")
+    length = 2.0 * math.pi * bearing.pitch_diameter if seal_length is None else float(seal_length)
+    if not math.isfinite(length) or length < 0.0:
+        raise ValueError(f"seal_length = {seal_length!r}: must be finite and >= 0 (m)")
+    return float(seal_torque + seal_torque_per_length * length)
+
+
+# ---- all contacts of the bearing ------------------------------------------------------------
+
+class _Workspace:
+    """Work arrays kept between calls, one set per thread and per name.
+
+    The per-point arrays of 67 balls are 0.1-0.2 MB each: allocated afresh on
+    every call, each is a new memory mapping whose page faults cost more than
+    the arithmetic (measured: ~1000 faults and ~3 ms per call). Views into
+    retained flat buffers avoid that; the buffers grow to the largest size
+    asked for (a few MB for 67 balls) and are reused."""
+
+    def __init__(self):
+        self._arrays: dict[str, np.ndarray] = {}
+
+    def get(self, name: str, shape: tuple) -> np.ndarray:
+        size = math.prod(shape)
+        flat = self._arrays.get(name)
+        if flat is None or flat.size < size:
+            flat = np.empty(size)
+            self._arrays[name] = flat
+        return flat[:size].reshape(shape)
+
+
+_LOCAL = threading.local()
+
+
+def _workspace(tag: str) -> _Workspace:
+    spaces = getattr(_LOCAL, "spaces", None)
+    if spaces is None:
+        spaces = _LOCAL.spaces = {}
+    if tag not in spaces:
+        spaces[tag] = _Workspace()
+    return spaces[tag]
+
+
+class _ContactSet:
+    """The loaded contacts of a load distribution, and what does not depend on
+    the quadrature rule: ball of each contact, normal, ellipse, ring speed."""
+
+    def __init__(self, bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float):
+        n_balls = bearing.ball_count
+        arrays = {}
+        for name in ("contact_load", "contact_angle", "semi_axis_a", "semi_axis_b"):
+            value = np.asarray(getattr(distribution, name), dtype=float)
+            if value.shape != (n_balls, 4):
+                raise ValueError(f"distribution.{name} has shape {value.shape}, expected ({n_balls}, 4) "
+                                 f"for this bearing ({bearing.name})")
+            if not np.all(np.isfinite(value)):
+                raise ValueError(f"distribution.{name}: must be finite (not NaN or infinite)")
+            arrays[name] = value
+        q = arrays["contact_load"]
+        if np.any(q < 0.0):
+            raise ValueError("distribution.contact_load: must be >= 0 (N)")
+        loaded = q > 0.0
+        if np.any(loaded & ((arrays["semi_axis_a"] <= 0.0) | (arrays["semi_axis_b"] <= 0.0))):
+            raise ValueError("distribution.semi_axis_a/b: must be > 0 (m) where the contact is loaded")
+        self.contact_load = q
+        self.loaded = loaded
+        self.ball_index, self.contact_index = np.nonzero(loaded)
+        active_mask = loaded.any(axis=1)
+        self.active = active = np.flatnonzero(active_mask)
+        self.inactive = np.flatnonzero(~active_mask)
+        position = np.full(n_balls, -1)
+        position[active] = np.arange(active.size)
+        self.owner = position[self.ball_index]                # active-ball row of every contact
+        n_c = self.ball_index.size
+        self.sum_matrix = np.zeros((active.size, n_c))        # per-contact -> per-ball sums
+        self.sum_matrix[self.owner, np.arange(n_c)] = 1.0
+        dw = np.full(n_balls, bearing.ball_diameter + bearing.preload)
+        if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
+            dw = dw + bearing.errors.ball_diameter_deviation
+        self.ball_radius = 0.5 * dw
+        self.pitch_radius = 0.5 * bearing.pitch_diameter
+        self.length_scale = 0.5 * bearing.ball_diameter
+        self.speed = speed
+        b_i, c_i = self.ball_index, self.contact_index
+        self.rb = self.ball_radius[b_i][:, None]
+        alpha = arrays["contact_angle"][b_i, c_i]
+        n_r = _NORMAL_SIGN_R[c_i] * np.cos(alpha)
+        n_z = _NORMAL_SIGN_Z[c_i] * np.sin(alpha)
+        self.normal = np.stack([n_r, n_z], axis=-1)
+        self.n_r, self.n_z = n_r[:, None], n_z[:, None]
+        self.rd = conformity_radius(self.rb, bearing.groove_radius[c_i][:, None])
+        self.a = arrays["semi_axis_a"][b_i, c_i][:, None]
+        self.b = arrays["semi_axis_b"][b_i, c_i][:, None]
+        self.moving = _IS_MOVING[bearing.moving_ring][c_i][:, None]
+        self.ring_speed = np.where(self.moving, speed, 0.0)
+        self.mu_load = mu * q[b_i, c_i]
+        self.eps2 = ((sliding_regularisation * abs(speed)) * self.a[:, :, None]) ** 2
+        self.force_scale = mu * q[active].max(axis=1) if active.size else np.zeros(0)
+        self.contact_angle = arrays["contact_angle"]
+        self.moving_ring = bearing.moving_ring
+
+    def initial_guess(self) -> np.ndarray:
+        """Scaled unknowns (B_active, 4) for a cold start: for each diagonal,
+        rolling without sliding at its two contact centres about an axis normal
+        to it (the classical two-contact kinematics); the two diagonals blended
+        in proportion to their loads."""
+        q = self.contact_load[self.active]
+        alpha = self.contact_angle[self.active]
+        rb = self.ball_radius[self.active]
+        big_r, ls = self.pitch_radius, self.length_scale
+        w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
+        guess = np.zeros((self.active.size, 4))
+        total = np.zeros(self.active.size)
+        for outer, sign in ((0, 1.0), (3, -1.0)):          # diagonal 1 (contacts 1, 3), diagonal 2 (4, 2)
+            n_r, n_z = np.cos(alpha[:, outer]), sign * np.sin(alpha[:, outer])
+            # v . t = 0 at the outer contact (normal n) and at the inner one (-n), w = w_g g, g = (-n_z, 0, n_r)
+            w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
+            w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
+            diag = np.stack([-w_g * n_z * ls, np.zeros_like(w_g), w_g * n_r * ls, w_c * big_r], axis=-1)
+            guess += q[:, outer, None] * diag
+            total += q[:, outer]
+        return guess / total[:, None]
+
+
+class _Contacts:
+    """Sliding velocities of the loaded contacts at the points of one rule.
+
+    For contact ``c`` (of active ball ``owner[c]``) and point ``(j, i)`` (``j``
+    along the rolling direction, ``i`` across the groove), the tangential
+    sliding velocity, raceway minus ball, is linear in the ball's scaled
+    unknowns ``u = (r w_r, r w_t, r w_z, R w_c)`` (m/s; ``r = Dw/2``,
+    ``R = dm/2``; ``w`` the ball's angular velocity along its (radial,
+    tangential, axial) directions, ``w_c`` its orbital speed). The contact
+    surface is flat along the rolling direction, so the rolling component
+    depends on the across position only and the across component is affine in
+    ``xi``:
+
+    ``v1 = g10 u0 + g12 u2 - u3 + h1``                     (C, I)
+    ``v2 = g21 u1 + xi (c20 u0 + c22 u2 + ch2)``            (C, J, I)
+
+    Derivation: ``v = W e_z x (c + r) - w_c e_z x c - w x r`` with ``W`` the
+    raceway's speed (``omega`` or 0), ``c = R e_r`` the ball centre and ``r``
+    the point on the bent surface relative to it."""
+
+    def __init__(self, geometry: _ContactSet, quad: EllipseQuadrature, workspace: str = "fine"):
+        geo = self.geometry = geometry
+        ls, big_r = geo.length_scale, geo.pitch_radius
+        rb, rd, n_r, n_z, ring_speed = geo.rb, geo.rd, geo.n_r, geo.n_z, geo.ring_speed
+        u_nodes = quad.across_nodes
+        theta = geo.a * u_nodes / rd                                    # (C, I)
+        sin_t, cos_t = np.sin(theta), np.cos(theta)
+        # point relative to the ball centre in the ball frame (r, t, z):
+        # (rb - Rd + Rd cos) n + Rd sin g + xi t,  g = n x t = (-n_z, 0, n_r)
+        rho = rb - rd + rd * cos_t
+        r_r = rho * n_r - rd * sin_t * n_z
+        r_z = rho * n_z + rd * sin_t * n_r
+        t2_r = -cos_t * n_z - sin_t * n_r                                # second tangent cos g - sin n
+        t2_z = cos_t * n_r - sin_t * n_z
+        #   v . t  = r_z w_r - r_r w_z - R w_c + W (R + r_r)
+        #   v . T2 = -T2_z xi w_r + (T2_z r_r - T2_r r_z) w_t + T2_r xi w_z - W T2_r xi
+        self.g10, self.g12 = r_z / ls, -r_r / ls
+        self.g21 = (t2_z * r_r - t2_r * r_z) / ls
+        self.h1 = ring_speed * (big_r + r_r)
+        self.c20, self.c22, self.ch2 = -t2_z / ls, t2_r / ls, -ring_speed * t2_r
+        # lever arm of the moving ring's torque: tangential components of e_z x (c + r)
+        self.arm1 = np.where(geo.moving, big_r + r_r, 0.0)
+        self.arm2 = np.where(geo.moving, -t2_r, 0.0)                     # times xi
+        # per-point arrays (C, J, I), in the retained workspace
+        space = _workspace(workspace)
+        shape = (geo.ball_index.size, quad.n_along, quad.n_across)
+        half = (geo.b * np.sqrt(1.0 - u_nodes**2))[:, None, :]
+        self.xi = np.multiply(half, quad.along_nodes[None, :, None], out=space.get("xi", shape))
+        weight = quad.weight.reshape(quad.n_across, quad.n_along).T       # (J, I)
+        self.weight = np.multiply(geo.mu_load[:, None, None], weight, out=space.get("weight", shape))
+        self._v2, self._n2, self._sp, self._t = (space.get(name, shape) for name in ("v2", "n2", "sp", "t"))
+        self._space, self._shape = space, shape
+        self._derivative_arrays = False
+
+    def _prepare_derivatives(self) -> None:
+        """Arrays needed for gradients and Hessians only (not for the power)."""
+        space, shape = self._space, self._shape
+        self.g20 = np.multiply(self.xi, self.c20[:, None, :], out=space.get("g20", shape))
+        self.g22 = np.multiply(self.xi, self.c22[:, None, :], out=space.get("g22", shape))
+        # across-only coefficients repeated along: contiguous operands are ~3x faster than broadcasting
+        self.g10_full, self.g12_full, self.g21_full = (space.get(name, shape) for name in ("g10", "g12", "g21"))
+        for full, g in ((self.g10_full, self.g10), (self.g12_full, self.g12), (self.g21_full, self.g21)):
+            full[...] = g[:, None, :]
+        self._p1, self._p2, self._norm, self._k = (space.get(name, shape) for name in ("p1", "p2", "norm", "k"))
+        self._z = space.get("z", (shape[0], 4, 2) + shape[1:])
+        self._derivative_arrays = True
+
+    def velocity(self, u: np.ndarray):
+        """``v1`` (C, I) and ``v2`` (C, J, I) for the scaled unknowns ``u``
+        (B_active, 4). ``v2`` is a work buffer."""
+        uc = u[self.geometry.owner]
+        u0, u1, u2, u3 = (uc[:, k, None] for k in range(4))
+        v1 = self.g10 * u0 + self.g12 * u2 + (self.h1 - u3)
+        slope = self.c20 * u0 + self.c22 * u2 + self.ch2
+        v2 = np.multiply(self.xi, slope[:, None, :], out=self._v2)
+        v2 += (self.g21 * u1)[:, None, :]
+        return v1, v2
+
+    def evaluate(self, u: np.ndarray, eps2: np.ndarray, derivatives: bool = True, majorant: bool = True):
+        """Regularised dissipated power ``D = sum w s``, ``s = sqrt(|v|^2 + eps^2)``,
+        of every active ball (W); with ``derivatives`` also its gradient
+        (B, 4), its Hessian ``H`` (B, 4, 4) and, with ``majorant``, ``M - H``
+        where ``M = sum (w/s) G^T G >= H`` is the Hessian of the quadratic
+        majorant of ``D`` at ``u`` (Weiszfeld).
+
+        With ``e = v/|v|``: ``grad = sum w (|v|/s) G^T e``; the Hessian of ``s``
+        in ``v`` is ``e_perp e_perp^T / s + eps^2 e e^T / s^3``, so
+        ``H = sum (w/s) m m^T + (w eps^2/s^3) n n^T`` (``m = G^T e_perp``,
+        ``n = G^T e``) and ``M - H = sum (w |v|^2/s^3) n n^T``."""
+        geo = self.geometry
+        v1, v2 = self.velocity(u)
+        n2, sp, t = self._n2, self._sp, self._t
+        np.multiply(v2, v2, out=n2)
+        n2 += (v1 * v1)[:, None, :]
+        np.add(n2, eps2, out=sp)
+        np.sqrt(sp, out=sp)
+        f = geo.sum_matrix @ np.einsum("cji,cji->c", self.weight, sp)
+        if not derivatives:
+            return f, None, None, None
+        if not self._derivative_arrays:
+            self._prepare_derivatives()
+        p1, p2, k, z, norm = self._p1, self._p2, self._k, self._z, self._norm
+        # gradient from the components: G1 = [g10, 0, g12, -1], G2 = [g20, g21, g22, 0]
+        np.divide(self.weight, sp, out=k)                                # w / s
+        np.multiply(k, v1[:, None, :], out=p1)
+        np.multiply(k, v2, out=p2)
+        s1 = p1.sum(axis=1)                                              # (C, I)
+        s2 = p2.sum(axis=1)
+        s2x = np.einsum("cji,cji->ci", p2, self.xi)
+        grad_c = np.stack([np.einsum("ci,ci->c", s1, self.g10) + np.einsum("ci,ci->c", s2x, self.c20),
+                           np.einsum("ci,ci->c", s2, self.g21),
+                           np.einsum("ci,ci->c", s1, self.g12) + np.einsum("ci,ci->c", s2x, self.c22),
+                           -s1.sum(axis=1)], axis=1)
+        grad = geo.sum_matrix @ grad_c
+        # Hessian rows, pre-scaled: sqrt(w/s) m = G^T (-p2, p1) with p = sqrt(w/s) v/|v|
+        np.sqrt(k, out=k)
+        np.add(n2, 1e-300, out=norm)
+        np.sqrt(norm, out=norm)                                          # |v|
+        np.divide(k, norm, out=k)
+        np.multiply(k, v1[:, None, :], out=p1)
+        np.multiply(k, v2, out=p2)
+        across, along = z[:, :, 0], z[:, :, 1]
+        g10, g12, g21 = self.g10_full, self.g12_full, self.g21_full
+        np.multiply(p1, self.g20, out=across[:, 0])
+        across[:, 0] -= np.multiply(p2, g10, out=t)
+        np.multiply(p1, g21, out=across[:, 1])
+        np.multiply(p1, self.g22, out=across[:, 2])
+        across[:, 2] -= np.multiply(p2, g12, out=t)
+        across[:, 3] = p2
+        # n rows: G^T q with q = p |v|/s (the M - H part) or q = p eps/s (the H part)
+        np.divide(norm if majorant else np.sqrt(eps2), sp, out=k)
+        p1 *= k
+        p2 *= k
+        np.multiply(p1, g10, out=along[:, 0])
+        along[:, 0] += np.multiply(p2, self.g20, out=t)
+        np.multiply(p2, g21, out=along[:, 1])
+        np.multiply(p1, g12, out=along[:, 2])
+        along[:, 2] += np.multiply(p2, self.g22, out=t)
+        np.negative(p1, out=along[:, 3])
+        flat = z.reshape(z.shape[0], 4, -1)
+        extra = None
+        if majorant:
+            half = flat.shape[2] // 2
+            extra_c = np.matmul(flat[:, :, half:], flat[:, :, half:].transpose(0, 2, 1))
+            extra = (geo.sum_matrix @ extra_c.reshape(-1, 16)).reshape(-1, 4, 4)
+            np.divide(np.sqrt(eps2), norm, out=k)                        # rescale to q = p eps/s
+            along *= k[:, None]
+        hess_c = np.matmul(flat, flat.transpose(0, 2, 1))
+        hess = (geo.sum_matrix @ hess_c.reshape(-1, 16)).reshape(-1, 4, 4)
+        return f, grad, hess, extra
+
+    def tractions(self, u: np.ndarray):
+        """Dissipated power (W) and torque on the moving ring about +z (N m) of
+        every contact, at the final regularisation."""
+        v1, v2 = self.velocity(u)
+        n2 = np.multiply(v2, v2, out=self._n2)
+        n2 += (v1 * v1)[:, None, :]
+        scale = np.add(n2, self.geometry.eps2, out=self._sp)
+        np.sqrt(scale, out=scale)
+        np.divide(self.weight, scale, out=scale)                         # |traction on the ball| / |v|
+        power = np.einsum("cji,cji->c", scale, n2)
+        # the traction on the ring is minus that on the ball; arm . v = arm1 v1 + arm2 xi v2
+        lever = np.multiply(self.xi, v2, out=self._t)
+        lever *= self.arm2[:, None, :]
+        lever += (self.arm1 * v1)[:, None, :]
+        torque = -np.einsum("cji,cji->c", scale, lever)
+        return power, torque
+
+
+def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int, safe: np.ndarray,
+              levels=()):
+    """Minimise the regularised dissipated power of every active ball (batched).
+
+    Step ``du = -(H + theta (M - H))^-1 g`` per ball: ``theta = 1`` is the
+    Weiszfeld (iteratively reweighted least squares) step, which lowers the
+    power however far from the minimum, where Newton's step (``theta = 0``)
+    can overshoot by orders of magnitude (the power is nearly linear in some
+    directions when every point slides); ``theta = 0`` converges
+    quadratically near the minimum. ``theta`` starts at 1 for the balls marked
+    ``safe`` (0 for the others), shrinks after each step that lowers the power
+    by at least half the predicted amount, and grows for a ball whose step
+    fails (the step is then retried at once).
+
+    ``levels``: continuation in the regularisation, e.g. ``(100, 10)``: one
+    step with ``eps`` 100 times, then one with 10 times the final one, then the
+    final ``eps``.
+
+    Stopping rule: the Newton decrement ``g . H^-1 g`` of every ball is at
+    most ``2 tol`` times its power (the power is then within ``tol`` of its
+    minimum); that last Newton step is taken where it lowers the power.
+
+    Returns ``(u, iterations, residual, converged)``; ``residual``: the largest
+    force residual of a ball, relative to ``mu Q_max``, at the last evaluation."""
+    schedule = [float(x) for x in levels] + [1.0]
+    level = 0
+    eps2 = contacts.geometry.eps2 * schedule[0] ** 2
+    n = u.shape[0]
+    theta = np.where(safe, 1.0, 0.0)
+    f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta > 0.0)))
+    scale = contacts.geometry.force_scale
+    eye = np.eye(4)
+    iterations = 0
+
+    def solve(a, rhs):
+        d = np.maximum(np.einsum("bii->b", a) / 4.0, 1e-300)
+        return np.linalg.solve(a + (1e-13 * d)[:, None, None] * eye, rhs[..., None])[..., 0]
+
+    def step(mask):
+        nonlocal h, extra
+        if not np.any(theta[mask] > 0.0):
+            return solve(h[mask], -g[mask])
+        if extra is None:
+            _, _, h, extra = contacts.evaluate(u, eps2, majorant=True)
+        return solve(h[mask] + theta[mask, None, None] * extra[mask], -g[mask])
+
+    while True:
+        final = level == len(schedule) - 1
+        residual = float(np.max(np.abs(g).max(axis=1) / scale))
+        if final:
+            newton = solve(h, -g)
+            if np.all(-np.einsum("bk,bk->b", g, newton) <= 2.0 * tol * f):
+                trial = u + newton
+                keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
+                return np.where(keep[:, None], trial, u), iterations + 1, residual, True
+        if iterations >= max_iterations:
+            return u, iterations, residual, False
+        iterations += 1
+        du = step(np.ones(n, dtype=bool))
+        slope = np.einsum("bk,bk->b", g, du)
+        predicted = -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
+        accepted = np.zeros(n, dtype=bool)
+        trial = u + du
+        f_t = f.copy()
+        fresh = None
+        for attempt in range(12):
+            derivatives = final and attempt == 0
+            f_new, g_t, h_t, x_t = contacts.evaluate(trial, eps2, derivatives=derivatives,
+                                                     majorant=bool(np.any(theta > 0.0)))
+            if derivatives:
+                fresh = (g_t, h_t, x_t)
+            actual = f - f_new
+            good = ~accepted & ((actual >= -1e-4 * slope) | (np.abs(actual) <= 1e-13 * np.abs(f)))
+            very = good & (actual >= 0.5 * predicted)
+            theta = np.where(very, np.where(theta > 1e-3, _THETA_DOWN * theta, 0.0), theta)
+            f_t = np.where(good, f_new, f_t)
+            accepted |= good
+            if np.all(accepted):
+                break
+            bad = ~accepted
+            if np.all(theta[bad] >= 1.0):        # the Weiszfeld step failed: round-off, stop there
+                trial[bad], f_t[bad] = u[bad], f[bad]
+                break
+            theta[bad] = np.minimum(1.0, np.maximum(_THETA_UP * theta[bad], _THETA_MIN_UP))
+            du[bad] = step(bad)
+            slope = np.einsum("bk,bk->b", g, du)
+            predicted = -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
+            trial[bad] = u[bad] + du[bad]
+        reuse = fresh is not None and attempt == 0
+        u = trial
+        if not final:
+            level += 1
+            eps2 = contacts.geometry.eps2 * schedule[level] ** 2
+        if reuse:
+            f, (g, h, extra) = f_t, fresh
+        else:
+            f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta > 0.0)))
+
+
+def _check_number(name: str, value, minimum: float | None = None, strict: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} = {value!r}: must be a number")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} = {value!r}: must be finite (not NaN or infinite)")
+    if minimum is not None and (value < minimum or (strict and value == minimum)):
+        raise ValueError(f"{name} = {value!r}: must be {'>' if strict else '>='} {minimum:g}")
+    return value
+
+
+def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, omega: float = 1.0,
+                    seal_torque: float = 0.0, seal_torque_per_length: float = 0.0, seal_length: float | None = None,
+                    omega_regularisation: float = DEFAULT_OMEGA_REGULARISATION, quadrature=DEFAULT_QUADRATURE,
+                    solve_quadrature=DEFAULT_SOLVE_QUADRATURE,
+                    sliding_regularisation: float = DEFAULT_SLIDING_REGULARISATION, initial=None,
+                    tol: float = 1e-6, max_iterations: int = 60) -> FrictionTorque:
+    """Friction torque of the bearing for a load distribution (full sliding, slow speed).
+
+    Parameters
+    ----------
+    bearing : Bearing
+        The bearing the distribution was solved for (ball and groove radii,
+        preload, ball-diameter errors, moving ring).
+    distribution : LoadDistribution
+        Rigid or flexible BIME result: ``contact_load`` (B, 4) N,
+        ``contact_angle`` (B, 4) rad, ``semi_axis_a``, ``semi_axis_b`` (B, 4) m.
+    mu : float
+        Coulomb coefficient of the ball-raceway contacts (default
+        :data:`DEFAULT_MU` = 0.1, boundary lubrication).
+    omega : float, rad/s
+        Speed of the moving ring about +z relative to the fixed ring.
+    seal_torque : float, N m
+        Load-independent torque (seals, lubricant).
+    seal_torque_per_length : float, N m per m of seal
+        Added as ``seal_torque_per_length * seal_length``.
+    seal_length : float, m, optional
+        Default: two seals on the pitch circle, ``2 pi dm``.
+    omega_regularisation : float, rad/s
+        Speed scale of :func:`regularised_torque` (0: discontinuous Coulomb law).
+    quadrature : int or (int, int)
+        Rule (points across x along each ellipse) on which the power, hence
+        the torque, is integrated (default :data:`DEFAULT_QUADRATURE`).
+    solve_quadrature : int, (int, int) or None
+        Rule on which the ball equilibrium is solved (default
+        :data:`DEFAULT_SOLVE_QUADRATURE`); None: ``quadrature`` itself.
+    sliding_regularisation : float
+        ``|v_s|`` becomes ``sqrt(|v_s|^2 + eps^2)`` with
+        ``eps = sliding_regularisation * |omega| * a`` per contact.
+    initial : FrictionTorque or ndarray (B, 4), optional
+        Warm start of the ball equilibrium: a previous result for this bearing.
+    tol : float
+        Relative accuracy of the minimum dissipated power of every ball (Newton
+        decrement test).
+    max_iterations : int
+
+    Returns
+    -------
+    FrictionTorque
+        ``converged`` is False if the ball equilibrium did not meet ``tol``
+        within ``max_iterations`` (the torque is then an upper bound).
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing, solve, Loads
+    >>> b = load_bearing("examples/bearings/table1.toml")
+    >>> t = friction_torque(b, solve(b, Loads(Fz=500e3)), mu=0.1, omega=0.05)
+    >>> t.torque < 0 < t.magnitude
+    True
+    """
+    mu = _check_number("mu", mu, 0.0)
+    omega = _check_number("omega", omega)
+    sliding_regularisation = _check_number("sliding_regularisation", sliding_regularisation, 0.0, strict=True)
+    tol = _check_number("tol", tol, 0.0, strict=True)
+    quad = _quadrature(quadrature)
+    solve_quad = quad if solve_quadrature is None else _quadrature(solve_quadrature)
+    seal = seal_torque_of(bearing, seal_torque, seal_torque_per_length, seal_length)
+    speed = omega if omega != 0.0 else 1.0
+    geometry = _ContactSet(bearing, distribution, mu, speed, sliding_regularisation)
+    n_balls = bearing.ball_count
+    ls, big_r = geometry.length_scale, geometry.pitch_radius
+    scale_u = np.array([ls, ls, ls, big_r])
+    active = geometry.active
+
+    iterations, residual, converged = 0, 0.0, True
+    u = np.zeros((active.size, 4))
+    if active.size and mu > 0.0:
+        contacts = _Contacts(geometry, quad)
+        same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
+        solver = contacts if same else _Contacts(geometry, solve_quad, workspace="solve")
+        u = geometry.initial_guess()
+        cold = np.ones(active.size, dtype=bool)
+        if initial is not None:
+            state = initial.state if isinstance(initial, FrictionTorque) else np.asarray(initial, dtype=float)
+            if state.shape != (n_balls, 4):
+                raise ValueError(f"initial: state of shape {state.shape}, expected ({n_balls}, 4) for this bearing")
+            warm = state[active] * speed * scale_u
+            cold = ~(np.all(np.isfinite(warm), axis=1) & np.any(warm != 0.0, axis=1))
+            u[~cold] = warm[~cold]
+        # cold balls: Weiszfeld-safe steps, and a regularisation continuation when all are cold
+        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations, safe=cold,
+                                                       levels=SOLVE_LEVELS if np.all(cold) else ())
+        power_c, torque_c = contacts.tractions(u)
+    else:
+        power_c = torque_c = np.zeros(active.size and geometry.ball_index.size)
+
+    contact_power = np.zeros((n_balls, 4))
+    contact_power[geometry.ball_index, geometry.contact_index] = power_c
+    per_ball = contact_power.sum(axis=1) / abs(speed)
+    contact_part = float(per_ball.sum())
+    contact_part_moments = -math.copysign(1.0, speed) * float(np.sum(torque_c))
+    magnitude = contact_part + seal
+
+    omega_ball = np.zeros((n_balls, 3))
+    orbital = np.zeros(n_balls)
+    state = np.zeros((n_balls, 4))
+    if active.size:
+        omega_ball[active] = u[:, :3] / ls
+        orbital[active] = u[:, 3] / big_r
+        state[active] = u / (speed * scale_u)
+    if geometry.inactive.size:       # unloaded balls: nominal rolling, for the record
+        from .assembly import cage_ratio
+        orbital[geometry.inactive] = cage_ratio(bearing) * speed
+    return FrictionTorque(
+        torque=regularised_torque(magnitude, omega, omega_regularisation),
+        magnitude=magnitude, contact_part=contact_part, contact_part_moments=contact_part_moments,
+        seal_part=seal, per_ball=per_ball, omega=omega, kinematics_speed=speed,
+        ball_angular_velocity=omega_ball, orbital_speed=orbital,
+        spin_roll_ratio=_spin_roll_ratio(geometry, u, n_balls), contact_power=contact_power,
+        contact_count=np.count_nonzero(geometry.loaded, axis=1), power=float(np.sum(power_c)), mu=mu,
+        iterations=iterations, residual=residual, converged=converged, state=state,
+    )
+
+
+def _spin_roll_ratio(geometry: _ContactSet, u: np.ndarray, n_balls: int) -> np.ndarray:
+    """Relative spin over relative rolling at each loaded contact centre."""
+    out = np.zeros((n_balls, 4))
+    if not geometry.active.size:
+        return out
+    rel = -u[geometry.owner, :3] / geometry.length_scale          # raceway minus ball: W e_z - w
+    rel[:, 2] += geometry.ring_speed[:, 0]
+    n_r, n_z = geometry.normal[:, 0], geometry.normal[:, 1]
+    spin = rel[:, 0] * n_r + rel[:, 2] * n_z
+    roll = -rel[:, 0] * n_z + rel[:, 2] * n_r                      # about g = (-n_z, 0, n_r)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out[geometry.ball_index, geometry.contact_index] = np.where(roll != 0.0, spin / roll, 0.0)
+    return out
+
+
+# ---- catalogue formula --------------------------------------------------------------------
+
+def catalogue_torque(bearing: Bearing, loads, mu: float = CATALOGUE_MU) -> float:
+    """Start-up friction torque of slewing bearing catalogues, N m.
+
+    ``M = mu / 2 (4.4 M_k + F_a D + 2.2 F_r D 1.73)``. The makers write it with
+    ``M`` and ``M_k`` in kN m, forces in kN and ``D`` (raceway, i.e. pitch,
+    diameter) in m; every term is a force times a length, so the same
+    expression holds in N, N m and m (both sides scale by 1000) and no
+    numerical conversion factor is needed.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    loads : Loads or None
+        ``F_a = |Fz|``, ``F_r = hypot(Fx, Fy)``, ``M_k = hypot(Mx, My)``.
+    mu : float
+        About 0.006 for four-point contact bearings (scatter about +-25 %).
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing, Loads
+    >>> b = load_bearing("examples/bearings/table1.toml")
+    >>> round(catalogue_torque(b, Loads(Fz=1e6)))   # 0.003 * 1e6 N * 1.5 m
+    4500
+    """
+    mu = _check_number("mu", mu, 0.0)
+    if loads is None:
+        return 0.0
+    d = bearing.pitch_diameter
+    f_a = abs(loads.Fz)
+    f_r = math.hypot(loads.Fx, loads.Fy)
+    m_k = math.hypot(loads.Mx, loads.My)
+    return 0.5 * mu * (4.4 * m_k + f_a * d + 2.2 * f_r * d * 1.73)
+
+
+# ---- rotation and studies -----------------------------------------------------------------
+
+def torque_ripple(bearing: Bearing, loads, psi, *, model: str = "rigid", superelement=None, mu: float = DEFAULT_MU,
+                  cage_angle=None, loads_frame: str = "fixed", seal_torque: float = 0.0,
+                  seal_torque_per_length: float = 0.0, quadrature=DEFAULT_QUADRATURE, bc: str = "free",
+                  mesh: str = "coarse", details: bool = False):
+    """Friction torque magnitude (N m) at each rotation ``psi`` of the moving ring.
+
+    At every ``psi`` the bearing is re-assembled (each ring's errors read under
+    the balls at that rotation, :mod:`slewing_model.assembly`), the load
+    distribution solved with a warm-started :class:`~slewing_model.bime.BimeSolver`
+    (``set_rotation``) and the friction computed with a warm-started ball
+    equilibrium. The configuration repeats when ``psi`` changes by ``2 pi`` at
+    the same cage angle and, without ball-diameter errors, when the cage angle
+    changes by one ball pitch ``2 pi / B``.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    loads : Loads or None
+        On the moving ring.
+    psi : array_like, rad
+        Rotations of the moving ring.
+    model : {"rigid", "flexible"}
+    superelement : Superelement, optional
+        For ``model="flexible"`` (built with ``bc`` and ``mesh`` when not given).
+    mu : float
+    cage_angle : array_like, rad, optional
+        Rotation of the ball set at each ``psi``; default: rolling without slip
+        (:func:`slewing_model.assembly.cage_ratio`).
+    loads_frame : {"fixed", "moving"}
+        Frame in which ``loads`` stays constant: ``"moving"`` turns it with the
+        moving ring (e.g. the blade loads on a pitch bearing).
+    seal_torque, seal_torque_per_length : float
+        As in :func:`friction_torque`.
+    quadrature : int or (int, int)
+    bc, mesh : str
+        Superelement options when it is built here.
+    details : bool
+        Also return the lists of load distributions and :class:`FrictionTorque`.
+
+    Returns
+    -------
+    ndarray, N m, shape of ``psi``
+        (and, with ``details``, the distributions and friction results).
+    """
+    from .bime import BimeSolver, Loads
+
+    if model not in ("rigid", "flexible"):
+        raise ValueError(f"model = {model!r}: must be 'rigid' or 'flexible'")
+    if loads_frame not in ("fixed", "moving"):
+        raise ValueError(f"loads_frame = {loads_frame!r}: must be 'fixed' or 'moving'")
+    loads = Loads() if loads is None else loads
+    psi = np.asarray(psi, dtype=float)
+    flat = psi.ravel()
+    cages = None if cage_angle is None else np.broadcast_to(np.asarray(cage_angle, dtype=float), psi.shape).ravel()
+    if model == "flexible" and superelement is None:
+        from .superelement import build_superelement
+
+        superelement = build_superelement(bearing, mesh=mesh, bc=bc)
+    solver = BimeSolver(bearing, superelement if model == "flexible" else None,
+                        psi=float(flat[0]) if flat.size else 0.0,
+                        cage_angle=None if cages is None else float(cages[0]))
+    out = np.empty(flat.size)
+    distributions, frictions = [], []
+    distribution = friction = None
+    for k, angle in enumerate(flat):
+        solver.set_rotation(float(angle), None if cages is None else float(cages[k]))
+        load_k = loads.rotated(float(angle)) if loads_frame == "moving" else loads
+        distribution = solver.solve(load_k, initial=distribution)
+        friction = friction_torque(bearing, distribution, mu=mu, seal_torque=seal_torque,
+                                   seal_torque_per_length=seal_torque_per_length, quadrature=quadrature,
+                                   initial=friction)
+        out[k] = friction.magnitude
+        if details:
+            distributions.append(distribution)
+            frictions.append(friction)
+    out = out.reshape(psi.shape)
+    return (out, distributions, frictions) if details else out
+
+
+def preload_sweep(bearing: Bearing, preloads, loads=None, *, model: str = "rigid", superelement=None,
+                  mu: float = DEFAULT_MU, psi: float = 0.0, quadrature=DEFAULT_QUADRATURE, details: bool = False):
+    """Friction torque magnitude (N m) against ball preload (m), as the paper's Figure 14.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    preloads : array_like, m
+        Ball oversize values (``Bearing.with_preload``).
+    loads : Loads, optional
+        External load (None: idling, as Figure 14).
+    model : {"rigid", "flexible"}
+    superelement : Superelement, optional
+        For the flexible model; the ring matrices do not depend on the preload.
+    mu, psi, quadrature
+        As in :func:`friction_torque` and :func:`slewing_model.bime.solve`.
+    details : bool
+        Also return the list of :class:`FrictionTorque` (contact counts etc.).
+    """
+    from .bime import solve
+
+    preloads = np.asarray(preloads, dtype=float)
+    out = np.empty(preloads.size)
+    results = []
+    friction = None
+    for k, preload in enumerate(preloads.ravel()):
+        b = bearing.with_preload(float(preload))
+        distribution = solve(b, loads, model=model, superelement=superelement, psi=psi)
+        friction = friction_torque(b, distribution, mu=mu, quadrature=quadrature, initial=friction)
+        out[k] = friction.magnitude
+        results.append(friction)
+    out = out.reshape(preloads.shape)
+    return (out, results) if details else out
