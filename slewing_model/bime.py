@@ -50,6 +50,9 @@ from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .geometry import RING_CONTACTS, Bearing
 
 LOAD_FIELDS = ("Fx", "Fy", "Fz", "Mx", "My")
+#: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
+#: residual by less than this factor (benchmarks/bench_flexible.py measured the choice)
+REFRESH = 0.25
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
 DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
@@ -285,6 +288,7 @@ class BimeSolver:
             None if superelement is None else contact_compliance(superelement))
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
+        self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self.set_rotation(psi, cage_angle)
 
     # ---- set-up -------------------------------------------------------------------
@@ -435,6 +439,7 @@ class BimeSolver:
         trust = 0.02 * dw
         mu = 1e-12 * self.reference_stiffness
         iterations = 0
+        last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         point = self._evaluate(qs, y, f_scaled)
         while True:
             f = point.force.ravel()
@@ -442,9 +447,10 @@ class BimeSolver:
             scale = max(float(np.abs(f_scaled).max()), float(point.q.max()), 1e-300)
             residual = float(np.abs(grad_q).max())
             if flexible:
+                scale = max(scale, float(np.abs(point.y).max()))
                 residual = max(residual, float(np.abs(f - point.y).max()))
             residual /= scale
-            if residual <= self.rtol or (not np.any(point.q > 0) and not np.any(f_scaled)):
+            if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
             if iterations >= self.max_iterations:
                 raise NoEquilibriumError(
@@ -453,7 +459,11 @@ class BimeSolver:
             iterations += 1
 
             if flexible:
-                dq, dy = self._flexible_direction(point, f_scaled, mu)
+                # a fresh reduced operator on the first iteration of a cold solve and whenever
+                # the residual fell by less than a factor 4 in the last iteration
+                fresh = last_residual is None or residual > REFRESH * last_residual
+                last_residual = residual
+                dq, dy = self._flexible_direction(point, f_scaled, mu, fresh)
                 slope = float(grad_q @ dq) - float((self.compliance @ (f - point.y)) @ dy)
             else:
                 dq, dy = self._rigid_direction(point, grad_q, mu), point.y
@@ -498,31 +508,45 @@ class BimeSolver:
         h = jac.reshape(-1, 5).T @ (p.hess.reshape(-1, 2, 2) @ jac.reshape(-1, 2, 5)).reshape(-1, 5)
         return np.linalg.solve(h + mu * np.eye(5), -grad_q)
 
-    def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float):
+    def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float, fresh: bool):
         """Newton step of the flexible model, reduced to the active contacts
-        (module docstring): returns the increments of ``qs`` and ``y``."""
+        (module docstring): returns the increments of ``qs`` and ``y``.
+
+        The reduced operator ``(A^-1 + M)_aa^-1`` is kept and reused (a modified
+        Newton step with the contact stiffness ``A`` of an earlier iterate, which
+        is still a descent direction) while the active contacts stay the same and
+        ``fresh`` is False; the solve loop asks for a fresh one when convergence
+        slows. Between warm-started solves of slowly changing loads (the FMU's
+        steps) an iteration then costs matrix-vector products only.
+        """
         dw = self.bearing.ball_diameter
         active = (p.delta > 1e-15 * dw).ravel()
         idx = np.flatnonzero(np.repeat(active, 2))
         y_new = np.zeros_like(p.y)
         if idx.size == 0:
+            self._reduced = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), y_new - p.y
-        nn = p.n[..., :, None] * p.n[..., None, :]
-        k_normal = 1.5 * self.assembly.stiffness * np.sqrt(np.maximum(p.delta, 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            a_inv = nn / k_normal[..., None, None] + (p.length / p.q)[..., None, None] * (np.eye(2) - nn)
-        a_inv = a_inv.reshape(-1, 2, 2)[active]           # A^-1 of the active diagonals
-        w_mat = self.compliance[np.ix_(idx, idx)]         # (A^-1 + M)_aa
-        blocks = np.arange(0, idx.size, 2)
-        for r in range(2):
-            for c in range(2):
-                w_mat[blocks + r, blocks + c] += a_inv[:, r, c]
+        cached = self._reduced
+        if fresh or cached is None or not np.array_equal(cached[0], idx):
+            nn = p.n[..., :, None] * p.n[..., None, :]
+            k_normal = 1.5 * self.assembly.stiffness * np.sqrt(np.maximum(p.delta, 0.0))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                a_inv = nn / k_normal[..., None, None] + (p.length / p.q)[..., None, None] * (np.eye(2) - nn)
+            a_inv = a_inv.reshape(-1, 2, 2)[active]           # A^-1 of the active diagonals
+            w_mat = self.compliance[np.ix_(idx, idx)]         # (A^-1 + M)_aa
+            blocks = np.arange(0, idx.size, 2)
+            for r in range(2):
+                for c in range(2):
+                    w_mat[blocks + r, blocks + c] += a_inv[:, r, c]
+            w_inv = np.linalg.inv(w_mat)
+            ja = self.jacobian.reshape(-1, 5)[idx]
+            z_mat = w_inv @ ja
+            schur_inv = np.linalg.inv(ja.T @ z_mat + mu * np.eye(5))
+            cached = self._reduced = (idx, active, a_inv, w_inv, ja, z_mat, schur_inv)
+        _, active, a_inv, w_inv, ja, z_mat, schur_inv = cached
         rhs = (a_inv @ p.force.reshape(-1, 2)[active][..., None]).ravel() + (self.compliance[idx] @ p.y)
-        ja = self.jacobian.reshape(-1, 5)[idx]
-        chol = np.linalg.cholesky(w_mat)
-        z_mat = _cho_solve(chol, ja)
-        w_vec = _cho_solve(chol, rhs)
-        dq = np.linalg.solve(ja.T @ z_mat + mu * np.eye(5), f_scaled - ja.T @ w_vec)
+        w_vec = w_inv @ rhs
+        dq = schur_inv @ (f_scaled - ja.T @ w_vec)
         y_new[idx] = w_vec + z_mat @ dq
         return dq, y_new - p.y
 

@@ -67,5 +67,5 @@ def test_warm_start_after_small_load_change(bearing):
     changed = Loads(*(1.01 * LOADS[1].as_array()))
     warm = solver.solve(changed, initial=first)
     cold = solver.solve(changed)
-    assert warm.iterations <= 3 < cold.iterations + 1
+    assert warm.iterations < cold.iterations
     assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
