@@ -145,6 +145,9 @@ class LoadDistribution:
         Hertz ellipse across the groove and along the rolling direction.
     contact_pressure : ndarray (B, 4), Pa
         Maximum Hertz pressure of each contact.
+    truncated : ndarray (B, 4) of bool
+        Edge loading: the contact ellipse runs over the groove edge (its
+        pressure is then higher than Hertz's, which assumes an untruncated ellipse).
     energy : float, J
         Total potential energy (eq 20).
     iterations : int
@@ -166,6 +169,7 @@ class LoadDistribution:
     semi_axis_a: np.ndarray
     semi_axis_b: np.ndarray
     contact_pressure: np.ndarray
+    truncated: np.ndarray
     energy: float
     iterations: int
     residual: float
@@ -190,6 +194,11 @@ class LoadDistribution:
         return math.inf if p <= 0.0 else (ISO76_PRESSURE_LIMIT / p) ** 3
 
     @property
+    def truncated_contacts(self) -> int:
+        """Number of contacts whose ellipse runs over the groove edge (edge loading)."""
+        return int(np.count_nonzero(self.truncated))
+
+    @property
     def balls_in_four_point_contact(self) -> int:
         """Number of balls whose both diagonals carry load."""
         return int(np.count_nonzero(np.all(self.interference > 0.0, axis=1)))
@@ -209,6 +218,7 @@ class LoadDistribution:
             "max_contact_pressure": self.max_contact_pressure,
             "static_safety_factor": self.static_safety_factor,
             "balls_in_four_point_contact": self.balls_in_four_point_contact,
+            "truncated_contacts": self.truncated_contacts,
             "energy": self.energy,
             "iterations": self.iterations,
         }
@@ -271,10 +281,16 @@ class BimeSolver:
     compliance : ndarray, optional
         Precomputed :func:`contact_compliance` of ``superelement`` (shared
         between solvers of the same bearing).
+    pressure_limit : float, Pa
+        Loads whose largest Hertz pressure exceeds this are refused
+        (:class:`LoadCapacityError`). Default ``2 x 4200 MPa``: twice the ISO 76
+        permanent-deformation limit (static safety factor 0.125), gross plastic
+        deformation where the elastic Hertz model no longer holds.
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
-                 rtol: float = 1e-10, max_iterations: int = 200, compliance: np.ndarray | None = None):
+                 rtol: float = 1e-10, max_iterations: int = 200, compliance: np.ndarray | None = None,
+                 pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT):
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
             raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
                              f"the bearing ball_count = {bearing.ball_count}")
@@ -283,6 +299,7 @@ class BimeSolver:
         self.model = "rigid" if superelement is None else "flexible"
         self.rtol = rtol
         self.max_iterations = max_iterations
+        self.pressure_limit = pressure_limit
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
         self.compliance = compliance if compliance is not None else (
             None if superelement is None else contact_compliance(superelement))
@@ -411,8 +428,8 @@ class BimeSolver:
             The load has no equilibrium within the bearing (a direction no
             contact resists, or no convergence).
         LoadCapacityError
-            A contact ellipse runs over the groove edge: the load is beyond what
-            the raceways can carry.
+            A contact point would leave the raceway (contact angle past the
+            groove edge): the load is beyond what the bearing can carry.
         """
         loads = Loads() if loads is None else loads
         f_scaled = self._scaled_load(loads)
@@ -431,7 +448,8 @@ class BimeSolver:
             # start from the rigid solution: the rings feel its contact forces
             rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, cage_angle=self.assembly.cage_angle, rtol=1e-6,
                                max_iterations=self.max_iterations)
-            rigid.edge_angle = np.full(4, np.pi)  # no truncation check on the starting guess
+            rigid.edge_angle = np.full(4, np.pi)  # no capacity checks on the starting guess
+            rigid.pressure_limit = math.inf
             start = rigid.solve(loads)
             qs = start.state[:5].copy()
             y = rigid._evaluate(qs, y, f_scaled).force.ravel()
@@ -568,24 +586,31 @@ class BimeSolver:
         ell = hertz_ellipse(contact_load, a.ball_diameter[:, None], a.groove_radius, contact_angle,
                             b.pitch_diameter, CONTACT_RING, b.youngs_modulus, b.poisson_ratio)
         semi_a, semi_b, pressure = ell.a, ell.b, ell.max_pressure
-        # truncation: the ellipse must stay on the raceway (below the groove edge)
-        reach = contact_angle + semi_a / a.groove_radius
-        over = (contact_load > 0.0) & (reach >= self.edge_angle[None, :])
-        if np.any(over):
-            ball, contact = map(int, np.argwhere(over)[0])
+        # the contact point must stay on the raceway: beyond the groove edge the ball rides the
+        # edge and the model (and the bearing) no longer carries the load
+        off = (contact_load > 0.0) & (contact_angle >= self.edge_angle[None, :])
+        if np.any(off):
+            ball, contact = map(int, np.argwhere(off)[0])
             raise LoadCapacityError(
-                f"loads {loads} are beyond what the bearing can carry: at ball {ball + 1} the contact ellipse of "
-                f"contact {contact + 1} (contact angle {math.degrees(contact_angle[ball, contact]):.1f} deg, half-width "
-                f"{math.degrees(semi_a[ball, contact] / a.groove_radius[ball, contact]):.1f} deg, load "
-                f"{contact_load[ball, contact]:.4g} N) runs over the groove edge at "
-                f"{math.degrees(self.edge_angle[contact]):.1f} deg")
+                f"loads {loads} are beyond what the bearing can carry: at ball {ball + 1} the contact angle of "
+                f"contact {contact + 1} would be {math.degrees(contact_angle[ball, contact]):.1f} deg, past the "
+                f"groove edge at {math.degrees(self.edge_angle[contact]):.1f} deg (load {contact_load[ball, contact]:.4g} N)")
+        if pressure.max() > self.pressure_limit:
+            ball, contact = np.unravel_index(int(np.argmax(pressure)), pressure.shape)
+            raise LoadCapacityError(
+                f"loads {loads} are beyond what the bearing can carry: the contact pressure of ball {ball + 1}, "
+                f"contact {contact + 1} would be {pressure.max() / 1e6:.0f} MPa, above the limit of "
+                f"{self.pressure_limit / 1e6:.0f} MPa (static safety factor "
+                f"{(ISO76_PRESSURE_LIMIT / pressure.max()) ** 3:.3f})")
+        # edge loading: the ellipse runs over the groove edge (reported, see LoadDistribution.truncated)
+        truncated = (contact_load > 0.0) & (contact_angle + semi_a / a.groove_radius >= self.edge_angle[None, :])
         displacement = qs.copy()
         displacement[3:] /= self.length
         return LoadDistribution(
             model=self.model, loads=loads, displacement=displacement, ball_angle=a.ball_angle.copy(),
             contact_load=contact_load, contact_angle=contact_angle, interference=delta.copy(),
             contact_deflection=deflection, ring_displacement=ring_disp, semi_axis_a=semi_a, semi_axis_b=semi_b,
-            contact_pressure=pressure, energy=p.total, iterations=iterations, residual=residual,
+            contact_pressure=pressure, truncated=truncated, energy=p.total, iterations=iterations, residual=residual,
             state=np.concatenate([qs, y]),
         )
 

@@ -146,10 +146,34 @@ def test_idling_with_clearance_is_at_rest(table3):
 
 
 def test_load_beyond_raceway_capacity_is_refused(table3):
-    with pytest.raises(LoadCapacityError, match=r"groove edge"):
+    # gross overload: Hertz pressure above twice the ISO 76 limit
+    with pytest.raises(LoadCapacityError, match=r"contact pressure .* above the limit of 8400 MPa"):
         solve(table3, Loads(Fz=5e7))
     with pytest.raises(LoadCapacityError, match=r"beyond what the bearing can carry"):
         solve(table3, Loads(Mx=2e7))
+
+
+def test_contact_point_past_the_groove_edge_is_refused():
+    # a wide gap between the rings leaves a shallow groove: its edge comes before the pressure limit
+    from slewing_model import bearing_from_dict
+
+    shallow = bearing_from_dict({"bearing": {"pitch_diameter_mm": 541.0, "ball_diameter_mm": 25.0,
+                                             "groove_radius_mm": 13.25, "contact_angle_deg": 56.0, "ball_count": 67},
+                                 "rings": {"gap_mm": 12.0}})
+    edge = shallow.groove_edge_angle(1)
+    assert math.radians(58) < edge < math.radians(62)
+    assert solve(shallow, Loads(Fz=2e5)).contact_angle.max() < edge
+    with pytest.raises(LoadCapacityError, match=r"past the groove edge"):
+        solve(shallow, Loads(Fz=3e6))
+
+
+def test_edge_loading_is_reported_before_the_load_is_refused(table1):
+    # the ellipse reaches the groove edge (82.3 deg for the default rings) before its centre does
+    moderate = solve(table1, Loads(Fz=2e6))
+    high = solve(table1, Loads(Fz=2e7))
+    assert moderate.truncated_contacts == 0 < high.truncated_contacts
+    reach = high.contact_angle + high.semi_axis_a / table1.groove_radius[0]
+    assert np.all(reach[high.truncated] >= table1.groove_edge_angle(1))
 
 
 def test_solver_stops_with_a_clear_error_instead_of_looping(table3):
