@@ -1,0 +1,133 @@
+"""Flexible-BIME with finite element superelements (paper sections 2.2-2.4)."""
+import math
+
+import numpy as np
+import pytest
+
+from slewing_model import BimeSolver, Loads, load_bearing, solve
+from slewing_model.superelement import build_superelement
+
+from conftest import BEARINGS
+
+
+@pytest.fixture(scope="module")
+def table3_errors():
+    return load_bearing(BEARINGS / "table3_errors.toml")
+
+
+@pytest.fixture(scope="module")
+def table3_free(table3_errors):
+    return build_superelement(table3_errors, mesh="coarse", bc="free")
+
+
+@pytest.fixture(scope="module")
+def table1_rings(table1):
+    return {bc: build_superelement(table1, mesh="coarse", bc=bc) for bc in ("clamped", "free")}
+
+
+def test_stiff_rings_give_the_rigid_result(table3_errors, table3_free):
+    bearing = table3_errors.with_preload(10e-6)
+    loads = Loads(Fx=1e4, Fz=4e4, My=2e3)
+    stiff = solve(bearing, loads, model="flexible", superelement=table3_free.scaled(1e6))
+    rigid = solve(bearing, loads)
+    assert np.allclose(stiff.contact_load, rigid.contact_load, rtol=1e-3, atol=1e-3 * rigid.max_ball_load)
+
+
+def test_ring_flexibility_lowers_and_smooths_the_preload_interference(table3_errors, table3_free):
+    # paper section 4.1: +20 um preload, rigid 25 -> flexible 14 um mean, band 14 -> 12 um
+    bearing = table3_errors.with_preload(20e-6)
+    rigid = solve(bearing)
+    flexible = solve(bearing, model="flexible", superelement=table3_free)
+    assert flexible.interference.mean() < 0.85 * rigid.interference.mean()
+    assert np.ptp(flexible.interference) < np.ptp(rigid.interference)
+
+
+def test_axial_stiffness_clamped_near_rigid_free_softer(table1, table1_rings):
+    # paper Fig. 6: rigid supports keep the rings near the rigid-ring curve, free rings are far softer
+    for force in (1e6, 2e6, 4e6):
+        z_rigid = solve(table1, Loads(Fz=force)).displacement[2]
+        z_clamped = solve(table1, Loads(Fz=force), model="flexible", superelement=table1_rings["clamped"]).displacement[2]
+        z_free = solve(table1, Loads(Fz=force), model="flexible", superelement=table1_rings["free"]).displacement[2]
+        assert z_rigid < z_clamped < 1.3 * z_rigid
+        assert z_free > 1.5 * z_rigid
+
+
+def _load_on_moving_ring(bearing, result):
+    """Forces and moments of the contacts on the moving (inner) ring, summed independently of the
+    solver from Q, the contact angles and the nominal groove-centre positions (eq 23 statics)."""
+    centres = bearing.groove_centres               # (4, 2) nominal (R, z)
+    phi = result.ball_angle
+    total = np.zeros(5)
+    for diagonal, (inner_contact, zsign) in enumerate(((3, 1.0), (2, -1.0))):
+        q, alpha = result.contact_load[:, diagonal], result.contact_angle[:, diagonal]
+        fr, fz = -q * np.cos(alpha), -zsign * q * np.sin(alpha)   # outer ring on inner ring
+        r, z = centres[inner_contact - 1]
+        fx, fy = fr * np.cos(phi), fr * np.sin(phi)
+        px, py = r * np.cos(phi), r * np.sin(phi)
+        total += [fx.sum(), fy.sum(), fz.sum(), (py * fz - z * fy).sum(), (z * fx - px * fz).sum()]
+    return -total  # the applied load balances the contact forces
+
+
+@pytest.mark.parametrize("loads", [Loads(Fz=3e4), Loads(Fx=2e4, Fz=1e4, Mx=2e3, My=-1e3)])
+def test_contact_forces_balance_the_applied_load(table3_errors, table3_free, loads):
+    r = solve(table3_errors.with_preload(10e-6), loads, model="flexible", superelement=table3_free)
+    got = _load_on_moving_ring(table3_errors, r)
+    scale = np.abs(loads.as_array() * [1, 1, 1, 2 / 0.541, 2 / 0.541]).max()
+    assert np.allclose(got * [1, 1, 1, 2 / 0.541, 2 / 0.541], loads.as_array() * [1, 1, 1, 2 / 0.541, 2 / 0.541],
+                       atol=1e-6 * scale)
+
+
+def _ring_loads(result):
+    """Contact forces on each ring's groove centres, in the superelement's DOF order."""
+    a1, a2 = result.contact_angle[:, 0], result.contact_angle[:, 1]
+    f1 = result.contact_load[:, 0:1] * np.stack([np.cos(a1), np.sin(a1)], axis=1)    # diagonal 1 direction
+    f2 = result.contact_load[:, 1:2] * np.stack([np.cos(a2), -np.sin(a2)], axis=1)   # diagonal 2 direction
+    on_inner = -np.stack([f2, f1], axis=1)   # contacts 2 (diag 2), 3 (diag 1)
+    on_outer = np.stack([f1, f2], axis=1)    # contacts 1 (diag 1), 4 (diag 2)
+    return on_outer.ravel(), on_inner.ravel()
+
+
+@pytest.mark.parametrize("bc", ["clamped", "free"])
+def test_each_ring_balances_its_strain_energy_gradient(table1, table1_rings, bc):
+    se = table1_rings[bc]
+    r = solve(table1.with_preload(10e-6), Loads(Fz=8e5, My=6e5), model="flexible", superelement=se)
+    on_outer, on_inner = _ring_loads(r)
+    d = r.ring_displacement
+    scale = r.max_ball_load
+    for ring, load, disp in ((se.outer, on_outer, d[:, [0, 3]].ravel()), (se.inner, on_inner, d[:, [1, 2]].ravel())):
+        k = ring.dense()
+        if bc == "free":  # a free ring is held against rigid motion: only the self-balanced part deforms it
+            w, v = np.linalg.eigh(k)
+            rigid = v[:, np.abs(w) < 1e-9 * np.abs(w).max()]
+            assert rigid.shape[1] == 5
+            load = load - rigid @ (rigid.T @ load)
+        assert np.allclose(k @ disp, load, atol=1e-6 * scale)
+
+
+def test_radial_load_has_no_spurious_circumferential_stiffness(table3_errors, table3_free):
+    # paper Fig. 12: springs that stay in each ball's radial plane carry a radial load only
+    # through their radial components; a load along x moves the ring along x only
+    bearing = load_bearing(BEARINGS / "table3.toml")  # nominal: symmetric about the x axis
+    se = build_superelement(bearing, mesh="coarse", bc="free")
+    for fx in (2e4, 4e4):
+        r = solve(bearing, Loads(Fx=fx), model="flexible", superelement=se)
+        got = _load_on_moving_ring(bearing, r)
+        assert got[0] == pytest.approx(fx, rel=1e-6)
+        assert abs(got[1]) < 1e-6 * fx and abs(r.displacement[1]) < 1e-9 * abs(r.displacement[0])
+    # radial stiffness from two solutions equals the radial load over the displacement increment
+    r1 = solve(bearing, Loads(Fx=2e4), model="flexible", superelement=se)
+    r2 = solve(bearing, Loads(Fx=2.02e4), model="flexible", superelement=se)
+    k_secant = (2.02e4 - 2e4) / (r2.displacement[0] - r1.displacement[0])
+    f1, f2 = _load_on_moving_ring(bearing, r1)[0], _load_on_moving_ring(bearing, r2)[0]
+    assert (f2 - f1) / (r2.displacement[0] - r1.displacement[0]) == pytest.approx(k_secant, rel=1e-5)
+
+
+def test_warm_started_solver_follows_rotation(table3_errors, table3_free):
+    solver = BimeSolver(table3_errors.with_preload(10e-6), table3_free)
+    previous = solver.solve(Loads(Fz=3e4))
+    for psi in np.linspace(0.0, 0.2, 5):
+        solver.set_rotation(psi)
+        warm = solver.solve(Loads(Fz=3e4), initial=previous)
+        cold = BimeSolver(table3_errors.with_preload(10e-6), table3_free, psi=psi).solve(Loads(Fz=3e4))
+        assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-7, atol=1e-7 * cold.max_ball_load)
+        previous = warm
