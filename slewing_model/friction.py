@@ -73,7 +73,7 @@ DEFAULT_SLIDING_REGULARISATION = 1e-3
 #: Default speed scale of the regularised Coulomb law near omega = 0, rad/s
 DEFAULT_OMEGA_REGULARISATION = 1e-4
 #: Regularisation continuation of a cold start (multiples of the final eps)
-SOLVE_LEVELS = (100.0, 10.0)
+SOLVE_LEVELS = (10.0,)
 
 #: sign of the (r, z) components of the contact normals of contacts 1..4
 #: (as :attr:`slewing_model.geometry.Bearing.contact_normals`)
@@ -200,8 +200,7 @@ class EllipseFriction:
 
 
 def ellipse_friction(load, a, b, mu, *, sliding_velocity=(0.0, 0.0), relative_rotation=(0.0, 0.0, 0.0),
-                     conformity_radius=np.inf, quadrature=DEFAULT_QUADRATURE, regularisation=0.0
-                     ) -> EllipseFriction:
+                     conformity_radius=np.inf, quadrature=None, regularisation=0.0) -> EllipseFriction:
     """Coulomb friction on one Hertz contact ellipse for a rigid relative motion.
 
     The raceway moves relative to the ball with the velocity ``v0 + w x (x - x0)``
@@ -218,14 +217,18 @@ def ellipse_friction(load, a, b, mu, *, sliding_velocity=(0.0, 0.0), relative_ro
         Semi-axes across the groove (``g``) and along the rolling direction (``t``).
     mu : float
         Coulomb coefficient.
-    sliding_velocity : (2,) array_like, m/s
+    sliding_velocity : (..., 2) array_like, m/s
         ``v0`` along (t, g).
-    relative_rotation : (3,) array_like, rad/s
+    relative_rotation : (..., 3) array_like, rad/s
         ``w`` along (t, g, n); ``(0, 0, w_n)`` is a pure spin (pivoting).
-    conformity_radius : float, m
+    conformity_radius : float or array, m
         ``R_d`` of the contact surface across the groove; ``inf``: a flat ellipse.
-    quadrature : int, (int, int) or EllipseQuadrature
-    regularisation : float, m/s
+    quadrature : int, (int, int), EllipseQuadrature or None
+        None: ``DEFAULT_QUADRATURE[0]`` points across and as many along as
+        keep the spacing (``>= n_across * b / a``, at least
+        ``DEFAULT_QUADRATURE[1]``): the bearing default suits its slender
+        ellipses (``a/b`` about 5-10), not a circle.
+    regularisation : float or array, m/s
         ``|v_s|`` becomes ``sqrt(|v_s|^2 + regularisation^2)``.
 
     Returns
@@ -240,19 +243,22 @@ def ellipse_friction(load, a, b, mu, *, sliding_velocity=(0.0, 0.0), relative_ro
     >>> round(float(f.moment[2] / (3 * math.pi / 16 * 0.1 * 1000.0 * 1e-3)), 3)
     1.0
     """
+    if quadrature is None:
+        n_across = DEFAULT_QUADRATURE[0]
+        ratio = float(np.max(np.asarray(b, dtype=float) / np.asarray(a, dtype=float)))
+        quadrature = (n_across, max(DEFAULT_QUADRATURE[1], math.ceil(n_across * ratio)))
     quad = _quadrature(quadrature)
     q = np.asarray(load, dtype=float)
     a = np.asarray(a, dtype=float)[..., None]
     b = np.asarray(b, dtype=float)[..., None]
-    radius = float(conformity_radius)
+    radius = np.asarray(conformity_radius, dtype=float)[..., None]
     eta, xi = a * quad.across, b * quad.along
-    if math.isinf(radius):
-        sin_t, cos_t = np.zeros_like(eta), np.ones_like(eta)
-        rg, rn = eta, np.zeros_like(eta)
-    else:
-        theta = eta / radius
-        sin_t, cos_t = np.sin(theta), np.cos(theta)
-        rg, rn = radius * sin_t, radius * (cos_t - 1.0)        # bent surface, centre of curvature on -n
+    flat = np.isinf(radius)
+    finite = np.where(flat, 1.0, radius)
+    theta = np.where(flat, 0.0, eta / finite)
+    sin_t, cos_t = np.sin(theta), np.cos(theta)
+    rg = np.where(flat, eta, finite * sin_t)                  # bent surface, centre of curvature on -n
+    rn = np.where(flat, 0.0, finite * (cos_t - 1.0))
     rt = xi
     v0 = np.asarray(sliding_velocity, dtype=float)
     w = np.asarray(relative_rotation, dtype=float)
@@ -260,7 +266,7 @@ def ellipse_friction(load, a, b, mu, *, sliding_velocity=(0.0, 0.0), relative_ro
     vg = v0[..., 1, None] + w[..., 2, None] * rt - w[..., 0, None] * rn
     vn = w[..., 0, None] * rg - w[..., 1, None] * rt
     s1, s2 = vt, cos_t * vg - sin_t * vn                      # along t and along the bent g
-    speed = np.sqrt(s1**2 + s2**2 + float(regularisation) ** 2)
+    speed = np.sqrt(s1**2 + s2**2 + np.asarray(regularisation, dtype=float)[..., None] ** 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         scale = np.where(speed > 0.0, (mu * q)[..., None] * quad.weight / speed, 0.0)
     ft, fb = scale * s1, scale * s2
@@ -1010,7 +1016,7 @@ def catalogue_torque(bearing: Bearing, loads, mu: float = CATALOGUE_MU) -> float
 def torque_ripple(bearing: Bearing, loads, psi, *, model: str = "rigid", superelement=None, mu: float = DEFAULT_MU,
                   cage_angle=None, loads_frame: str = "fixed", seal_torque: float = 0.0,
                   seal_torque_per_length: float = 0.0, quadrature=DEFAULT_QUADRATURE, bc: str = "free",
-                  mesh: str = "coarse", details: bool = False):
+                  mesh: str = "coarse", rtol: float = 1e-8, details: bool = False):
     """Friction torque magnitude (N m) at each rotation ``psi`` of the moving ring.
 
     At every ``psi`` the bearing is re-assembled (each ring's errors read under
@@ -1043,6 +1049,9 @@ def torque_ripple(bearing: Bearing, loads, psi, *, model: str = "rigid", superel
     quadrature : int or (int, int)
     bc, mesh : str
         Superelement options when it is built here.
+    rtol : float
+        Force tolerance of the BIME solves (1e-8 is ample for the torque; the
+        BIME default 1e-10 sits at the round-off floor of some cases).
     details : bool
         Also return the lists of load distributions and :class:`FrictionTorque`.
 
@@ -1067,7 +1076,7 @@ def torque_ripple(bearing: Bearing, loads, psi, *, model: str = "rigid", superel
         superelement = build_superelement(bearing, mesh=mesh, bc=bc)
     solver = BimeSolver(bearing, superelement if model == "flexible" else None,
                         psi=float(flat[0]) if flat.size else 0.0,
-                        cage_angle=None if cages is None else float(cages[0]))
+                        cage_angle=None if cages is None else float(cages[0]), rtol=rtol)
     out = np.empty(flat.size)
     distributions, frictions = [], []
     distribution = friction = None
@@ -1087,7 +1096,8 @@ def torque_ripple(bearing: Bearing, loads, psi, *, model: str = "rigid", superel
 
 
 def preload_sweep(bearing: Bearing, preloads, loads=None, *, model: str = "rigid", superelement=None,
-                  mu: float = DEFAULT_MU, psi: float = 0.0, quadrature=DEFAULT_QUADRATURE, details: bool = False):
+                  mu: float = DEFAULT_MU, psi: float = 0.0, quadrature=DEFAULT_QUADRATURE, rtol: float = 1e-8,
+                  details: bool = False):
     """Friction torque magnitude (N m) against ball preload (m), as the paper's Figure 14.
 
     Parameters
@@ -1100,7 +1110,7 @@ def preload_sweep(bearing: Bearing, preloads, loads=None, *, model: str = "rigid
     model : {"rigid", "flexible"}
     superelement : Superelement, optional
         For the flexible model; the ring matrices do not depend on the preload.
-    mu, psi, quadrature
+    mu, psi, quadrature, rtol
         As in :func:`friction_torque` and :func:`slewing_model.bime.solve`.
     details : bool
         Also return the list of :class:`FrictionTorque` (contact counts etc.).
@@ -1113,7 +1123,7 @@ def preload_sweep(bearing: Bearing, preloads, loads=None, *, model: str = "rigid
     friction = None
     for k, preload in enumerate(preloads.ravel()):
         b = bearing.with_preload(float(preload))
-        distribution = solve(b, loads, model=model, superelement=superelement, psi=psi)
+        distribution = solve(b, loads, model=model, superelement=superelement, psi=psi, rtol=rtol)
         friction = friction_torque(b, distribution, mu=mu, quadrature=quadrature, initial=friction)
         out[k] = friction.magnitude
         results.append(friction)
