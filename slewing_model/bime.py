@@ -729,9 +729,11 @@ def solve_dense_newton(solver: BimeSolver, loads: Loads | None = None, *, rtol: 
     dense factorisation of the full Hessian (:meth:`BimeSolver.energy_terms`).
 
     The baseline the structured solver is measured against, and an independent
-    check of it. A free ring's rigid-body modes are fixed by a penalty on the
-    ring's null space (they are redundant with the moving ring's ``q``; the
-    minimum is the same).
+    check of it. A free ring's deformation is kept orthogonal to its rigid-body
+    modes (the null space of its superelement) by an exact projection: the
+    ring's rigid motion is the moving ring's ``q``, on which the load works;
+    letting the deformation carry rigid motion too would make the energy
+    unbounded under load.
 
     Returns
     -------
@@ -744,32 +746,28 @@ def solve_dense_newton(solver: BimeSolver, loads: Loads | None = None, *, rtol: 
     se = solver.superelement
     x = np.zeros(5 + 8 * n)
     start = BimeSolver(solver.bearing, None, psi=solver.assembly.psi, cage_angle=solver.assembly.cage_angle)
-    start.edge_angle = np.full(4, np.pi)
+    start.edge_angle, start.pressure_limit = np.full(4, np.pi), math.inf
     x[:5] = start.solve(loads).displacement
-    gauge = np.zeros((8 * n, 8 * n))
+    null = np.zeros((5 + 8 * n, 0))
     for k, ring in enumerate((se.outer, se.inner)):
-        dense = ring.dense()
-        w, v = np.linalg.eigh(dense)
-        null = v[:, np.abs(w) <= 1e-9 * np.abs(w).max()]
-        sl = slice(4 * n * k, 4 * n * (k + 1))
-        gauge[sl, sl] = np.abs(w).max() * null @ null.T
+        w, v = np.linalg.eigh(ring.dense())
+        modes = v[:, np.abs(w) <= 1e-9 * np.abs(w).max()]
+        block = np.zeros((5 + 8 * n, modes.shape[1]))
+        block[5 + 4 * n * k:5 + 4 * n * (k + 1)] = modes
+        null = np.hstack([null, block])
+    project = np.eye(5 + 8 * n) - null @ null.T
     units = np.ones(5 + 8 * n)
     units[3:5] = 1.0 / solver.length  # moments as forces at the pitch radius
-
-    def objective(x):
-        u, g, h = solver.energy_terms(x, loads)
-        return u + 0.5 * x[5:] @ gauge @ x[5:], np.concatenate([g[:5], g[5:] + gauge @ x[5:]]), h
-
+    force_scale = max(float(np.abs(loads.as_array() * units[:5]).max()), 1.0)
     for iteration in range(max_iterations + 1):
-        u, g, h = objective(x)
-        if iteration:
-            force_scale = max(float(np.abs(loads.as_array() * units[:5]).max()), 1.0)
-            if np.abs(g * units).max() <= rtol * force_scale:
-                return x, iteration
-        h[5:, 5:] += gauge
-        step = np.linalg.solve(h, -g)
+        u, g, h = solver.energy_terms(x, loads)
+        g = project @ g
+        if iteration and np.abs(g * units).max() <= rtol * force_scale:
+            return x, iteration
+        reduced = project @ h @ project
+        step = np.linalg.solve(reduced + np.abs(np.diag(reduced)).max() * (null @ null.T), -g)
         t = 1.0
-        while objective(x + t * step)[0] > u + 1e-4 * t * (g @ step) + 1e-13 * abs(u) and t > 1e-12:
+        while solver.energy_terms(x + t * step, loads)[0] > u + 1e-4 * t * (g @ step) + 1e-13 * abs(u) and t > 1e-12:
             t *= 0.5
         x = x + t * step
     raise NoEquilibriumError(f"dense Newton: no convergence after {max_iterations} iterations")

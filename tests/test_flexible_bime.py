@@ -131,3 +131,20 @@ def test_warm_started_solver_follows_rotation(table3_errors, table3_free):
         cold = BimeSolver(table3_errors.with_preload(10e-6), table3_free, psi=psi).solve(Loads(Fz=3e4))
         assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-7, atol=1e-7 * cold.max_ball_load)
         previous = warm
+
+
+@pytest.mark.parametrize("bc", ["free", "clamped"])
+def test_structured_solver_equals_dense_newton_on_fe_rings(table3_errors, bc):
+    # the dense Newton on all 5 + 8B unknowns of eq 20 (free rings: deformation kept orthogonal to
+    # the rigid-body modes, the ring's rigid motion being q) is an independent check of the reduction
+    from slewing_model.bime import solve_dense_newton
+
+    se = build_superelement(table3_errors, mesh="coarse", bc=bc)
+    bearing = table3_errors.with_preload(10e-6)
+    loads = Loads(Fx=1e4, Fz=5e4, Mx=3e3, My=-2e3)
+    r = BimeSolver(bearing, se).solve(loads)
+    x, _ = solve_dense_newton(BimeSolver(bearing, se), loads)
+    n = bearing.ball_count
+    assert np.allclose(r.displacement, x[:5], rtol=1e-8, atol=1e-14)
+    assert np.allclose(r.ring_displacement[:, [0, 3]].ravel(), x[5:5 + 4 * n], atol=1e-13)
+    assert np.allclose(r.ring_displacement[:, [1, 2]].ravel(), x[5 + 4 * n:], atol=1e-13)
