@@ -92,16 +92,29 @@ def benchmark(repeat: int) -> None:
 
 # ---- studies -------------------------------------------------------------------------------------
 
-def _entries(stiff) -> dict:
-    """A few condensed stiffness entries (GN/m) and a global compliance of the outer ring."""
-    c = stiff.first_row
+def compliance_first_row(stiff, rcond=1e-10) -> np.ndarray:
+    """First block row of the pseudo-inverse of K (the ring's compliance; rigid modes dropped), m/N."""
     blocks = stiff.harmonic_blocks().real
-    n1 = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0])     # contact-1 normal
-    q = np.linalg.qr(np.stack([n1, [0, 0, 1, 0], [0, 0, 0, 1], [-n1[1], n1[0], 0, 0]], 1))[0]
-    g2 = q.T @ np.linalg.inv(blocks[2]) @ q
-    return {"C0[R1,R1]": c[0][0, 0] / 1e9, "C0[z1,z1]": c[0][1, 1] / 1e9, "C0[R1,z1]": c[0][0, 1] / 1e9,
-            "C0[R1,R4]": c[0][0, 2] / 1e9, "C1[R1,R1]": c[1][0, 0] / 1e9,
-            "g2 normal [nm/N]": abs(g2[0, 0]) * 1e9}
+    top = max(np.abs(np.linalg.eigvalsh(b)).max() for b in blocks)
+    inv = []
+    for b in blocks:
+        w, v = np.linalg.eigh(b)
+        keep = np.abs(w) > rcond * top
+        inv.append((v[:, keep] / w[keep]) @ v[:, keep].T)
+    return np.real(np.fft.fft(np.array(inv), axis=0)) / len(blocks)
+
+
+def _entries(stiff) -> dict:
+    """A few condensed stiffness entries (GN/m) and compliance entries (um/kN = 1e-9 m/N) of the
+    outer ring: along the contact-1 normal n1 and the groove tangent t1 at contact 1."""
+    g = compliance_first_row(stiff)
+    n1 = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0])
+    t1 = np.array([-np.sin(np.pi / 4), np.cos(np.pi / 4), 0.0, 0.0])
+    g10 = np.linalg.pinv(stiff.harmonic_blocks()[10].real)
+    c = stiff.first_row / 1e9
+    return {"C0[R1,R1]": c[0][0, 0], "C0[z1,z1]": c[0][1, 1], "C0[R1,z1]": c[0][0, 1], "C1[R1,R1]": c[1][0, 0],
+            "(G0-G1) n1n1": n1 @ (g[0] - g[1]) @ n1 * 1e9, "G0 t1t1": t1 @ g[0] @ t1 * 1e9,
+            "g10 n1n1": n1 @ g10 @ n1 * 1e9}
 
 
 def _row(label, entries, ref=None):
@@ -123,8 +136,11 @@ def study() -> None:
     ring, B = "outer", bearing.ball_count
     factors = (4, 8, 12, 16, 24)
     ns = [auto_harmonics(bearing, ring, f) for f in factors]
-    print("\n## Convergence, table1.toml, outer ring, free (entries in GN/m; g2: compliance of harmonic 2 "
-          "along the contact-1 normal)\n")
+    print("\n## Convergence, table1.toml, outer ring, free\n")
+    print("C0, C1: blocks 0 and 1 of the first block row of K, GN/m. Compliance entries in um/kN (1e-9 m/N): "
+          "G_k = block k of the first row of the ring's compliance (pseudo-inverse of K), along the contact-1 "
+          "normal n1 or the groove tangent t1 at contact 1; G0 - G1: the part of a ball's own compliance not "
+          "shared with its neighbour; g10: compliance of ball harmonic 10 (inverse of its 4x4 block) along n1.\n")
     harm = {}
     for mesh in ("coarse", "fine", "finer"):
         t0 = time.perf_counter()
@@ -157,6 +173,18 @@ def study() -> None:
                 print(f"| {scale} | {'removed' if subtract else 'kept'} | {n} | {cells} |")
     print("\nPercentages: against patch 1.0, half-space part removed, N = "
           f"{ns[2]} (the default).")
+
+    print("\n## Compliance floor, table1.toml, outer ring, free, fine mesh, N default\n")
+    print("| floor (x half-space compliance of the patch) | " + " | ".join(keys) + " |")
+    print("|---|" + "---|" * len(keys))
+    base = None
+    for eps in (0.05, 0.02, 0.1, 0.2):
+        h = ring_harmonics(bearing, ring, MESH_PRESETS["fine"], "free", ns[2],
+                           dict(DEFAULT_OPTIONS, compliance_floor=eps))
+        e = _entries(condense_ring(h, B)[0])
+        base = base or e
+        cells = " | ".join(f"{v:.4f} ({100 * (v / base[k] - 1):+.1f} %)" for k, v in e.items())
+        print(f"| {eps} | {cells} |")
 
 
 def main() -> None:

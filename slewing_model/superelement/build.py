@@ -87,16 +87,14 @@ def auto_harmonics(bearing: Bearing, ring: str, factor: float) -> int:
     return int(math.ceil(factor * s.outer_radius / w))
 
 
-def _floor(patches, lams, factor, e, nu) -> np.ndarray:
+def _floor(bearing: Bearing, ring: str, factor: float, reference_pressure: float) -> np.ndarray:
     """Compliance floor, (4, 4): ``factor`` times the half-space self-compliance of the two
-    patches (the ring side of the Hertz compliance), in master DOFs."""
-    return factor * cd.halfspace_self_block(patches, lams, e, nu)
-
-
-def _j1(x):
-    from scipy.special import j1
-
-    return float(j1(x))
+    reference patches (Hertz ellipse at ``reference_pressure``: the ring side of the Hertz
+    compliance), in master DOFs. It does not depend on ``patch_scale``."""
+    sizes = [cp.patch_size(bearing, c, reference_pressure) for c in RING_CONTACTS[ring]]
+    patches = cp.ring_patches(bearing, ring, sizes)
+    lams = [np.linalg.inv(p.resultant_matrix()) for p in patches]
+    return factor * cd.halfspace_self_block(patches, lams, bearing.youngs_modulus, bearing.poisson_ratio)
 
 
 def cache_key(bearing: Bearing, options: dict) -> str:
@@ -232,7 +230,7 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     c_fe = cd.harmonic_compliances(model, loads, range(n_max + 1), support, progress)
     t2 = time.perf_counter()
     c_hs = cd.halfspace_blocks(patches, lams, range(n_max + 1), e, nu)
-    floor = _floor(patches, lams, opts["compliance_floor"], e, nu)
+    floor = _floor(bearing, ring, opts["compliance_floor"], opts["reference_pressure"])
     info = {"mesh": {**sm.info, "dofs": int(model.ndofs)}, "patch_semi_axes_m": [list(s) for s in sizes],
             "seconds": {"setup": t1 - t0, "harmonics": t2 - t1}}
     return RingHarmonics(ring, bc, patches, lams, c_fe, c_hs, floor, info)

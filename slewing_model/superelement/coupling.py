@@ -103,6 +103,17 @@ class Patch:
         w = np.sqrt(1.0 - t * t)
         return np.stack([dr / rho, dz / rho]), w, t * w
 
+    def resultant_matrix(self) -> np.ndarray:
+        """Resultant (F_R, F_z) of the two basis pressures on the exact arc, columns (2, 2), m:
+        ``a pi J1(c)/c n`` and ``a pi J2(c)/c t`` with ``c = a / Rc``, n and t the contact normal
+        and the groove tangent at the contact point. Its inverse maps a master force to
+        (lambda_0, lambda_1); :func:`master_loads` computes the same on the mesh."""
+        c = self.a / self.groove_radius
+        n = np.array([math.cos(self.psi), math.sin(self.psi)])
+        t = np.array([-math.sin(self.psi), math.cos(self.psi)])
+        return np.stack([self.a * math.pi * special.j1(c) / c * n, self.a * math.pi * special.jv(2, c) / c * t],
+                        axis=1)
+
     def circumferential_factor(self, n):
         """``h_n``: Fourier coefficient of the unit circumferential profile H, ``2 J1(k b)/(k b)``
         with ``k = n / radius``."""
