@@ -47,7 +47,7 @@ from pythonfmu.default_experiment import DefaultExperiment
 
 
 from slewing_model import Bearing, Loads, NoEquilibriumError
-from slewing_model.simulator import BearingSimulator, SimulatorSettings
+from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
 
 #: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
 UNITS = {
@@ -283,3 +283,11 @@ class SlewingBearing(Fmi2Slave):
             if self.simulator is None:
                 self._build_simulator()
             self.simulator.set_state(simulator)
+
+    @staticmethod
+    def _fmu_state_to_bytes(state) -> bytes:
+        return json.dumps(encode_state(state)).encode("utf-8")
+
+    @staticmethod
+    def _fmu_state_from_bytes(state: bytes):
+        return decode_state(json.loads(state.decode("utf-8")))

@@ -172,14 +172,40 @@ class BearingSimulator:
 
     # ---- state -------------------------------------------------------------------
     def get_state(self) -> dict:
-        """Everything that affects the next step, as plain JSON data."""
-        return {"warm": None if self._warm is None else self._warm.tolist(), "psi": self._psi}
+        """Everything that affects the next step: the warm start, the rotation and
+        the solver's reused Newton operator (numpy arrays, not copied: they are
+        never changed in place). :func:`encode_state` makes it JSON data."""
+        return {"warm": self._warm, "psi": self._psi, "operator": self.solver._reduced}
 
     def set_state(self, state: dict) -> None:
-        """Restore :meth:`get_state`."""
+        """Restore :meth:`get_state` (or its :func:`decode_state`)."""
         self._warm = None if state["warm"] is None else np.asarray(state["warm"], dtype=float)
         self._psi = float(state["psi"])
         self.solver.set_rotation(self._psi)
+        self.solver._reduced = None if state["operator"] is None else tuple(state["operator"])
+
+
+def encode_state(value):
+    """JSON-ready copy of a state: numpy arrays become ``{"__array__": dtype, "shape", "data": hex}``
+    (exact, unlike decimal text)."""
+    if isinstance(value, np.ndarray):
+        return {"__array__": value.dtype.str, "shape": list(value.shape), "data": value.tobytes().hex()}
+    if isinstance(value, dict):
+        return {k: encode_state(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [encode_state(v) for v in value]
+    return value
+
+
+def decode_state(value):
+    """Inverse of :func:`encode_state`."""
+    if isinstance(value, dict):
+        if "__array__" in value:
+            return np.frombuffer(bytes.fromhex(value["data"]), dtype=value["__array__"]).reshape(value["shape"]).copy()
+        return {k: decode_state(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [decode_state(v) for v in value]
+    return value
 
 
 #: speed (rad/s) below which the friction torque is scaled down linearly (see _regularised_sign)

@@ -25,3 +25,15 @@ def table3():
 def _cache_dir(tmp_path_factory):
     # superelements built by the tests go to a private cache, not the user's
     os.environ.setdefault("SLEWING_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
+
+
+@pytest.fixture(scope="session")
+def table3_fmu(tmp_path_factory):
+    """The bearing FMU of table3 with synthetic errors (coarse superelement, free rings), built once."""
+    import sys
+
+    sys.path.insert(0, str(ROOT))
+    from build_fmu import build_fmu
+
+    path = tmp_path_factory.mktemp("fmu") / "SlewingBearing_table3.fmu"
+    return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free")

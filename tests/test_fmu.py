@@ -1,0 +1,292 @@
+"""The bearing FMU, driven by fmpy (and by the ecos C++ host): model description,
+outputs against the library, rollback, instances, bad input."""
+import math
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+from slewing_model import Loads, load_bearing
+from slewing_model.simulator import BearingSimulator, SimulatorSettings
+
+ROOT = Path(__file__).resolve().parents[1]
+BEARING = ROOT / "examples" / "bearings" / "table3_errors.toml"
+
+
+def test_model_description_is_valid(table3_fmu):
+    assert validate_fmu(str(table3_fmu)) == []
+    md = read_model_description(str(table3_fmu))
+    variables = {v.name: v for v in md.modelVariables}
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+    for v in md.modelVariables:
+        assert v.description, v.name
+        if v.type == "Real":
+            assert v.unit, v.name
+    for name in ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega"):
+        assert variables[name].causality == "input" and variables[name].start is not None
+    names = set(variables)
+    assert {"ball[67].Q4", "ball[1].alpha13", "ball[67].alpha24", "friction_torque", "static_safety_factor"} <= names
+    assert {u.variable.name for u in md.initialUnknowns} == {v.name for v in md.modelVariables if v.causality == "output"}
+    assert md.defaultExperiment is not None
+
+
+def test_runtime_is_numpy_only(table3_fmu, tmp_path):
+    # the FMU's Python must not need scipy or scikit-fem: run it with both made unimportable
+    script = tmp_path / "run.py"
+    script.write_text(
+        "import sys\nsys.modules['scipy'] = None\nsys.modules['skfem'] = None\n"
+        "from fmpy import simulate_fmu\n"
+        f"r = simulate_fmu({str(table3_fmu)!r}, stop_time=0.02, step_size=0.01, start_values={{'Fz': 2e4}})\n"
+        "print(r['max_ball_load'][-1])\n")
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert float(out.stdout.split()[-1]) > 0
+    with zipfile.ZipFile(table3_fmu) as z:
+        sources = [z.read(n).decode() for n in z.namelist() if n.endswith(".py") and "pythonfmu" not in n]
+    assert not any("import scipy" in s or "from scipy" in s or "skfem" in s for s in sources)
+
+
+LOADS = {"Fx": 8e3, "Fy": -3e3, "Fz": 3e4, "Mx": 1.5e3, "My": -2.5e3, "psi": 0.4, "omega": 0.05}
+
+
+def _library_step(loads, psi, omega, **settings):
+    from slewing_model.ring_stiffness import Superelement
+    from slewing_model.superelement import build_superelement
+
+    bearing = load_bearing(BEARING)
+    se = build_superelement(bearing, mesh="coarse", bc="free")
+    sim = BearingSimulator(bearing, se, SimulatorSettings(**settings))
+    return sim.step(loads, psi, omega)
+
+
+def test_constant_loads_give_the_library_solution(table3_fmu):
+    names = ["x", "z", "rx", "ry", "friction_torque", "friction_torque_magnitude", "max_ball_load",
+             "max_contact_pressure", "static_safety_factor", "ball[1].Q1", "ball[20].Q2", "ball[40].alpha13"]
+    res = simulate_fmu(str(table3_fmu), stop_time=0.03, step_size=0.01, start_values=LOADS, output=names)
+    ref = _library_step(Loads(*(LOADS[k] for k in ("Fx", "Fy", "Fz", "Mx", "My"))), LOADS["psi"], LOADS["omega"])
+    d = ref.distribution
+    expected = {"x": d.displacement[0], "z": d.displacement[2], "rx": d.displacement[3], "ry": d.displacement[4],
+                "friction_torque": ref.friction_torque, "friction_torque_magnitude": ref.friction_torque_magnitude,
+                "max_ball_load": d.max_ball_load, "max_contact_pressure": d.max_contact_pressure,
+                "static_safety_factor": d.static_safety_factor, "ball[1].Q1": d.contact_load[0, 0],
+                "ball[20].Q2": d.contact_load[19, 1], "ball[40].alpha13": d.contact_angle[39, 0]}
+    for name, value in expected.items():
+        assert res[name][-1] == pytest.approx(value, rel=1e-9, abs=1e-12), name
+    assert ref.friction_torque < 0 < LOADS["omega"]  # opposes the speed
+
+
+def _inputs(t, **columns):
+    names = ["time", "Fx", "Fy", "Fz", "Mx", "My", "psi", "omega"]
+    data = np.zeros(len(t), dtype=[(n, np.float64) for n in names])
+    data["time"] = t
+    for k, v in columns.items():
+        data[k] = v
+    return data
+
+
+def test_outputs_follow_a_load_ramp_smoothly(table3_fmu):
+    t = np.linspace(0, 1, 101)
+    res = simulate_fmu(str(table3_fmu), stop_time=1.0, step_size=0.01, input=_inputs(t, Fz=1e4 + 5e4 * t, omega=0.02),
+                       output=["z", "max_ball_load", "friction_torque_magnitude"])
+    z, q = res["z"][2:], res["max_ball_load"][2:]
+    assert np.all(np.diff(z) > 0) and np.all(np.diff(q) > 0)
+    # smooth: no jump larger than a few times the mean increment
+    for y in (z, q, res["friction_torque_magnitude"][2:]):
+        steps = np.abs(np.diff(y))
+        assert steps.max() < 5 * steps.mean()
+
+
+def test_friction_varies_with_psi_and_opposes_omega(table3_fmu):
+    period = 2.0
+    t = np.linspace(0, period, 201)
+    results = {}
+    for sign in (1, -1):
+        # a slight preload: the errors under the balls decide which balls keep four contacts
+        res = simulate_fmu(str(table3_fmu), stop_time=period, step_size=0.01, start_values={"preload": 5e-6},
+                           input=_inputs(t, Fz=5e3, psi=sign * 2 * np.pi * t / period, omega=sign * 2 * np.pi / period),
+                           output=["friction_torque", "friction_torque_magnitude"])
+        results[sign] = res
+        torque = res["friction_torque"][1:]
+        assert np.all(np.sign(torque) == -sign)
+        magnitude = res["friction_torque_magnitude"][1:]
+        assert np.ptp(magnitude) > 0.05 * magnitude.mean()  # errors under the balls change with psi
+
+
+def _slave(path, name="bearing"):
+    """An instantiated FMU2Slave whose log messages are collected in ``messages``."""
+    from fmpy import calloc, free
+    from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
+                           fmi2CallbackLoggerTYPE)
+
+    md = read_model_description(str(path))
+    unzipped = extract(str(path))
+    messages = []
+
+    def logger(component, instance, status, category, message):
+        messages.append(message.decode())
+
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName=name)
+    fmu.instantiate(loggingOn=True, callbacks=callbacks)
+    fmu._keep_callbacks = callbacks  # the C side keeps pointers to them
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    return fmu, refs, messages, unzipped
+
+
+@pytest.fixture
+def slave(table3_fmu):
+    fmu, refs, messages, unzipped = _slave(table3_fmu)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    yield fmu, refs, messages
+    fmu.terminate()
+    fmu.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
+
+
+def _step(fmu, refs, t, **inputs):
+    fmu.setReal([refs[k] for k in inputs], list(inputs.values()))
+    fmu.doStep(t, 0.01)
+    names = ["z", "rx", "friction_torque", "max_ball_load", "ball[5].Q1", "ball[60].Q2"]
+    return fmu.getReal([refs[n] for n in names])
+
+
+def test_rollback_repeats_steps_exactly(slave):
+    fmu, refs, _ = slave
+    for k in range(3):
+        _step(fmu, refs, 0.01 * k, Fz=1e4 * (k + 1), psi=0.1 * k, omega=0.1)
+    state = fmu.getFMUstate()
+    serialized = fmu.serializeFMUstate(state)
+    first = [_step(fmu, refs, 0.03 + 0.01 * k, Fz=4e4 + 3e3 * k, Mx=500.0 * k, psi=0.3 + 0.1 * k, omega=0.1)
+             for k in range(4)]
+    fmu.setFMUstate(state)
+    again = [_step(fmu, refs, 0.03 + 0.01 * k, Fz=4e4 + 3e3 * k, Mx=500.0 * k, psi=0.3 + 0.1 * k, omega=0.1)
+             for k in range(4)]
+    assert again == first
+    fmu.setFMUstate(fmu.deSerializeFMUstate(serialized))
+    assert [_step(fmu, refs, 0.03 + 0.01 * k, Fz=4e4 + 3e3 * k, Mx=500.0 * k, psi=0.3 + 0.1 * k, omega=0.1)
+            for k in range(4)] == first
+    fmu.freeFMUstate(state)
+
+
+def test_two_instances_run_independently(table3_fmu):
+    runs = {}
+    for loads in ({"Fz": 2e4}, {"Fz": 5e4, "My": 3e3}):
+        fmu, refs, _, unzipped = _slave(table3_fmu, name="alone")
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        runs[tuple(loads)] = [_step(fmu, refs, 0.01 * k, psi=0.05 * k, omega=0.05, **loads) for k in range(3)]
+        fmu.terminate()
+        fmu.freeInstance()
+    a, ra, _, ua = _slave(table3_fmu, name="a")
+    b, rb, _, ub = _slave(table3_fmu, name="b")
+    for f in (a, b):
+        f.setupExperiment(startTime=0.0)
+        f.enterInitializationMode()
+        f.exitInitializationMode()
+    out_a, out_b = [], []
+    for k in range(3):  # interleaved in one process
+        out_a.append(_step(a, ra, 0.01 * k, psi=0.05 * k, omega=0.05, Fz=2e4))
+        out_b.append(_step(b, rb, 0.01 * k, psi=0.05 * k, omega=0.05, Fz=5e4, My=3e3))
+    assert out_a == runs[("Fz",)] and out_b == runs[("Fz", "My")]
+    for f in (a, b):
+        f.terminate()
+        f.freeInstance()
+
+
+@pytest.mark.parametrize("inputs,message", [
+    ({"Fz": float("nan")}, "input Fz = nan: must be finite"),
+    ({"omega": float("inf")}, "input omega = inf: must be finite"),
+    ({"Fz": 5e7}, "beyond what the bearing can carry"),
+])
+def test_bad_input_is_refused_with_a_logged_reason(slave, inputs, message):
+    fmu, refs, messages = slave
+    fmu.setReal([refs[k] for k in inputs], list(inputs.values()))
+    with pytest.raises(Exception) as info:
+        fmu.doStep(0.0, 0.01)
+    assert "fmi2Discard" in str(info.value) or "status 2" in str(info.value)
+    assert any(message in m for m in messages), messages
+    # the instance is still alive: a good input steps again
+    fmu.setReal([refs["Fz"], refs["omega"]], [1e4, 0.1])
+    fmu.doStep(0.01, 0.01)
+
+
+def test_bad_input_is_explained_in_the_log(slave):
+    fmu, refs, messages = slave
+    fmu.setReal([refs["Fz"]], [float("nan")])
+    with pytest.raises(Exception):
+        fmu.doStep(0.0, 0.01)
+    assert any("input Fz = nan: must be finite (not NaN or infinite)" in m for m in messages), messages
+
+
+def test_unknown_parameter_value_is_refused(table3_fmu):
+    fmu, refs, messages, unzipped = _slave(table3_fmu)
+    try:
+        fmu.setupExperiment(startTime=0.0)
+        fmu.setInteger([refs["ring_model"]], [7])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        with pytest.raises(Exception) as info:
+            fmu.doStep(0.0, 0.01)
+        assert "status 2" in str(info.value) or "fmi2Discard" in str(info.value)
+        assert any("parameter ring_model = 7: must be one of 1 (rigid), 2 (flexible)" in m for m in messages), messages
+    finally:
+        fmu.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+
+
+def _ecos_binary(tmp_path):
+    try:
+        import ecospy
+    except ImportError:
+        pytest.skip("ecospy is not installed")
+    source = Path(ecospy.__file__).parent / "binaries" / "ecos"
+    if subprocess.run(["bash", "-c", "ldconfig -p | grep -q 'libtbb.so.12 '"]).returncode != 0:
+        pytest.skip("Debian's libtbb12 is missing (make installs it when run as root)")
+    binary = tmp_path / "ecos"
+    shutil.copy2(source, binary)
+    binary.chmod(0o755)  # the wheel ships it without the executable bit
+    return binary
+
+
+def test_ecos_cpp_host_gives_the_fmpy_outputs(table3_fmu, tmp_path):
+    from build_fmu import host_environment
+
+    ecos = _ecos_binary(tmp_path)
+    fmu = tmp_path / "bearing.fmu"
+    shutil.copy2(table3_fmu, fmu)
+    values = {"Fz": 3e4, "Mx": 1.5e3, "My": -2.5e3, "psi": 0.4, "omega": 0.05}
+    actions = "".join(f'<ecos:variable id="instance::{k}"><ecos:real value="{v!r}"/></ecos:variable>'
+                      for k, v in values.items())
+    scenario = tmp_path / "scenario.xml"
+    scenario.write_text('<?xml version="1.0" encoding="UTF-8"?>\n'
+                        '<ecos:Scenario xmlns:ecos="http://github.com/Ecos-platform/libecos/resources/schema/ScenarioConfig">'
+                        f'<ecos:action t="0">{actions}</ecos:action></ecos:Scenario>')
+    env = dict(os.environ, **host_environment())
+    # 20 steps: ecos 0.7.2 divides by zero (SIGFPE) in its progress report for runs of fewer than 10 steps
+    run = subprocess.run([str(ecos), "simulate", "--path", str(fmu), "--stepSize", "0.01", "--stopTime", "0.2",
+                          "--scenarioConfig", str(scenario), "--noParallel", "-l", "warn"],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stdout + run.stderr
+    rows = [line.split(",") for line in (tmp_path / "bearing.csv").read_text().splitlines()]
+    header = [h.strip() for h in rows[0]]
+    last = rows[-1]
+    names = ["z", "max_ball_load", "friction_torque", "ball[1].Q1", "ball[30].Q3", "ball[50].alpha24"]
+    got = {n: float(last[header.index(f"instance::{n}[REAL]")]) for n in names}
+    ref = simulate_fmu(str(table3_fmu), stop_time=0.2, step_size=0.01, start_values=values, output=names)
+    for n in names:  # ecos writes 6 decimals
+        assert got[n] == pytest.approx(ref[n][-1], rel=1e-6, abs=1.5e-6), n
