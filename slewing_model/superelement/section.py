@@ -29,11 +29,10 @@ from skfem import MeshTri
 
 from ..geometry import RING_CONTACTS, Bearing, RingSection
 
-#: direction of the contact normal (ball centre -> contact point) of contacts 1..4, as an
-#: angle in the (r, z) plane for the contact angle ``alpha``: 1 upper-outer, 2 upper-inner,
-#: 3 lower-inner, 4 lower-outer
 def contact_direction(contact: int, alpha: float) -> float:
-    """Angle (rad) of the unit vector from the ball centre to contact point ``contact``."""
+    """Angle (rad) in the (r, z) plane of the unit vector from the ball centre to contact point
+    ``contact`` for the contact angle ``alpha``: 1 upper-outer, 2 upper-inner, 3 lower-inner,
+    4 lower-outer (``Bearing.contact_normals``)."""
     return {1: alpha, 2: math.pi - alpha, 3: math.pi + alpha, 4: -alpha}[contact]
 
 
@@ -239,9 +238,11 @@ def mesh_section(profile: RingProfile, patch_half_widths, size: MeshSize | str =
     g_up = gammas[profile.arcs.index(upper)]
     for arc, g in ((lower, g_low), (upper, g_up)):
         lo, hi = sorted((arc.psi_crest, arc.psi_edge))
-        if not lo < arc.psi_contact - g and arc.psi_contact + g < hi:
-            raise ValueError(f"contact {arc.contact}: the patch (half-angle {math.degrees(g):.1f} deg) "
-                             f"does not fit on the raceway arc")
+        if not (lo < arc.psi_contact - g and arc.psi_contact + g < hi):
+            raise ValueError(f"contact {arc.contact}: the load patch (half-angle {math.degrees(g):.1f} deg around "
+                             f"the contact point) does not fit on the raceway arc "
+                             f"({math.degrees(lo):.1f}..{math.degrees(hi):.1f} deg): lower the reference "
+                             f"pressure or the patch scale")
 
     # curve pieces: each a callable t -> (r, z) on [0, L] and the patch intervals (in t) it holds
     land = profile.land_radius
@@ -302,11 +303,11 @@ def mesh_section(profile: RingProfile, patch_half_widths, size: MeshSize | str =
     K = np.stack([np.full_like(z, back), z])
     # logical xi direction (groove side -> back face), graded from the groove
     width = abs(back - profile.crest[0])
-    xi = _graded(width, lambda t: np.minimum(h_patch + size.growth * t + 0.0 * t, h_max)) / width
-    # TFI: x = (1-xi) G(eta) + xi K(eta) + lower/upper face corrections (faces are straight lines)
+    xi = _graded(width, lambda t: np.minimum(h_patch + size.growth * t, h_max)) / width
+    # TFI between the groove side G(eta) and the back face K(eta); the lower and upper faces are
+    # straight and G, K end on them, so the linear blend reproduces them exactly
     Xi = xi[None, :]
     P = (1 - Xi)[None] * G[:, :, None] + Xi[None] * K[:, :, None]  # (2, n_eta+1, n_xi+1)
-    # the faces z = +-h/2 are straight, G and K end on them: linear blending is exact there
     n_eta, n_xi = G.shape[1] - 1, len(xi) - 1
     P = _smooth(P, size.smoothing)
     idx = np.arange((n_eta + 1) * (n_xi + 1)).reshape(n_eta + 1, n_xi + 1)
@@ -360,6 +361,5 @@ def _smooth(P: np.ndarray, iterations: int) -> np.ndarray:
 
 def rectangle_mesh(inner_radius: float, outer_radius: float, height: float, n_r: int, n_z: int) -> MeshTri:
     """Uniform triangle mesh of a rectangular section (the closed-form test rings)."""
-    m = MeshTri.init_tensor(np.linspace(inner_radius, outer_radius, n_r + 1),
-                            np.linspace(-height / 2, height / 2, n_z + 1))
-    return m
+    return MeshTri.init_tensor(np.linspace(inner_radius, outer_radius, n_r + 1),
+                               np.linspace(-height / 2, height / 2, n_z + 1))
