@@ -13,6 +13,7 @@ import sys
 import numpy as np
 
 from .bime import LOAD_FIELDS, Loads, NoEquilibriumError, solve
+from .friction import catalogue_torque, friction_torque
 from .geometry import BearingDefinitionError, load_bearing
 
 
@@ -39,6 +40,10 @@ def _add_solve(sub) -> None:
     p.add_argument("--preload", type=_finite_float, default=None, metavar="m",
                    help="ball preload (oversize), m, overriding the bearing file")
     p.add_argument("--psi", type=_finite_float, default=0.0, metavar="rad", help="rotation of the moving ring")
+    p.add_argument("--mu", type=_finite_float, default=None, metavar="-",
+                   help="Coulomb friction coefficient of the raceway contacts (default: the friction model's)")
+    p.add_argument("--seal-torque", type=_finite_float, default=0.0, metavar="Nm",
+                   help="load-independent friction torque (seals, grease)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_run_solve)
 
@@ -49,8 +54,14 @@ def _run_solve(args) -> int:
         bearing = bearing.with_preload(args.preload)
     loads = Loads(args.fx, args.fy, args.fz, args.mx, args.my)
     result = solve(bearing, loads, model=args.model, bc=args.bc, mesh=args.mesh, psi=args.psi)
+    options = {} if args.mu is None else {"mu": args.mu}
+    friction = friction_torque(bearing, result, omega=1.0, seal_torque=args.seal_torque, **options)
+    catalogue = catalogue_torque(bearing, loads)
     if args.json:
-        print(json.dumps(result.to_dict()))
+        data = result.to_dict()
+        data["friction_torque"] = friction.magnitude              # N m, for a positive omega
+        data["friction_torque_catalogue"] = catalogue              # N m, maker's start-up formula
+        print(json.dumps(data))
         return 0
     print(f"{bearing.name}: {args.model} rings, {bearing.ball_count} balls, {result.iterations} Newton iterations")
     d = result.displacement
@@ -59,6 +70,8 @@ def _run_solve(args) -> int:
     print(f"max ball load {result.max_ball_load / 1e3:.3f} kN, max contact pressure "
           f"{result.max_contact_pressure / 1e6:.0f} MPa, static safety factor {result.static_safety_factor:.3g}, "
           f"{result.balls_in_four_point_contact} balls in four-point contact")
+    print(f"friction torque {friction.magnitude:.4g} N m (analytical, full sliding), catalogue formula "
+          f"{catalogue:.4g} N m")
     print(f"{'ball':>4} {'phi deg':>8} {'Q1 kN':>8} {'Q2 kN':>8} {'Q3 kN':>8} {'Q4 kN':>8} "
           f"{'a13 deg':>8} {'a24 deg':>8} {'d13 um':>8} {'d24 um':>8}")
     for b in range(bearing.ball_count):

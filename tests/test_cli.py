@@ -35,7 +35,7 @@ def test_solve_json_has_the_documented_fields_and_sign_convention():
 
 def test_solve_table_is_readable():
     out = _run("solve", "examples/bearings/table3.toml", "--fz", "1e4")
-    assert out.returncode == 0 and "max ball load" in out.stdout and len(out.stdout.splitlines()) == 67 + 4
+    assert out.returncode == 0 and "max ball load" in out.stdout and len(out.stdout.splitlines()) == 67 + 5
 
 
 def test_bad_definition_gives_a_clear_error(tmp_path):
@@ -50,3 +50,29 @@ def test_bad_definition_gives_a_clear_error(tmp_path):
 def test_non_finite_load_option_is_refused():
     out = _run("solve", "examples/bearings/table3.toml", "--fz", "nan")
     assert out.returncode == 2 and "'nan' must be finite" in out.stderr
+
+
+def test_solve_json_has_friction_torques_and_takes_mu_and_preload():
+    from slewing_model.friction import catalogue_torque, friction_torque
+
+    out = _run("solve", "examples/bearings/table3.toml", "--fz", "30000", "--mu", "0.08", "--preload", "5e-6", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    bearing = load_bearing(ROOT / "examples/bearings/table3.toml").with_preload(5e-6)
+    ref = solve(bearing, Loads(Fz=3e4))
+    assert data["friction_torque"] == pytest.approx(friction_torque(bearing, ref, mu=0.08).magnitude, rel=1e-9)
+    assert data["friction_torque_catalogue"] == pytest.approx(catalogue_torque(bearing, Loads(Fz=3e4)), rel=1e-12)
+    assert np.allclose(data["Q"], ref.contact_load, rtol=1e-12)
+
+
+def test_flexible_model_from_the_command_line(tmp_path):
+    import os
+
+    env = dict(os.environ, SLEWING_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([SLEWING, "solve", "examples/bearings/table3.toml", "--fz", "30000", "--model", "flexible",
+                          "--bc", "clamped", "--json"], capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["model"] == "flexible" and np.array(data["ring_displacement"]).shape == (67, 4, 2)
+    rigid = solve(load_bearing(ROOT / "examples/bearings/table3.toml"), Loads(Fz=3e4))
+    assert data["displacement"]["z"] > rigid.displacement[2]  # flexible rings are softer
