@@ -112,6 +112,7 @@ class SlewingBearing(Fmi2Slave):
         self.friction_coefficient = 0.1
         self.seal_torque = 0.0
         self.tolerance = 1e-9
+        self.omega_regularisation = 1e-4
         self.ring_model = 2
         self.moving_ring = 1 if self.bearing.moving_ring == "inner" else 2
         self.load_frame = 1
@@ -123,6 +124,10 @@ class SlewingBearing(Fmi2Slave):
                    Fmi2Causality.parameter, Fmi2Variability.tunable)
         self._real("tolerance", "1", "relative tolerance of the load distribution solver",
                    Fmi2Causality.parameter, Fmi2Variability.fixed)
+        self._real("omega_regularisation", "rad/s",
+                   "speed over which friction_torque rises to its full-sliding level (tanh); "
+                   "at least magnitude * step / inertia for an explicit coupling",
+                   Fmi2Causality.parameter, Fmi2Variability.tunable)
         for name, choices, text in (("ring_model", RING_MODELS, "ring model"),
                                     ("moving_ring", MOVING_RINGS, "ring the loads act on and that turns"),
                                     ("load_frame", LOAD_FRAMES, "frame of the input loads")):
@@ -214,7 +219,7 @@ class SlewingBearing(Fmi2Slave):
                 ring_model=RING_MODELS[self.ring_model], moving_ring=MOVING_RINGS[self.moving_ring],
                 load_frame=LOAD_FRAMES[self.load_frame], preload=float(self.preload),
                 friction_coefficient=float(self.friction_coefficient), seal_torque=float(self.seal_torque),
-                tolerance=float(self.tolerance))
+                tolerance=float(self.tolerance), omega_regularisation=float(self.omega_regularisation))
             superelement = None
             if settings.ring_model == "flexible":
                 from slewing_model.ring_stiffness import Superelement
@@ -241,9 +246,11 @@ class SlewingBearing(Fmi2Slave):
                 if not math.isfinite(value):
                     raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
             sim = self.simulator
-            if (self.friction_coefficient, self.seal_torque) != (sim.settings.friction_coefficient,
-                                                                 sim.settings.seal_torque):
-                sim.tune(friction_coefficient=float(self.friction_coefficient), seal_torque=float(self.seal_torque))
+            tunable = {"friction_coefficient": float(self.friction_coefficient),
+                       "seal_torque": float(self.seal_torque),
+                       "omega_regularisation": float(self.omega_regularisation)}
+            if any(getattr(sim.settings, k) != v for k, v in tunable.items()):
+                sim.tune(**tunable)
             result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
         except (ValueError, NoEquilibriumError) as exc:
             self.log(f"{self.instance_name}: step refused: {exc}", Fmi2Status.error)

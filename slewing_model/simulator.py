@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .bime import BimeSolver, LoadDistribution, Loads, contact_compliance
+from .friction import friction_torque, regularised_torque
 from .geometry import Bearing
 
 RING_MODELS = ("rigid", "flexible")
@@ -43,6 +44,11 @@ class SimulatorSettings:
         Load-independent friction torque (seals, grease).
     tolerance : float
         Relative tolerance of the load distribution solver.
+    omega_regularisation : float, rad/s
+        Speed over which the signed friction torque goes from 0 to its
+        full-sliding level (:func:`slewing_model.friction.regularised_torque`);
+        choose at least ``magnitude * step / inertia`` for an explicit coupling
+        (:func:`slewing_model.friction.omega_regularisation_for_step`).
     """
 
     ring_model: str = "flexible"
@@ -52,12 +58,13 @@ class SimulatorSettings:
     friction_coefficient: float = 0.1
     seal_torque: float = 0.0
     tolerance: float = 1e-9
+    omega_regularisation: float = 1e-4
 
     def __post_init__(self):
         _choice("ring_model", self.ring_model, RING_MODELS)
         _choice("moving_ring", self.moving_ring, ("inner", "outer"))
         _choice("load_frame", self.load_frame, LOAD_FRAMES)
-        for name in ("friction_coefficient", "seal_torque", "tolerance"):
+        for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise ValueError(f"{name} = {value!r}: must be a finite number >= 0")
@@ -132,10 +139,10 @@ class BearingSimulator:
         self.last: StepResult | None = None
 
     def tune(self, **changes) -> None:
-        """Change the tunable settings (``friction_coefficient``, ``seal_torque``)
-        between steps; the others need a new simulator."""
+        """Change the tunable settings (``friction_coefficient``, ``seal_torque``,
+        ``omega_regularisation``) between steps; the others need a new simulator."""
         for name in changes:
-            if name not in ("friction_coefficient", "seal_torque"):
+            if name not in ("friction_coefficient", "seal_torque", "omega_regularisation"):
                 raise ValueError(f"{name} is not tunable: build a new simulator")
         self.settings = replace(self.settings, **changes)
 
@@ -160,11 +167,9 @@ class BearingSimulator:
         distribution = self.solver.solve(loads, initial=self._warm)
         magnitude = self.settings.seal_torque
         if self.settings.friction_coefficient > 0.0:
-            from .friction import friction_torque
-
             magnitude = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
                                         omega=1.0, seal_torque=self.settings.seal_torque).magnitude
-        signed = -magnitude * _regularised_sign(omega)
+        signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         self._warm = distribution.state
         self._psi = psi
         self.last = StepResult(distribution, signed, magnitude)
@@ -206,12 +211,3 @@ def decode_state(value):
     if isinstance(value, list):
         return [decode_state(v) for v in value]
     return value
-
-
-#: speed (rad/s) below which the friction torque is scaled down linearly (see _regularised_sign)
-OMEGA_REGULARISATION = 1e-4
-
-
-def _regularised_sign(omega: float, width: float = OMEGA_REGULARISATION) -> float:
-    """``sign(omega)`` smoothed over ``|omega| < width``: ``omega / width`` there."""
-    return max(-1.0, min(1.0, omega / width))
