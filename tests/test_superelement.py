@@ -178,6 +178,20 @@ def test_halfspace_harmonic_compliance_matches_fe_on_a_flat_face():
         assert abs(c[0, 1]) < 1e-3 * c[0, 0]     # even and odd pressures do not couple
 
 
+def test_harmonic_sum_of_the_halfspace_compliance_is_the_self_compliance(table1):
+    """Two independent evaluations of the half-space compliance of a row of patches: the mean over
+    the ball harmonics of the aliasing sums of coupling.halfspace_harmonic (1-D integrals per
+    harmonic) is the ball's own compliance, the 2-D integral of coupling.halfspace_self. This
+    checks the harmonic normalisation (1/(2 pi), B/(2 pi), h_n) of the condensation."""
+    from slewing_model.superelement import condense as cd
+
+    patch = cp.ring_patches(table1, "outer", [cp.patch_size(table1, 1)] * 2)[0]
+    rows = cd.halfspace_periodic(patch, table1.ball_count, E, NU)
+    own = cp.halfspace_self(patch, E, NU)
+    np.testing.assert_allclose(rows.mean(axis=0), own, rtol=0.01)
+    assert rows[0, 0] > own[0] > rows[table1.ball_count // 2, 0]    # neighbours add up at long waves only
+
+
 def _normal_compliance(bearing, scale, n, subtract):
     """Per-harmonic compliance of contact 1 along its contact normal, coarse mesh."""
     from slewing_model.superelement import condense as cd

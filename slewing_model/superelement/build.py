@@ -30,7 +30,7 @@ from .section import MESH_PRESETS, MeshSize, mesh_section, ring_profile
 from .supports import BOUNDARY_CONDITIONS, NULL_SPACE, SUPPORT_REMOVES, Support
 
 #: bump when the numbers a build produces change for the same inputs (invalidates caches)
-ALGORITHM_VERSION = 1
+ALGORITHM_VERSION = 2
 
 #: expert options and their defaults (see :func:`build_superelement`)
 DEFAULT_OPTIONS = {
@@ -208,6 +208,8 @@ class RingHarmonics:
     c_fe: np.ndarray          # (N + 1, 4, 4), m/N per unit of the theta integral
     c_hs: np.ndarray          # (N + 1, 4, 4), flat half-space part
     floor: np.ndarray         # (4, 4), m/N
+    youngs_modulus: float
+    poisson_ratio: float
     info: dict
 
 
@@ -233,7 +235,7 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     floor = _floor(bearing, ring, opts["compliance_floor"], opts["reference_pressure"])
     info = {"mesh": {**sm.info, "dofs": int(model.ndofs)}, "patch_semi_axes_m": [list(s) for s in sizes],
             "seconds": {"setup": t1 - t0, "harmonics": t2 - t1}}
-    return RingHarmonics(ring, bc, patches, lams, c_fe, c_hs, floor, info)
+    return RingHarmonics(ring, bc, patches, lams, c_fe, c_hs, floor, e, nu, info)
 
 
 def condense_ring(h: RingHarmonics, ball_count: int, n_max: int | None = None,
@@ -244,11 +246,14 @@ def condense_ring(h: RingHarmonics, ball_count: int, n_max: int | None = None,
     free = h.bc == "free"
     c_hs = h.c_hs[:n + 1] if subtract_halfspace else 0.0 * h.c_hs[:n + 1]
     c, ring_report = cd.ring_part(h.c_fe[:n + 1], c_hs, h.patches, free)
-    k_hat, report = cd.stiffness_blocks(cd.ball_blocks(c, h.patches, ball_count), h.patches, free, h.floor)
+    back = (cd.halfspace_addback(h.patches, h.lams, ball_count, h.youngs_modulus, h.poisson_ratio)
+            if subtract_halfspace else 0.0)
+    k_hat, report = cd.stiffness_blocks(cd.ball_blocks(c, h.patches, ball_count) + back, h.patches, free, h.floor)
     row = cd.first_row(k_hat)
     # harmonic truncation figure: the same with 3/4 of the harmonics
     n34 = max(2, (3 * n) // 4)
-    k34, _ = cd.stiffness_blocks(cd.ball_blocks(c[:n34 + 1], h.patches, ball_count), h.patches, free, h.floor)
+    k34, _ = cd.stiffness_blocks(cd.ball_blocks(c[:n34 + 1], h.patches, ball_count) + back, h.patches, free,
+                                 h.floor)
     diag, diag34 = np.diag(row[0]), np.diag(cd.first_row(k34)[0])
     trunc = float(np.max(np.abs(diag - diag34) / np.abs(diag)))
     B = ball_count

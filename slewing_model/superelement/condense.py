@@ -6,7 +6,9 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
    of the master loads (:mod:`.coupling`), ``c_n = L^T K(n)^-1 L``, with the
    supports of the boundary condition.
 2. :func:`ring_part` -- minus the flat half-space compliance of the same patch
-   loads, ``c_n - c_n^HS`` (the Hertz springs hold that part).
+   loads, ``c_n - c_n^HS`` (the Hertz springs hold that part); at long waves,
+   where this removes more than each ball's own half-space compliance,
+   :func:`halfspace_addback` gives the excess back.
 3. :func:`ball_blocks` -- the **aliasing sums**. A unit master force of ball
    ``b`` is the patch pressure times ``H(s - r phi_b)``; with
    ``h_n = H_hat(n / r)`` the ball-to-ball compliance is
@@ -88,6 +90,43 @@ def halfspace_blocks(patches, lams, harmonics, youngs_modulus, poisson_ratio) ->
     for k, (patch, lam) in enumerate(zip(patches, lams)):
         c = cp.halfspace_harmonic(patch, ns, youngs_modulus, poisson_ratio)     # (len, 2)
         out[:, 2 * k:2 * k + 2, 2 * k:2 * k + 2] = np.einsum("ia,ni,ib->nab", lam, c, lam)
+    return out
+
+
+def halfspace_periodic(patch, ball_count: int, youngs_modulus: float, poisson_ratio: float) -> np.ndarray:
+    """Ball-harmonic blocks of the half-space compliance of a whole row of B patches, in the
+    basis (lambda_0, lambda_1): ``(B/2pi) sum_{n = +-j mod B} h_n^2 c_n^HS``, shape (B, 2), with
+    the same n = 0 stand-in (the n = 1 value) as :func:`halfspace_blocks`. Harmonics up to
+    40 r/b (where h_n^2 has decayed below 1e-6), interpolated log-log between 200 exact values."""
+    n_max = int(40 * patch.radius / patch.b) + 2 * ball_count
+    samples = np.unique(np.round(np.geomspace(1, n_max, 200)))
+    c_s = cp.halfspace_harmonic(patch, samples, youngs_modulus, poisson_ratio)
+    n = np.arange(n_max + 1)
+    c = np.stack([np.exp(np.interp(np.log(np.maximum(n, 1)), np.log(samples), np.log(c_s[:, i])))
+                  for i in range(2)], axis=1)
+    cw = c * patch.circumferential_factor(n)[:, None] ** 2
+    g = np.zeros((ball_count, 2))
+    np.add.at(g, n % ball_count, cw)
+    np.add.at(g, (-n[1:]) % ball_count, cw[1:])
+    return g * ball_count / (2 * np.pi)
+
+
+def halfspace_addback(patches, lams, ball_count: int, youngs_modulus: float, poisson_ratio: float) -> np.ndarray:
+    """What the per-harmonic subtraction removes beyond each ball's own half-space compliance,
+    (B, 4, 4) in master DOFs, to be added back to the ring compliance blocks.
+
+    Removing ``c_n^HS`` harmonic by harmonic removes the half-space compliance of the whole row
+    of patches, ``G_hat_j^HS``. Hertz holds only each ball's own part, ``S`` (the mean of
+    ``G_hat_j^HS`` over j). At long waves (j < ~B/6) the row's half-space compliance exceeds S
+    (the 1/distance tails of the neighbours add up; at j = 0 it diverges): there the excess
+    ``max(G_hat_j^HS - S, 0)`` is given back, so that what is removed is S. At short waves it is
+    below S and stays removed (removing S there would leave a negative ring compliance)."""
+    out = np.zeros((ball_count, 4, 4))
+    for k, (patch, lam) in enumerate(zip(patches, lams)):
+        g = halfspace_periodic(patch, ball_count, youngs_modulus, poisson_ratio)
+        s = cp.halfspace_self(patch, youngs_modulus, poisson_ratio)
+        excess = np.maximum(g - s[None, :], 0.0)
+        out[:, 2 * k:2 * k + 2, 2 * k:2 * k + 2] = np.einsum("ia,ni,ib->nab", lam, excess, lam)
     return out
 
 
