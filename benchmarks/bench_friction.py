@@ -4,8 +4,9 @@ For three load distributions (all balls on one diagonal; all in four-point
 contact; a mix) it times, as medians of repeated runs in this process:
 
 * cold: ``friction_torque(bearing, distribution)`` with no previous result;
-* warm: the next co-simulation step, i.e. ``initial=`` the result for a load
-  0.5 % away (what the FMU does every step);
+* warm: the next co-simulation step, i.e. ``initial=`` the previous result:
+  for a load 0.5 % away or, last row, one degree of rotation further on a
+  bearing with synthetic errors (what the FMU does every step);
 * baseline 1, per-ball loop: the same computation called ball by ball (one
   ball loaded at a time), the naive way to write it;
 * baseline 2, fine rule: the ball equilibrium solved and integrated on a
@@ -25,7 +26,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import median_time, print_table  # noqa: E402
 
-from slewing_model import Loads, load_bearing, solve  # noqa: E402
+from slewing_model import Loads, load_bearing, solve, synthetic_errors  # noqa: E402
 from slewing_model.friction import friction_torque  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -44,15 +45,18 @@ def per_ball_loop(bearing, distribution):
 
 def main() -> None:
     table3 = load_bearing(ROOT / "examples/bearings/table3.toml")
+    with_errors = table3.with_preload(10e-6).with_errors(synthetic_errors(table3.ball_count, seed=1))
     cases = [
-        ("axial 300 kN, no preload", table3, Loads(Fz=300e3), Loads(Fz=301.5e3)),
-        ("idling, preload 20 um", table3.with_preload(20e-6), None, Loads(Fz=0.5e3)),
-        ("Fz 100 kN + Mx 50 kNm", table3, Loads(Fz=100e3, Mx=50e3), Loads(Fz=100.5e3, Mx=50.25e3)),
+        ("axial 300 kN, no preload", table3, Loads(Fz=300e3), Loads(Fz=301.5e3), 0.0),
+        ("idling, preload 20 um", table3.with_preload(20e-6), None, Loads(Fz=0.5e3), 0.0),
+        ("Fz 100 kN + Mx 50 kNm", table3, Loads(Fz=100e3, Mx=50e3), Loads(Fz=100.5e3, Mx=50.25e3), 0.0),
+        ("errors, preload 10 um, Fz 50 kN; psi + 1 deg", with_errors, Loads(Fz=50e3), Loads(Fz=50e3),
+         np.radians(1.0)),
     ]
     rows = []
-    for name, bearing, loads, next_loads in cases:
-        dist = solve(bearing, loads)
-        dist_next = solve(bearing, next_loads)
+    for name, bearing, loads, next_loads, dpsi in cases:
+        dist = solve(bearing, loads, rtol=1e-8)
+        dist_next = solve(bearing, next_loads, psi=dpsi, rtol=1e-8)
         result = friction_torque(bearing, dist)
         step = friction_torque(bearing, dist_next, initial=result)
         t_cold = median_time(lambda: friction_torque(bearing, dist), repeat=21)

@@ -399,3 +399,31 @@ def test_result_serialises(axial):
     d = friction_torque(bearing, dist).to_dict()
     assert isinstance(d["magnitude"], float) and len(d["per_ball"]) == bearing.ball_count
     assert isinstance(friction_torque(bearing, dist), FrictionTorque)
+
+
+def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
+    # internals of the ball equilibrium: the analytic gradient and Hessian of the regularised power
+    # match central differences, and M = H + (M - H) majorises the power (Weiszfeld step is safe)
+    from slewing_model.friction import _Contacts, _ContactSet
+
+    bearing, dist = combined
+    geo = _ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
+    contacts = _Contacts(geo, ellipse_quadrature(12, 2), workspace="test")
+    rng = np.random.default_rng(5)
+    u = geo.initial_guess() * (1 + 0.01 * rng.standard_normal((geo.active.size, 4)))
+    eps2 = geo.eps2 * 100
+    f, g, h, extra = contacts.evaluate(u, eps2)
+    step = 1e-7 * np.abs(u).max()
+    g_fd, h_fd = np.zeros_like(g), np.zeros_like(h)
+    for k in range(4):
+        du = np.zeros_like(u)
+        du[:, k] = step
+        fp, gp, _, _ = contacts.evaluate(u + du, eps2)
+        fm, gm, _, _ = contacts.evaluate(u - du, eps2)
+        g_fd[:, k], h_fd[:, :, k] = (fp - fm) / (2 * step), (gp - gm) / (2 * step)
+    assert np.abs(g_fd - g).max() < 1e-6 * np.abs(g).max()
+    assert np.abs(h_fd - h).max() < 1e-5 * np.abs(h).max()
+    for _ in range(5):
+        du = 1e-2 * np.abs(u).max() * rng.standard_normal(u.shape)
+        bound = f + np.einsum("bk,bk->b", g, du) + 0.5 * np.einsum("bk,bkl,bl->b", du, h + extra, du)
+        assert np.all(contacts.evaluate(u + du, eps2, derivatives=False)[0] <= bound * (1 + 1e-12))
