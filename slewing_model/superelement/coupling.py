@@ -219,8 +219,18 @@ def halfspace_self(patch: Patch, youngs_modulus: float, poisson_ratio: float) ->
 
         C_i = int dxi deta / (4 pi^2) |P_i_hat(xi)|^2 |H_hat(eta)|^2 2 (1 - nu^2) / (E sqrt(xi^2 + eta^2))
 
-    evaluated in polar coordinates of (xi a, eta b) so that the 1/kappa singularity is absorbed."""
-    a, b = patch.a, patch.b
+    evaluated in polar coordinates of (xi a, eta b) so that the 1/kappa singularity is absorbed.
+    It depends on a, b, E, nu only and is remembered (both patches of a ring usually agree)."""
+    key = (patch.a, patch.b, youngs_modulus, poisson_ratio)
+    if key not in _SELF_CACHE:
+        _SELF_CACHE[key] = _halfspace_self(patch.a, patch.b, youngs_modulus, poisson_ratio)
+    return _SELF_CACHE[key].copy()
+
+
+_SELF_CACHE: dict = {}
+
+
+def _halfspace_self(a, b, youngs_modulus, poisson_ratio):
     factor = 2 * (1 - poisson_ratio**2) / youngs_modulus
     u, wu = _u_quadrature()                      # radial variable rho in the scaled plane
     xt, wt = np.polynomial.legendre.leggauss(96)
