@@ -1,4 +1,4 @@
-"""`make demo`: the main job on a fresh machine.
+"""Load distributions of the paper's example bearings.
 
 Solves the example bearings of the paper (Tables 1 and 3) under idling, axial,
 tilting and combined loads with rigid rings and prints their load distributions.

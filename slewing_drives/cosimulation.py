@@ -110,6 +110,7 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
     if not friction:
         values.update(friction_coefficient=0.0, seal_torque=0.0)
     sim = ElectricDrive(drive)
+    sim.hold(loads.at(0.0)[5])
     k = 0
     try:
         fmu.instantiate(loggingOn=True, callbacks=None)

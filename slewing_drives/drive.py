@@ -162,6 +162,15 @@ class ElectricDrive:
         self.substeps = substeps
         self.state = DriveState()
 
+    def hold(self, load_torque: float) -> None:
+        """Start at rest holding ``load_torque`` (N m on the ring), as a drive that
+        has been holding its position (brake released with the torque applied):
+        motor torque and speed-loop integrator in equilibrium with the load."""
+        p, s = self.p, self.state
+        torque = load_torque / p.torque_gain
+        s.motor_torque = s.mean_motor_torque = torque
+        s.speed_integral = torque / p.speed_integral_gain if p.speed_integral_gain else 0.0
+
     def step(self, command: float, dt: float, load_torque: float, friction_torque: float) -> DriveState:
         """Advance by ``dt`` with the angle ``command`` (rad), an external load
         torque on the ring (N m, opposing positive rotation when positive) and

@@ -495,7 +495,8 @@ class BimeSolver:
             t = 1.0
             for _ in range(60):
                 trial = self._evaluate(point.qs + t * dq, point.y + t * dy if flexible else point.y, f_scaled)
-                if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + 1e-13 * abs(point.total):
+                roundoff = 1e-12 * max(point.energy_scale, trial.energy_scale)
+                if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + roundoff:
                     break
                 t *= 0.5
             else:
@@ -518,7 +519,10 @@ class BimeSolver:
             e = e - my.reshape(e.shape)       # e_D = -M y: groove centres moved by ring deformation
             ring = 0.5 * float(y @ my)        # eq 15
         delta, q, force, energy, hess, n, length = self._contacts(e)
-        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - float(f_scaled @ qs), energy)
+        work = float(f_scaled @ qs)
+        # the total is a difference of larger terms: its roundoff scales with them
+        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy,
+                      energy + ring + abs(work))
 
     def _rigid_direction(self, p: "_Point", grad_q: np.ndarray, mu: float) -> np.ndarray:
         """Newton step of the rigid model: ``(sum J^T A J) dq = -grad``."""
@@ -651,6 +655,7 @@ class _Point:
     length: np.ndarray
     total: float
     contact_energy: float
+    energy_scale: float
 
 
 def _ring_index(n: int, slots: np.ndarray) -> np.ndarray:
