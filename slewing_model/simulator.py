@@ -135,6 +135,7 @@ class BearingSimulator:
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
                                  rtol=s.tolerance, compliance=compliance)
         self._warm: np.ndarray | None = None
+        self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
         self._psi = 0.0
         self.last: StepResult | None = None
 
@@ -167,8 +168,10 @@ class BearingSimulator:
         distribution = self.solver.solve(loads, initial=self._warm)
         magnitude = self.settings.seal_torque
         if self.settings.friction_coefficient > 0.0:
-            magnitude = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
-                                        omega=1.0, seal_torque=self.settings.seal_torque).magnitude
+            friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                       omega=1.0, seal_torque=self.settings.seal_torque, initial=self._friction_warm)
+            magnitude = friction.magnitude
+            self._friction_warm = friction.state
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         self._warm = distribution.state
         self._psi = psi
@@ -180,7 +183,8 @@ class BearingSimulator:
         """Everything that affects the next step: the warm start, the rotation and
         the solver's reused Newton operator (numpy arrays, not copied: they are
         never changed in place). :func:`encode_state` makes it JSON data."""
-        return {"warm": self._warm, "psi": self._psi, "operator": self.solver._reduced}
+        return {"warm": self._warm, "psi": self._psi, "operator": self.solver._reduced,
+                "friction": self._friction_warm}
 
     def set_state(self, state: dict) -> None:
         """Restore :meth:`get_state` (or its :func:`decode_state`)."""
@@ -188,6 +192,7 @@ class BearingSimulator:
         self._psi = float(state["psi"])
         self.solver.set_rotation(self._psi)
         self.solver._reduced = None if state["operator"] is None else tuple(state["operator"])
+        self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
 
 
 def encode_state(value):
