@@ -530,6 +530,61 @@ class BimeSolver:
         h = jac.reshape(-1, 5).T @ (p.hess.reshape(-1, 2, 2) @ jac.reshape(-1, 2, 5)).reshape(-1, 5)
         return np.linalg.solve(h + mu * np.eye(5), -grad_q)
 
+    def _contact_compliance_blocks(self, p: "_Point", active: np.ndarray) -> np.ndarray:
+        """``A^-1`` (n_active, 2, 2): compliance of the active diagonals' springs at ``p``."""
+        n = p.n.reshape(-1, 2)[active]
+        nn = n[:, :, None] * n[:, None, :]
+        delta = p.delta.ravel()[active]
+        k_normal = 1.5 * self.assembly.stiffness.ravel()[active] * np.sqrt(delta)
+        return nn / k_normal[:, None, None] + (p.length.ravel()[active] / p.q.ravel()[active])[:, None, None] * (
+            np.eye(2) - nn)
+
+    def _reduced_operator(self, idx, active, a_inv, w_inv, mu):
+        """Everything a Newton step needs from ``W^-1 = (A^-1 + M)_aa^-1``."""
+        ja = self.jacobian.reshape(-1, 5)[idx]
+        z_mat = w_inv @ ja
+        schur_inv = np.linalg.inv(ja.T @ z_mat + mu * np.eye(5))
+        self._reduced = (idx, active, a_inv, w_inv, ja, z_mat, schur_inv)
+        return self._reduced
+
+    def _update_reduced(self, cached, p: "_Point", idx, active, mu):
+        """Follow a change of the active contacts by a low-rank update of ``W^-1``.
+
+        Dropping rows: ``(W_kk)^-1 = P - Q S^-1 Q^T`` from the blocks of the old
+        inverse; adding rows (bordering): with ``X = W_kk^-1 B`` and the Schur
+        complement ``C - B^T X``. O(n^2 r) instead of O(n^3) for r changed rows.
+        Returns None (rebuild) when many contacts changed."""
+        old_idx, old_active, old_a_inv, w_inv = cached[:4]
+        keep = np.isin(old_idx, idx)
+        added = ~np.isin(idx, old_idx)
+        changed = int((~keep).sum() + added.sum())
+        if changed > 0.25 * idx.size:
+            return None
+        if not keep.all():  # drop the contacts that opened
+            q_mat = w_inv[np.ix_(keep, ~keep)]
+            w_inv = w_inv[np.ix_(keep, keep)] - q_mat @ np.linalg.solve(w_inv[np.ix_(~keep, ~keep)], q_mat.T)
+        kept_idx = old_idx[keep]
+        kept_a_inv = old_a_inv[keep[::2]]
+        new_idx = idx[added]
+        new_diagonals = np.zeros_like(active)
+        new_diagonals[new_idx[::2] // 2] = True
+        new_a_inv = self._contact_compliance_blocks(p, new_diagonals)
+        if new_idx.size:  # border with the contacts that closed
+            b_mat = self.compliance[np.ix_(kept_idx, new_idx)]
+            c_mat = self.compliance[np.ix_(new_idx, new_idx)].copy()
+            blocks = np.arange(0, new_idx.size, 2)
+            for r in range(2):
+                for c in range(2):
+                    c_mat[blocks + r, blocks + c] += new_a_inv[:, r, c]
+            x_mat = w_inv @ b_mat
+            schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
+            xs = x_mat @ schur
+            w_inv = np.block([[w_inv + xs @ x_mat.T, -xs], [-xs.T, schur]])
+        order = np.argsort(np.concatenate([kept_idx, new_idx]), kind="stable")
+        w_inv = w_inv[np.ix_(order, order)]
+        a_inv = np.concatenate([kept_a_inv, new_a_inv])[order[::2] // 2]
+        return self._reduced_operator(idx, active, a_inv, w_inv, mu)
+
     def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float, fresh: bool):
         """Newton step of the flexible model, reduced to the active contacts
         (module docstring): returns the increments of ``qs`` and ``y``.
@@ -549,22 +604,16 @@ class BimeSolver:
             self._reduced = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), y_new - p.y
         cached = self._reduced
-        if fresh or cached is None or not np.array_equal(cached[0], idx):
-            nn = p.n[..., :, None] * p.n[..., None, :]
-            k_normal = 1.5 * self.assembly.stiffness * np.sqrt(np.maximum(p.delta, 0.0))
-            with np.errstate(divide="ignore", invalid="ignore"):
-                a_inv = nn / k_normal[..., None, None] + (p.length / p.q)[..., None, None] * (np.eye(2) - nn)
-            a_inv = a_inv.reshape(-1, 2, 2)[active]           # A^-1 of the active diagonals
+        if not fresh and cached is not None and not np.array_equal(cached[0], idx):
+            cached = self._update_reduced(cached, p, idx, active, mu)
+        if fresh or cached is None:
+            a_inv = self._contact_compliance_blocks(p, active)
             w_mat = self.compliance[np.ix_(idx, idx)]         # (A^-1 + M)_aa
             blocks = np.arange(0, idx.size, 2)
             for r in range(2):
                 for c in range(2):
                     w_mat[blocks + r, blocks + c] += a_inv[:, r, c]
-            w_inv = np.linalg.inv(w_mat)
-            ja = self.jacobian.reshape(-1, 5)[idx]
-            z_mat = w_inv @ ja
-            schur_inv = np.linalg.inv(ja.T @ z_mat + mu * np.eye(5))
-            cached = self._reduced = (idx, active, a_inv, w_inv, ja, z_mat, schur_inv)
+            cached = self._reduced_operator(idx, active, a_inv, np.linalg.inv(w_mat), mu)
         _, active, a_inv, w_inv, ja, z_mat, schur_inv = cached
         rhs = (a_inv @ p.force.reshape(-1, 2)[active][..., None]).ravel() + (self.compliance[idx] @ p.y)
         w_vec = w_inv @ rhs
