@@ -83,24 +83,30 @@ def _run_solve(args) -> int:
     return 0
 
 
-def _add_superelement(sub) -> None:
+def _add_superelement(sub, wanted: bool) -> None:
+    """The build-time subcommand; its module (scipy, scikit-fem) is imported only when asked for."""
+    help_text = "build a ring superelement (scikit-fem; `slewing superelement -h` for its options)"
+    if not wanted:
+        sub.add_parser("superelement", help=help_text, add_help=False)
+        return
     try:
         from .superelement import command
     except ImportError as exc:  # build-time dependencies missing
-        p = sub.add_parser("superelement", help=f"unavailable: {exc}")
+        p = sub.add_parser("superelement", help=help_text)
         p.set_defaults(func=lambda args: (print(f"slewing superelement needs scipy and scikit-fem: {exc}",
                                                  file=sys.stderr), 2)[1])
         return
-    p = sub.add_parser("superelement", help="build a ring superelement (scikit-fem)")
+    p = sub.add_parser("superelement", help=help_text)
     command.add_arguments(p)
     p.set_defaults(func=command.run)
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_solve(sub)
-    _add_superelement(sub)
+    _add_superelement(sub, wanted=bool(argv) and argv[0] == "superelement")
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
