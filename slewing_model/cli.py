@@ -83,6 +83,34 @@ def _run_solve(args) -> int:
     return 0
 
 
+def _add_plot(sub) -> None:
+    p = sub.add_parser("plot", help="per-ball interference or load, rigid and flexible rings side by side (PNG)")
+    p.add_argument("bearing", help="bearing definition (TOML)")
+    for name, unit in zip(LOAD_FIELDS, ("N", "N", "N", "Nm", "Nm")):
+        p.add_argument(f"--{name.lower()}", type=_finite_float, default=0.0, metavar=unit, help=f"{name}, {unit}")
+    p.add_argument("--preload", type=_finite_float, default=None, metavar="m", help="ball preload, m")
+    p.add_argument("--quantity", choices=("interference", "load"), default="interference")
+    p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free")
+    p.add_argument("--mesh", choices=("coarse", "fine"), default="coarse")
+    p.add_argument("-o", "--output", required=True, help="PNG file to write")
+    p.set_defaults(func=_run_plot)
+
+
+def _run_plot(args) -> int:
+    from .plots import plot_distribution
+
+    bearing = load_bearing(args.bearing)
+    if args.preload is not None:
+        bearing = bearing.with_preload(args.preload)
+    loads = Loads(args.fx, args.fy, args.fz, args.mx, args.my)
+    results = {"rigid rings": solve(bearing, loads),
+               f"flexible rings ({args.bc})": solve(bearing, loads, model="flexible", bc=args.bc, mesh=args.mesh)}
+    plot_distribution(results, args.output, quantity=args.quantity,
+                      title=f"{bearing.name}, preload {bearing.preload * 1e6:g} um, {loads}")
+    print(f"wrote {args.output}")
+    return 0
+
+
 def _add_superelement(sub, wanted: bool) -> None:
     """The build-time subcommand; its module (scipy, scikit-fem) is imported only when asked for."""
     help_text = "build a ring superelement (scikit-fem; `slewing superelement -h` for its options)"
@@ -106,6 +134,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_solve(sub)
+    _add_plot(sub)
     _add_superelement(sub, wanted=bool(argv) and argv[0] == "superelement")
     args = parser.parse_args(argv)
     try:

@@ -76,3 +76,14 @@ def test_flexible_model_from_the_command_line(tmp_path):
     assert data["model"] == "flexible" and np.array(data["ring_displacement"]).shape == (67, 4, 2)
     rigid = solve(load_bearing(ROOT / "examples/bearings/table3.toml"), Loads(Fz=3e4))
     assert data["displacement"]["z"] > rigid.displacement[2]  # flexible rings are softer
+
+
+def test_plot_writes_a_png(tmp_path):
+    import os
+
+    env = dict(os.environ, SLEWING_CACHE_DIR=str(tmp_path))
+    png = tmp_path / "fig.png"
+    out = subprocess.run([SLEWING, "plot", "examples/bearings/table3.toml", "--preload", "2e-5", "--bc", "clamped",
+                          "-o", str(png)], capture_output=True, text=True, cwd=ROOT, timeout=600, env=env)
+    assert out.returncode == 0, out.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
