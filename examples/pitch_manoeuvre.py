@@ -10,7 +10,6 @@ once with it switched off. Writes ``results/pitch_manoeuvre.png`` and
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 from pathlib import Path
@@ -20,7 +19,7 @@ sys.path.insert(0, str(ROOT))
 
 from build_fmu import build_fmu  # noqa: E402
 from slewing_drives import DriveParameters, LoadSeries  # noqa: E402
-from slewing_drives.cosimulation import plot_manoeuvre, run_manoeuvre  # noqa: E402
+from slewing_drives.cosimulation import plot_manoeuvre, run_manoeuvre, summary_table, write_csv  # noqa: E402
 
 STEP_DEG, T_ON, T_OFF, T_END, DT = 5.0, 1.0, 6.0, 12.0, 0.01
 
@@ -44,25 +43,8 @@ def run(results: Path, *, ring_model: int = 2, progress: bool = True):
     results.mkdir(parents=True, exist_ok=True)
     plot_manoeuvre(with_friction, results / "pitch_manoeuvre.png", without_friction=without,
                    title=f"{STEP_DEG:g} deg pitch step and back, {drive.name}, bearing FMU in the loop")
-    with open(results / "pitch_manoeuvre.csv", "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["time_s", "command_deg", "angle_deg", "motor_torque_Nm", "friction_torque_Nm",
-                    "max_ball_load_N", "static_safety_factor", "angle_no_friction_deg", "motor_torque_no_friction_Nm"])
-        for k in range(len(with_friction.time)):
-            w.writerow([f"{with_friction.time[k]:.3f}", f"{math.degrees(with_friction.command[k]):.4f}",
-                        f"{math.degrees(with_friction.angle[k]):.5f}", f"{with_friction.motor_torque[k]:.4f}",
-                        f"{with_friction.friction_torque[k]:.2f}", f"{with_friction.outputs['max_ball_load'][k]:.1f}",
-                        f"{with_friction.outputs['static_safety_factor'][k]:.4f}",
-                        f"{math.degrees(without.angle[k]):.5f}", f"{without.motor_torque[k]:.4f}"])
+    write_csv(with_friction, results / "pitch_manoeuvre.csv", without)
     return with_friction, without
-
-
-def summary_table(with_friction, without) -> str:
-    a, b = with_friction.summary(), without.summary()
-    lines = ["| quantity | with bearing friction | friction off |", "|---|---|---|"]
-    for key in a:
-        lines.append(f"| {key} | {a[key]:.3g} | {b[key]:.3g} |")
-    return "\n".join(lines)
 
 
 def main(argv=None) -> int:

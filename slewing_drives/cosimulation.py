@@ -196,3 +196,31 @@ def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: Manoeuvre
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def summary_table(with_friction: ManoeuvreResult, without: ManoeuvreResult | None = None) -> str:
+    """Markdown table of :meth:`ManoeuvreResult.summary`, with and without bearing friction."""
+    a = with_friction.summary()
+    b = without.summary() if without is not None else None
+    head = "| quantity | with bearing friction |" + (" friction off |" if b else "")
+    lines = [head, "|---|---|" + ("---|" if b else "")]
+    for key in a:
+        lines.append(f"| {key} | {a[key]:.3g} |" + (f" {b[key]:.3g} |" if b else ""))
+    return "\n".join(lines)
+
+
+def write_csv(result: ManoeuvreResult, path, without: ManoeuvreResult | None = None) -> None:
+    """Time histories as CSV (angles in deg, torques in N m, loads in N)."""
+    import csv
+
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["time_s", "command_deg", "angle_deg", "motor_torque_Nm", "friction_torque_Nm", "max_ball_load_N",
+                    "static_safety_factor"] + (["angle_no_friction_deg", "motor_torque_no_friction_Nm"] if without else []))
+        for k in range(len(result.time)):
+            row = [f"{result.time[k]:.3f}", f"{np.degrees(result.command[k]):.5f}", f"{np.degrees(result.angle[k]):.5f}",
+                   f"{result.motor_torque[k]:.4f}", f"{result.friction_torque[k]:.2f}",
+                   f"{result.outputs['max_ball_load'][k]:.1f}", f"{result.outputs['static_safety_factor'][k]:.4f}"]
+            if without is not None:
+                row += [f"{np.degrees(without.angle[k]):.5f}", f"{without.motor_torque[k]:.4f}"]
+            w.writerow(row)
