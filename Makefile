@@ -25,8 +25,13 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q
 
+# speed figures of the README (several minutes: the FMU memory run takes 100 000 steps)
 bench: $(STAMP)
 	$(PY) benchmarks/bench_rigid.py
+	$(PY) benchmarks/bench_superelement.py
+	$(PY) benchmarks/bench_flexible.py
+	$(PY) benchmarks/bench_friction.py
+	$(PY) benchmarks/bench_fmu.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info results
