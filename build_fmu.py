@@ -25,7 +25,7 @@ RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "bim
                    "friction", "simulator")
 
 
-def build_fmu(bearing_file, output=None, *, bc="free", mesh="coarse", progress=False) -> Path:
+def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -37,6 +37,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="coarse", progress=F
     bc : {"free", "clamped", "frictionless"}
         Ring support of the superelement.
     mesh : {"coarse", "fine"}
+        Superelement mesh; "fine" (default) is within 0.5 % of a finer one, "coarse" is for tests.
     """
     from pythonfmu import FmuBuilder
 
@@ -83,7 +84,7 @@ def main(argv=None) -> int:
     parser.add_argument("bearing", nargs="?", help="bearing definition (TOML)")
     parser.add_argument("-o", "--output", help="FMU file to write")
     parser.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free")
-    parser.add_argument("--mesh", choices=("coarse", "fine"), default="coarse")
+    parser.add_argument("--mesh", choices=("coarse", "fine"), default="fine")
     parser.add_argument("--host-env", action="store_true",
                         help="only print the environment a C/C++ host on Linux needs (LD_PRELOAD of libpython)")
     args = parser.parse_args(argv)
