@@ -48,11 +48,16 @@ def _add_solve(sub) -> None:
     p.set_defaults(func=_run_solve)
 
 
-def _run_solve(args) -> int:
+def _bearing_and_loads(args):
+    """The bearing (with ``--preload`` applied) and the loads of the command line."""
     bearing = load_bearing(args.bearing)
     if args.preload is not None:
         bearing = bearing.with_preload(args.preload)
-    loads = Loads(args.fx, args.fy, args.fz, args.mx, args.my)
+    return bearing, Loads(args.fx, args.fy, args.fz, args.mx, args.my)
+
+
+def _run_solve(args) -> int:
+    bearing, loads = _bearing_and_loads(args)
     result = solve(bearing, loads, model=args.model, bc=args.bc, mesh=args.mesh, psi=args.psi)
     options = {} if args.mu is None else {"mu": args.mu}
     friction = friction_torque(bearing, result, omega=1.0, seal_torque=args.seal_torque, **options)
@@ -99,10 +104,7 @@ def _add_plot(sub) -> None:
 def _run_plot(args) -> int:
     from .plots import plot_distribution
 
-    bearing = load_bearing(args.bearing)
-    if args.preload is not None:
-        bearing = bearing.with_preload(args.preload)
-    loads = Loads(args.fx, args.fy, args.fz, args.mx, args.my)
+    bearing, loads = _bearing_and_loads(args)
     results = {"rigid rings": solve(bearing, loads),
                f"flexible rings ({args.bc})": solve(bearing, loads, model="flexible", bc=args.bc, mesh=args.mesh)}
     plot_distribution(results, args.output, quantity=args.quantity,

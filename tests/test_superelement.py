@@ -161,14 +161,7 @@ def test_halfspace_harmonic_compliance_matches_fe_on_a_flat_face():
     patch = cp.Patch(1, np.array([rm, h / 2 - flat]), flat, np.pi / 2, a, b, rm)
     facets = mesh.facets_satisfying(lambda x: np.isclose(x[1], h / 2) & (abs(x[0] - rm) < a + 1e-9),
                                     boundaries_only=True)
-    loads = []
-    for k in (1, 2):
-        def traction(r, z, k=k):
-            nrm, w0, w1 = patch.pressure_basis(r, z)
-            p = (w0, w1)[k - 1] / r
-            return (p * nrm[0], 0 * r, p * nrm[1])
-        loads.append(model.facet_load(facets, traction, intorder=12))
-    g = np.stack(loads, axis=1)
+    g = cp.basis_loads(model, facets, patch)
     ns = [150, 300]
     hs = cp.halfspace_harmonic(patch, ns, E, NU)
     for n, ref in zip(ns, hs):

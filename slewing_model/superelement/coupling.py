@@ -138,6 +138,19 @@ def ring_patches(bearing: Bearing, ring: str, sizes) -> tuple[Patch, Patch]:
     return tuple(out)
 
 
+def basis_loads(model, facets, patch: Patch) -> np.ndarray:
+    """Load vectors (ndofs, 2) of the patch's two basis pressures ``w0, w1`` acting along the
+    raceway normal over ``facets`` (traction ``P / r``: see :func:`master_loads`)."""
+    loads = []
+    for k in (1, 2):
+        def traction(r, z, k=k):
+            nrm, w0, w1 = patch.pressure_basis(r, z)
+            p = (w0, w1)[k - 1] / r
+            return (p * nrm[0], 0.0 * r, p * nrm[1])
+        loads.append(model.facet_load(facets, traction, intorder=12))
+    return np.stack(loads, axis=1)
+
+
 def master_loads(model, mesh_facets, patches) -> tuple[np.ndarray, list]:
     """Load vectors of unit master forces, shape (ndofs, 4), columns [R_a, z_a, R_b, z_b].
 
@@ -151,14 +164,7 @@ def master_loads(model, mesh_facets, patches) -> tuple[np.ndarray, list]:
     e_w = model.field(w=lambda r, z: 1.0)
     cols, lams = [], []
     for facets, patch in zip(mesh_facets, patches):
-        g = []
-        for k in (1, 2):
-            def traction(r, z, k=k):
-                nrm, w0, w1 = patch.pressure_basis(r, z)
-                p = (w0, w1)[k - 1] / r
-                return (p * nrm[0], 0.0 * r, p * nrm[1])
-            g.append(model.facet_load(facets, traction, intorder=12))
-        g = np.stack(g, axis=1)                      # (ndofs, 2) basis pressures
+        g = basis_loads(model, facets, patch)        # (ndofs, 2) basis pressures
         resultant = np.stack([e_u @ g, e_w @ g])     # rows F_R, F_z; columns lambda_0, lambda_1
         lam = np.linalg.inv(resultant)
         cols.append(g @ lam)
