@@ -148,3 +148,25 @@ def test_structured_solver_equals_dense_newton_on_fe_rings(table3_errors, bc):
     assert np.allclose(r.displacement, x[:5], rtol=1e-8, atol=1e-14)
     assert np.allclose(r.ring_displacement[:, [0, 3]].ravel(), x[5:5 + 4 * n], atol=1e-13)
     assert np.allclose(r.ring_displacement[:, [1, 2]].ravel(), x[5 + 4 * n:], atol=1e-13)
+
+
+def test_flexible_gradient_and_hessian_match_finite_differences(table3_errors, table3_free):
+    # eq 20 with both rings: all 5 + 8B unknowns, at a point where contacts are loaded
+    solver = BimeSolver(table3_errors.with_preload(10e-6), table3_free)
+    loads = Loads(Fx=5e3, Fz=2e4, My=1e3)
+    r = solver.solve(loads)
+    n = table3_errors.ball_count
+    rng = np.random.default_rng(3)
+    x = np.concatenate([r.displacement, r.ring_displacement[:, [0, 3]].ravel(), r.ring_displacement[:, [1, 2]].ravel()])
+    x = x + rng.normal(size=x.size) * np.r_[np.full(3, 1e-7), np.full(2, 1e-7), np.full(8 * n, 1e-7)]
+    u, g, h = solver.energy_terms(x, loads)
+    picks = [0, 2, 3, 5, 6, 5 + 4 * n + 7, 5 + 8 * n - 1]
+    for i in picks:
+        step = 1e-10
+        dx = np.zeros_like(x)
+        dx[i] = step
+        up, gp, _ = solver.energy_terms(x + dx, loads)
+        um, gm, _ = solver.energy_terms(x - dx, loads)
+        assert (up - um) / (2 * step) == pytest.approx(g[i], rel=1e-5, abs=1e-6 * np.abs(g).max())
+        assert np.allclose((gp - gm) / (2 * step), h[:, i], rtol=1e-4, atol=1e-6 * np.abs(h).max())
+    assert np.allclose(h, h.T)
