@@ -21,7 +21,6 @@ Run: .venv/bin/python examples/friction_study.py [--out DIR] [--quick]
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 import time

@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
 
 from slewing_model import Loads, load_bearing, solve
 

@@ -130,7 +130,7 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
             t = time[k]
             load = loads.at(t)
             _set_inputs(fmu, refs, load, sim.state.angle, sim.state.speed)
-            status = fmu.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
+            fmu.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
             for name, value in zip(OUTPUTS, fmu.getReal(out_refs)):
                 out[name][k] = value
             cmd[k] = command(t)

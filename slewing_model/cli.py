@@ -122,9 +122,9 @@ def _add_superelement(sub, wanted: bool) -> None:
     try:
         from .superelement import command
     except ImportError as exc:  # build-time dependencies missing
+        reason = f"slewing superelement needs scipy and scikit-fem: {exc}"
         p = sub.add_parser("superelement", help=help_text)
-        p.set_defaults(func=lambda args: (print(f"slewing superelement needs scipy and scikit-fem: {exc}",
-                                                 file=sys.stderr), 2)[1])
+        p.set_defaults(func=lambda args: (print(reason, file=sys.stderr), 2)[1])
         return
     p = sub.add_parser("superelement", help=help_text)
     command.add_arguments(p)

@@ -1,5 +1,4 @@
 """Pitch drive co-simulated with the real bearing FMU (fmpy step loop)."""
-import math
 
 import numpy as np
 import pytest

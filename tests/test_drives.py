@@ -1,5 +1,4 @@
 """Pitch and yaw drive models (python-control) without the bearing."""
-import math
 
 import control
 import numpy as np

@@ -1,5 +1,4 @@
 """Flexible-BIME with finite element superelements (paper sections 2.2-2.4)."""
-import math
 
 import numpy as np
 import pytest

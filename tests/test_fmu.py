@@ -1,6 +1,5 @@
 """The bearing FMU, driven by fmpy (and by the ecos C++ host): model description,
 outputs against the library, rollback, instances, bad input."""
-import math
 import os
 import shutil
 import subprocess

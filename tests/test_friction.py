@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy import integrate, special
 
-from slewing_model import Loads, load_bearing, solve, synthetic_errors
+from slewing_model import Loads, solve, synthetic_errors
 from slewing_model.friction import (
     CATALOGUE_MU, EllipseQuadrature, FrictionTorque, catalogue_torque, conformity_radius, ellipse_friction,
     ellipse_quadrature, friction_torque, omega_regularisation_for_step, preload_sweep, regularised_torque,
