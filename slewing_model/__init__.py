@@ -13,6 +13,7 @@ The run-time part of this package imports numpy only; building a superelement
 from .geometry import Bearing, BearingDefinitionError, RingSection, load_bearing, bearing_from_dict
 from .errors import ManufacturingErrors, RingErrorMap, synthetic_errors
 from .bime import BimeSolver, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError, solve
+from .friction import FrictionTorque, catalogue_torque, friction_torque
 
 __version__ = "0.1.0"
 
@@ -20,5 +21,6 @@ __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",
     "ManufacturingErrors", "RingErrorMap", "synthetic_errors",
     "BimeSolver", "LoadCapacityError", "LoadDistribution", "Loads", "NoEquilibriumError", "solve",
+    "FrictionTorque", "catalogue_torque", "friction_torque",
     "__version__",
 ]
