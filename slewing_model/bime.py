@@ -244,18 +244,23 @@ def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np
     return row[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
 
 
-def contact_compliance(superelement) -> np.ndarray:
+def ring_compliances(superelement) -> dict[str, np.ndarray]:
+    """``G`` (4B, 4B) of each ring: its compliance at its groove centres, the
+    pseudo-inverse of its superelement (a free ring's rigid modes dropped)."""
+    return {name: _pseudo_inverse_circulant(np.asarray(getattr(superelement, name).first_row, dtype=float))
+            for name in ("outer", "inner")}
+
+
+def contact_compliance(rings: dict[str, np.ndarray]) -> np.ndarray:
     """``M`` (4B, 4B): the combined compliance of both rings seen by the contacts,
     ordered like the relative vectors ``e`` (ball, diagonal, (r, z)).
 
-    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` each ring's
-    compliance at its groove centres (pseudo-inverse of its superelement)."""
-    n = superelement.outer.ball_count
+    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` from :func:`ring_compliances`."""
+    n = rings["outer"].shape[0] // 4
     total = 0.0
-    for ring, slots in ((superelement.outer, OUTER_SLOT), (superelement.inner, INNER_SLOT)):
-        g = _pseudo_inverse_circulant(np.asarray(ring.first_row, dtype=float))
+    for name, slots in (("outer", OUTER_SLOT), ("inner", INNER_SLOT)):
         index = _ring_index(n, slots)
-        total = total + g[np.ix_(index, index)]
+        total = total + rings[name][np.ix_(index, index)]
     return total
 
 
@@ -278,9 +283,6 @@ class BimeSolver:
     rtol : float
         Relative tolerance of the stopping rule.
     max_iterations : int
-    compliance : ndarray, optional
-        Precomputed :func:`contact_compliance` of ``superelement`` (shared
-        between solvers of the same bearing).
     pressure_limit : float, Pa
         Loads whose largest Hertz pressure exceeds this are refused
         (:class:`LoadCapacityError`). Default ``2 x 4200 MPa``: twice the ISO 76
@@ -289,8 +291,7 @@ class BimeSolver:
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
-                 rtol: float = 1e-10, max_iterations: int = 200, compliance: np.ndarray | None = None,
-                 pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT):
+                 rtol: float = 1e-10, max_iterations: int = 200, pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT):
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
             raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
                              f"the bearing ball_count = {bearing.ball_count}")
@@ -301,8 +302,8 @@ class BimeSolver:
         self.max_iterations = max_iterations
         self.pressure_limit = pressure_limit
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
-        self.compliance = compliance if compliance is not None else (
-            None if superelement is None else contact_compliance(superelement))
+        self.ring_compliance = None if superelement is None else ring_compliances(superelement)
+        self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
@@ -674,19 +675,13 @@ class BimeSolver:
         forces = y.reshape(n, 2, 2)
         out = np.zeros((n, 4, 2))
         for ring, slots, sign in (("outer", OUTER_SLOT, 1.0), ("inner", INNER_SLOT, -1.0)):
-            g = self._ring_compliance(ring)
+            g = self.ring_compliance[ring]
             load = np.zeros((n, 2, 2))
             load[:, slots] = forces
             d = (g @ load.ravel()).reshape(n, 2, 2) * sign
             cols = [c - 1 for c in RING_CONTACTS[ring]]
             out[:, cols] = d
         return out
-
-    def _ring_compliance(self, ring: str) -> np.ndarray:
-        cache = self.__dict__.setdefault("_g_cache", {})
-        if ring not in cache:
-            cache[ring] = _pseudo_inverse_circulant(np.asarray(getattr(self.superelement, ring).first_row, float))
-        return cache[ring]
 
 
 @dataclass

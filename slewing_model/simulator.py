@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .bime import BimeSolver, LoadDistribution, Loads, contact_compliance
+from .bime import BimeSolver, LoadDistribution, Loads
 from .friction import friction_torque, regularised_torque
 from .geometry import Bearing
 
@@ -131,9 +131,8 @@ class BearingSimulator:
         if s.preload is not None:
             bearing = bearing.with_preload(s.preload)
         self.bearing = bearing
-        compliance = contact_compliance(self.superelement) if s.ring_model == "flexible" else None
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
-                                 rtol=s.tolerance, compliance=compliance)
+                                 rtol=s.tolerance)
         self._warm: np.ndarray | None = None
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
         self._psi = 0.0
