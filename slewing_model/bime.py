@@ -522,8 +522,7 @@ class BimeSolver:
         delta, q, force, energy, hess, n, length = self._contacts(e)
         work = float(f_scaled @ qs)
         # the total is a difference of larger terms: its roundoff scales with them
-        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy,
-                      energy + ring + abs(work))
+        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work))
 
     def _rigid_direction(self, p: "_Point", grad_q: np.ndarray, mu: float) -> np.ndarray:
         """Newton step of the rigid model: ``(sum J^T A J) dq = -grad``."""
@@ -555,7 +554,7 @@ class BimeSolver:
         inverse; adding rows (bordering): with ``X = W_kk^-1 B`` and the Schur
         complement ``C - B^T X``. O(n^2 r) instead of O(n^3) for r changed rows.
         Returns None (rebuild) when many contacts changed."""
-        old_idx, old_active, old_a_inv, w_inv = cached[:4]
+        old_idx, _, old_a_inv, w_inv = cached[:4]
         keep = np.isin(old_idx, idx)
         added = ~np.isin(idx, old_idx)
         changed = int((~keep).sum() + added.sum())
@@ -698,7 +697,6 @@ class _Point:
     n: np.ndarray
     length: np.ndarray
     total: float
-    contact_energy: float
     energy_scale: float
 
 
@@ -714,12 +712,6 @@ def _ring_selector(n: int, slots: np.ndarray) -> np.ndarray:
     p = np.zeros((4 * n, 4 * n))
     p[np.arange(4 * n), _ring_index(n, slots)] = 1.0
     return p
-
-
-def _cho_solve(chol: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve ``L L^T x = rhs`` with numpy only (the FMU has no scipy)."""
-    z = np.linalg.solve(chol, rhs)
-    return np.linalg.solve(chol.T, z)
 
 
 def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid", superelement=None,

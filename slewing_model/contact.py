@@ -115,12 +115,6 @@ _K_TABLE, _E_TABLE = elliptic_integrals(1.0 - np.exp(-2.0 * _LOG_KAPPA))
 _F_TABLE = _curvature_difference(np.exp(_LOG_KAPPA))
 
 
-def ellipticity(curvature_difference):
-    """Ellipticity ``kappa = a/b`` for Hertz's curvature difference ``F(rho)`` in [0, 1)."""
-    f = np.asarray(curvature_difference, dtype=float)
-    return np.exp(np.interp(f, _F_TABLE, _LOG_KAPPA, left=0.0))
-
-
 @dataclass(frozen=True)
 class ContactEllipse:
     """Hertz contact ellipse of a ball-raceway contact (arrays broadcast like the load).
