@@ -82,7 +82,8 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
     progress : bool
         Show a progress bar (tqdm).
     logger : callable, optional
-        FMU log messages ``logger(message)``; by default errors raise.
+        Called with every FMU log message (str); the last ones are also quoted
+        in the error raised when the co-simulation fails.
 
     Returns
     -------
@@ -98,7 +99,12 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
     messages = []
 
     def log(component, instance, status, category, message):
-        messages.append(message.decode(errors="replace"))
+        text = message.decode(errors="replace")
+        messages.append(text)
+        if logger is not None:
+            logger(text)
+
+    callbacks = logging_callbacks(log)
 
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
                     instanceName="bearing")
@@ -113,7 +119,7 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
     sim.hold(loads.at(0.0)[5])
     k = 0
     try:
-        fmu.instantiate(loggingOn=True, callbacks=None)
+        fmu.instantiate(loggingOn=True, callbacks=callbacks)
         fmu.setupExperiment(startTime=0.0)
         for name, value in values.items():
             (fmu.setInteger if types[name] == "Integer" else fmu.setReal)([refs[name]], [value])
@@ -146,6 +152,20 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
         fmu.freeInstance()
         shutil.rmtree(unzipped, ignore_errors=True)
     return ManoeuvreResult(time + dt, cmd, angle, speed, motor, ring, mz, out, sim.state.motor_energy, drive)
+
+
+def logging_callbacks(log):
+    """fmpy FMI 2.0 callbacks whose logger is ``log(component, instance, status, category, message)``.
+    Keep the returned object alive as long as the FMU instance: the FMU holds pointers into it."""
+    from fmpy import calloc, free
+    from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
+                           fmi2CallbackLoggerTYPE)
+
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(log)
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    return callbacks
 
 
 def _set_inputs(fmu, refs, load, psi, omega):

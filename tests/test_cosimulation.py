@@ -67,3 +67,13 @@ def test_shipped_load_series_is_the_seeded_generator(tmp_path):
     shipped = LoadSeries.read_csv(ROOT / "examples/loads/blade_root_loads.csv")
     assert np.allclose(shipped.loads, fresh.loads, rtol=1e-5, atol=1e-3)
     assert shipped.at(0.005)[4] == pytest.approx(0.5 * (shipped.loads[0, 4] + shipped.loads[1, 4]))
+
+
+def test_failure_quotes_the_fmu_log(table3_fmu):
+    # an overload the bearing cannot carry: the FMU discards the step and says why; the error quotes it
+    drive = DriveParameters.from_toml(ROOT / "examples/drives/pitch_drive.toml")
+    loads = LoadSeries(np.array([0.0, 1.0]), np.array([[0.0, 0.0, 5e7, 0.0, 0.0, 0.0]] * 2))
+    seen = []
+    with pytest.raises(RuntimeError, match="beyond what the bearing can carry"):
+        run_manoeuvre(table3_fmu, drive, loads, lambda t: 0.0, t_end=0.05, dt=0.01, logger=seen.append)
+    assert any("beyond what the bearing can carry" in m for m in seen)

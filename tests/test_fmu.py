@@ -125,9 +125,7 @@ def test_friction_varies_with_psi_and_opposes_omega(table3_fmu):
 
 def _slave(path, name="bearing"):
     """An instantiated FMU2Slave whose log messages are collected in ``messages``."""
-    from fmpy import calloc, free
-    from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                           fmi2CallbackLoggerTYPE)
+    from slewing_drives.cosimulation import logging_callbacks
 
     md = read_model_description(str(path))
     unzipped = extract(str(path))
@@ -136,10 +134,7 @@ def _slave(path, name="bearing"):
     def logger(component, instance, status, category, message):
         messages.append(message.decode())
 
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
-    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    callbacks = logging_callbacks(logger)
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
                     instanceName=name)
     fmu.instantiate(loggingOn=True, callbacks=callbacks)
