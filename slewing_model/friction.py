@@ -73,7 +73,7 @@ DEFAULT_SLIDING_REGULARISATION = 1e-3
 #: Default speed scale of the regularised Coulomb law near omega = 0, rad/s
 DEFAULT_OMEGA_REGULARISATION = 1e-4
 #: Regularisation continuation of a cold start (multiples of the final eps)
-SOLVE_LEVELS = (10.0,)
+SOLVE_LEVELS = ()
 
 #: sign of the (r, z) components of the contact normals of contacts 1..4
 #: (as :attr:`slewing_model.geometry.Bearing.contact_normals`)
@@ -81,6 +81,8 @@ _NORMAL_SIGN_R = np.array([1.0, -1.0, -1.0, 1.0])
 _NORMAL_SIGN_Z = np.array([1.0, 1.0, -1.0, -1.0])
 #: for each possible moving ring, which of contacts 1..4 turn with it
 _IS_MOVING = {ring: np.isin(np.arange(4), [c - 1 for c in RING_CONTACTS[ring]]) for ring in ("inner", "outer")}
+#: columns of the ball state (r w_r, r w_t, r w_z, R w_c) that are solved for (w_t = 0, see _Contacts)
+_SOLVED = [0, 2, 3]
 #: damping schedule of the Newton / Weiszfeld blend (see _minimise)
 _THETA_DOWN, _THETA_UP, _THETA_MIN_UP = 0.2, 10.0, 0.1
 _THETA_COLD = 1.0
@@ -111,6 +113,11 @@ class EllipseQuadrature:
         ``u``.
     along_nodes : ndarray (n_along,)
         ``t``.
+    along_squared : ndarray (K,)
+        The distinct ``t^2``: the nodes ``+t`` and ``-t`` folded into one
+        (the sliding speed over a contact depends on ``t^2`` only).
+    folded_weight : ndarray (K, n_across)
+        The weights summed over the nodes of each ``t^2``.
     """
 
     n_across: int
@@ -120,6 +127,8 @@ class EllipseQuadrature:
     weight: np.ndarray
     across_nodes: np.ndarray
     along_nodes: np.ndarray
+    along_squared: np.ndarray
+    folded_weight: np.ndarray
 
     @property
     def size(self) -> int:
@@ -150,9 +159,12 @@ def ellipse_quadrature(n_across: int = DEFAULT_QUADRATURE[0], n_along: int = DEF
     across = np.repeat(u, n_along)
     along = np.sqrt(1.0 - across**2) * np.tile(t, n_across)
     weight = 1.5 / np.pi * np.outer(wu, wt).ravel()
-    for arr in (across, along, weight, u, t):
+    along_squared, index = np.unique(np.round(t**2, 12), return_inverse=True)
+    folded = np.zeros((along_squared.size, n_across))
+    np.add.at(folded, index, weight.reshape(n_across, n_along).T)
+    for arr in (across, along, weight, u, t, along_squared, folded):
         arr.setflags(write=False)
-    return EllipseQuadrature(n_across, n_along, across, along, weight, u, t)
+    return EllipseQuadrature(n_across, n_along, across, along, weight, u, t, along_squared, folded)
 
 
 def _quadrature(quadrature) -> EllipseQuadrature:
@@ -531,13 +543,13 @@ class _ContactSet:
         self.moving = _IS_MOVING[bearing.moving_ring][c_i][:, None]
         self.ring_speed = np.where(self.moving, speed, 0.0)
         self.mu_load = mu * q[b_i, c_i]
-        self.eps2 = ((sliding_regularisation * abs(speed)) * self.a[:, :, None]) ** 2
+        self.eps2 = ((sliding_regularisation * abs(speed)) * self.a) ** 2
         self.force_scale = mu * q[active].max(axis=1) if active.size else np.zeros(0)
         self.contact_angle = arrays["contact_angle"]
         self.moving_ring = bearing.moving_ring
 
     def initial_guess(self) -> np.ndarray:
-        """Scaled unknowns (B_active, 4) for a cold start: for each diagonal,
+        """Scaled unknowns (B_active, 3) for a cold start: for each diagonal,
         rolling without sliding at its two contact centres about an axis normal
         to it (the classical two-contact kinematics); the two diagonals blended
         in proportion to their loads."""
@@ -546,14 +558,14 @@ class _ContactSet:
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
         w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
-        guess = np.zeros((self.active.size, 4))
+        guess = np.zeros((self.active.size, 3))
         total = np.zeros(self.active.size)
         for outer, sign in ((0, 1.0), (3, -1.0)):          # diagonal 1 (contacts 1, 3), diagonal 2 (4, 2)
             n_r, n_z = np.cos(alpha[:, outer]), sign * np.sin(alpha[:, outer])
             # v . t = 0 at the outer contact (normal n) and at the inner one (-n), w = w_g g, g = (-n_z, 0, n_r)
             w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
             w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
-            diag = np.stack([-w_g * n_z * ls, np.zeros_like(w_g), w_g * n_r * ls, w_c * big_r], axis=-1)
+            diag = np.stack([-w_g * n_z * ls, w_g * n_r * ls, w_c * big_r], axis=-1)
             guess += q[:, outer, None] * diag
             total += q[:, outer]
         return guess / total[:, None]
@@ -562,18 +574,26 @@ class _ContactSet:
 class _Contacts:
     """Sliding velocities of the loaded contacts at the points of one rule.
 
-    For contact ``c`` (of active ball ``owner[c]``) and point ``(j, i)`` (``j``
-    along the rolling direction, ``i`` across the groove), the tangential
-    sliding velocity, raceway minus ball, is linear in the ball's scaled
-    unknowns ``u = (r w_r, r w_t, r w_z, R w_c)`` (m/s; ``r = Dw/2``,
-    ``R = dm/2``; ``w`` the ball's angular velocity along its (radial,
-    tangential, axial) directions, ``w_c`` its orbital speed). The contact
-    surface is flat along the rolling direction, so the rolling component
-    depends on the across position only and the across component is affine in
-    ``xi``:
+    The unknowns of active ball ``b`` are ``u = (r w_r, r w_z, R w_c)`` (m/s;
+    ``r = Dw/2``, ``R = dm/2``; ``w_r``, ``w_z`` the ball's angular velocity
+    along its radial and axial directions, ``w_c`` its orbital speed). Its
+    tangential component ``w_t`` is zero at the equilibrium and is not solved
+    for: the rule is symmetric in ``xi``, the mirror ``xi -> -xi`` maps the
+    power at ``w_t`` onto the power at ``-w_t``, and a convex function even in
+    ``w_t`` has its minimum at ``w_t = 0``.
 
-    ``v1 = g10 u0 + g12 u2 - u3 + h1``                     (C, I)
-    ``v2 = g21 u1 + xi (c20 u0 + c22 u2 + ch2)``            (C, J, I)
+    For contact ``c`` (of active ball ``owner[c]``) and point ``(t, i)``
+    (``t`` along the rolling direction, ``i`` across the groove), the
+    tangential sliding velocity, raceway minus ball, is
+
+    ``v1 = A_ci = g10 u0 + g12 u1 - u2 + h1``     along the rolling direction,
+    ``v2 = t S_ci,  S_ci = s0 u0 + s1 u1 + hs``   across the (bent) groove
+
+    (coefficients (C, I)): the contact surface is flat along the rolling
+    direction, so ``v1`` depends on the across position only and ``v2`` is
+    linear in ``xi = t b sqrt(1 - u_i^2)``. ``|v|^2 = A^2 + t^2 S^2``
+    depends on ``t^2`` only: the along nodes ``+t`` and ``-t`` fold into one,
+    and the per-point arrays are (K, C, I) with K the distinct ``t^2``.
 
     Derivation: ``v = W e_z x (c + r) - w_c e_z x c - w x r`` with ``W`` the
     raceway's speed (``omega`` or 0), ``c = R e_r`` the ball centre and ``r``
@@ -583,9 +603,12 @@ class _Contacts:
         geo = self.geometry = geometry
         ls, big_r = geo.length_scale, geo.pitch_radius
         rb, rd, n_r, n_z, ring_speed = geo.rb, geo.rd, geo.n_r, geo.n_z, geo.ring_speed
-        u_nodes = quad.across_nodes
-        theta = geo.a * u_nodes / rd                                    # (C, I)
-        sin_t, cos_t = np.sin(theta), np.cos(theta)
+        u_nodes, t2, weight = quad.across_nodes, quad.along_squared, quad.folded_weight
+        # sin of the angle a u / Rd (C, I), |angle| < pi/2; the nodes u are symmetric and sin is odd
+        n_i, n_neg = u_nodes.size, u_nodes.size // 2
+        sin_pos = np.sin(geo.a * (u_nodes[n_neg:] / rd))
+        sin_t = np.concatenate([-sin_pos[:, n_i - n_neg - 1::-1][:, :n_neg], sin_pos], axis=1)
+        cos_t = np.sqrt(1.0 - sin_t * sin_t)
         # point relative to the ball centre in the ball frame (r, t, z):
         # (rb - Rd + Rd cos) n + Rd sin g + xi t,  g = n x t = (-n_z, 0, n_r)
         rho = rb - rd + rd * cos_t
@@ -594,137 +617,139 @@ class _Contacts:
         t2_r = -cos_t * n_z - sin_t * n_r                                # second tangent cos g - sin n
         t2_z = cos_t * n_r - sin_t * n_z
         #   v . t  = r_z w_r - r_r w_z - R w_c + W (R + r_r)
-        #   v . T2 = -T2_z xi w_r + (T2_z r_r - T2_r r_z) w_t + T2_r xi w_z - W T2_r xi
+        #   v . T2 = xi (-T2_z w_r + T2_r w_z - W T2_r)       (w_t = 0)
+        half = geo.b * np.sqrt(1.0 - u_nodes**2)                        # xi = half * t
         self.g10, self.g12 = r_z / ls, -r_r / ls
-        self.g21 = (t2_z * r_r - t2_r * r_z) / ls
         self.h1 = ring_speed * (big_r + r_r)
-        self.c20, self.c22, self.ch2 = -t2_z / ls, t2_r / ls, -ring_speed * t2_r
-        # lever arm of the moving ring's torque: tangential components of e_z x (c + r)
+        self.s0, self.s1, self.hs = -half * t2_z / ls, half * t2_r / ls, -half * ring_speed * t2_r
+        # lever arm of the moving ring's torque: e_z x (c + r) . v = arm1 v1 + arm2 t^2 S
         self.arm1 = np.where(geo.moving, big_r + r_r, 0.0)
-        self.arm2 = np.where(geo.moving, -t2_r, 0.0)                     # times xi
-        # per-point arrays (C, J, I), in the retained workspace
-        space = _workspace(workspace)
-        shape = (geo.ball_index.size, quad.n_along, quad.n_across)
-        half = (geo.b * np.sqrt(1.0 - u_nodes**2))[:, None, :]
-        self.xi = np.multiply(half, quad.along_nodes[None, :, None], out=space.get("xi", shape))
-        weight = quad.weight.reshape(quad.n_across, quad.n_along).T       # (J, I)
-        self.weight = np.multiply(geo.mu_load[:, None, None], weight, out=space.get("weight", shape))
-        self._v2, self._n2, self._sp, self._t = (space.get(name, shape) for name in ("v2", "n2", "sp", "t"))
-        self._space, self._shape = space, shape
-        self._derivative_arrays = False
+        self.arm2 = np.where(geo.moving, -t2_r * half, 0.0)
+        self.t2 = t2
+        space = self._space = _workspace(workspace)
+        shape = (self.t2.size, geo.ball_index.size, quad.n_across)
+        self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))
+        self._s, self._k, self._k3 = (space.get(name, shape) for name in ("s", "k", "k3"))
+        self._products = None
 
     def _prepare_derivatives(self) -> None:
-        """Arrays needed for gradients and Hessians only (not for the power)."""
-        space, shape = self._space, self._shape
-        self.g20 = np.multiply(self.xi, self.c20[:, None, :], out=space.get("g20", shape))
-        self.g22 = np.multiply(self.xi, self.c22[:, None, :], out=space.get("g22", shape))
-        # across-only coefficients repeated along: contiguous operands are ~3x faster than broadcasting
-        self.g10_full, self.g12_full, self.g21_full = (space.get(name, shape) for name in ("g10", "g12", "g21"))
-        for full, g in ((self.g10_full, self.g10), (self.g12_full, self.g12), (self.g21_full, self.g21)):
-            full[...] = g[:, None, :]
-        self._p1, self._p2, self._norm, self._k = (space.get(name, shape) for name in ("p1", "p2", "norm", "k"))
-        self._z = space.get("z", (shape[0], 4, 2) + shape[1:])
-        self._derivative_arrays = True
+        """Coefficient products of the Hessian (derivatives only)."""
+        g10, g12, s0, s1 = self.g10, self.g12, self.s0, self.s1
+        self._products = (g10 * g10, g10 * g12, g12 * g12, s0 * s0, s0 * s1, s1 * s1,
+                          2.0 * g10 * s0, g10 * s1 + s0 * g12, 2.0 * g12 * s1)
+        self._rows = self._space.get("rows", (15,) + g10.shape)
 
     def velocity(self, u: np.ndarray):
-        """``v1`` (C, I) and ``v2`` (C, J, I) for the scaled unknowns ``u``
-        (B_active, 4). ``v2`` is a work buffer."""
+        """``A`` and ``S`` (C, I) for the scaled unknowns ``u`` (B_active, 3)."""
         uc = u[self.geometry.owner]
-        u0, u1, u2, u3 = (uc[:, k, None] for k in range(4))
-        v1 = self.g10 * u0 + self.g12 * u2 + (self.h1 - u3)
-        slope = self.c20 * u0 + self.c22 * u2 + self.ch2
-        v2 = np.multiply(self.xi, slope[:, None, :], out=self._v2)
-        v2 += (self.g21 * u1)[:, None, :]
-        return v1, v2
+        u0, u1, u2 = uc[:, 0, None], uc[:, 1, None], uc[:, 2, None]
+        return self.g10 * u0 + self.g12 * u1 + (self.h1 - u2), self.s0 * u0 + self.s1 * u1 + self.hs
+
+    def _speed(self, a2, s2, eps2):
+        """``s = sqrt(A^2 + t^2 S^2 + eps^2)`` (K, C, I), in a work buffer."""
+        s = self._s
+        for k, t2 in enumerate(self.t2):
+            np.multiply(s2, t2, out=s[k])
+            s[k] += a2
+        s += eps2
+        np.sqrt(s, out=s)
+        return s
+
+    def _moment(self, x, power):
+        """``sum_K x t^(2 power)`` (C, I)."""
+        out = x[0] * self.t2[0] ** power if power else x[0].copy()
+        for k in range(1, self.t2.size):
+            out += x[k] * self.t2[k] ** power
+        return out
 
     def evaluate(self, u: np.ndarray, eps2: np.ndarray, derivatives: bool = True, majorant: bool = True):
-        """Regularised dissipated power ``D = sum w s``, ``s = sqrt(|v|^2 + eps^2)``,
+        """Regularised dissipated power ``D = sum w s``, ``s = sqrt(A^2 + t^2 S^2 + eps^2)``,
         of every active ball (W); with ``derivatives`` also its gradient
-        (B, 4), its Hessian ``H`` (B, 4, 4) and, with ``majorant``, ``M - H``
+        (B, 3), its Hessian ``H`` (B, 3, 3) and, with ``majorant``, ``M - H``
         where ``M = sum (w/s) G^T G >= H`` is the Hessian of the quadratic
-        majorant of ``D`` at ``u`` (Weiszfeld).
+        majorant of ``D`` at ``u`` (Weiszfeld), ``G`` the rows ``(GA, t GS)``,
+        ``GA = (g10, g12, -1)``, ``GS = (s0, s1, 0)``.
 
-        With ``e = v/|v|``: ``grad = sum w (|v|/s) G^T e``; the Hessian of ``s``
-        in ``v`` is ``e_perp e_perp^T / s + eps^2 e e^T / s^3``, so
-        ``H = sum (w/s) m m^T + (w eps^2/s^3) n n^T`` (``m = G^T e_perp``,
-        ``n = G^T e``) and ``M - H = sum (w |v|^2/s^3) n n^T``."""
+        In ``(A, S)``: ``ds = (A, t^2 S) / s``, and the Hessian of ``s`` is
+        ``diag(1, t^2) / s - (A, t^2 S)(A, t^2 S)^T / s^3``, whose first part is
+        the majorant's. Summed over the points, per (C, I):
+        ``M = alpha GA GA^T + beta GS GS^T`` and
+        ``M - H = e_aa GA GA^T + e_as (GA GS^T + GS GA^T) + e_ss GS GS^T``
+        with ``alpha = sum w/s``, ``beta = sum w t^2/s``, ``e_aa = A^2 sum w/s^3``,
+        ``e_as = A S sum w t^2/s^3``, ``e_ss = S^2 sum w t^4/s^3``."""
         geo = self.geometry
-        v1, v2 = self.velocity(u)
-        n2, sp, t = self._n2, self._sp, self._t
-        np.multiply(v2, v2, out=n2)
-        n2 += (v1 * v1)[:, None, :]
-        np.add(n2, eps2, out=sp)
-        np.sqrt(sp, out=sp)
-        f = geo.sum_matrix @ np.einsum("cji,cji->c", self.weight, sp)
+        a, s_ = self.velocity(u)
+        a2, s2 = a * a, s_ * s_
+        s = self._speed(a2, s2, eps2)
+        ws = np.multiply(self.weight, s, out=self._k)
+        n_i = ws.shape[2]
+        f_c = (ws.reshape(-1, n_i) @ np.ones(n_i)).reshape(ws.shape[:2]).sum(axis=0)   # BLAS: short axis
         if not derivatives:
-            return f, None, None, None
-        if not self._derivative_arrays:
+            return geo.sum_matrix @ f_c, None, None, None
+        if self._products is None:
             self._prepare_derivatives()
-        p1, p2, k, z, norm = self._p1, self._p2, self._k, self._z, self._norm
-        # gradient from the components: G1 = [g10, 0, g12, -1], G2 = [g20, g21, g22, 0]
-        np.divide(self.weight, sp, out=k)                                # w / s
-        np.multiply(k, v1[:, None, :], out=p1)
-        np.multiply(k, v2, out=p2)
-        s1 = p1.sum(axis=1)                                              # (C, I)
-        s2 = p2.sum(axis=1)
-        s2x = np.einsum("cji,cji->ci", p2, self.xi)
-        grad_c = np.stack([np.einsum("ci,ci->c", s1, self.g10) + np.einsum("ci,ci->c", s2x, self.c20),
-                           np.einsum("ci,ci->c", s2, self.g21),
-                           np.einsum("ci,ci->c", s1, self.g12) + np.einsum("ci,ci->c", s2x, self.c22),
-                           -s1.sum(axis=1)], axis=1)
-        grad = geo.sum_matrix @ grad_c
-        # Hessian rows, pre-scaled: sqrt(w/s) m = G^T (-p2, p1) with p = sqrt(w/s) v/|v|
-        np.sqrt(k, out=k)
-        np.add(n2, 1e-300, out=norm)
-        np.sqrt(norm, out=norm)                                          # |v|
-        np.divide(k, norm, out=k)
-        np.multiply(k, v1[:, None, :], out=p1)
-        np.multiply(k, v2, out=p2)
-        across, along = z[:, :, 0], z[:, :, 1]
-        g10, g12, g21 = self.g10_full, self.g12_full, self.g21_full
-        np.multiply(p1, self.g20, out=across[:, 0])
-        across[:, 0] -= np.multiply(p2, g10, out=t)
-        np.multiply(p1, g21, out=across[:, 1])
-        np.multiply(p1, self.g22, out=across[:, 2])
-        across[:, 2] -= np.multiply(p2, g12, out=t)
-        across[:, 3] = p2
-        # n rows: G^T q with q = p |v|/s (the M - H part) or q = p eps/s (the H part)
-        np.divide(norm if majorant else np.sqrt(eps2), sp, out=k)
-        p1 *= k
-        p2 *= k
-        np.multiply(p1, g10, out=along[:, 0])
-        along[:, 0] += np.multiply(p2, self.g20, out=t)
-        np.multiply(p2, g21, out=along[:, 1])
-        np.multiply(p1, g12, out=along[:, 2])
-        along[:, 2] += np.multiply(p2, self.g22, out=t)
-        np.negative(p1, out=along[:, 3])
-        flat = z.reshape(z.shape[0], 4, -1)
-        extra = None
-        if majorant:
-            half = flat.shape[2] // 2
-            extra_c = np.matmul(flat[:, :, half:], flat[:, :, half:].transpose(0, 2, 1))
-            extra = (geo.sum_matrix @ extra_c.reshape(-1, 16)).reshape(-1, 4, 4)
-            np.divide(np.sqrt(eps2), norm, out=k)                        # rescale to q = p eps/s
-            along *= k[:, None]
-        hess_c = np.matmul(flat, flat.transpose(0, 2, 1))
-        hess = (geo.sum_matrix @ hess_c.reshape(-1, 16)).reshape(-1, 4, 4)
-        return f, grad, hess, extra
+        p00, p01, p11, q00, q01, q11, x00, x01, x11 = self._products
+        g10, g12, s0, s1 = self.g10, self.g12, self.s0, self.s1
+        k, k3 = self._k, self._k3
+        np.divide(self.weight, s, out=k)                                 # w / s
+        alpha, beta = self._moment(k, 0), self._moment(k, 1)
+        rows = self._rows
+        # gradient: dD/dA = alpha A, dD/dS = beta S
+        ga, gs = alpha * a, beta * s_
+        np.multiply(ga, g10, out=rows[0])
+        rows[0] += gs * s0
+        np.multiply(ga, g12, out=rows[1])
+        rows[1] += gs * s1
+        np.negative(ga, out=rows[2])
+        # majorant M: entries 00, 01, 02, 11, 12, 22
+        np.multiply(alpha, p00, out=rows[3])
+        rows[3] += beta * q00
+        np.multiply(alpha, p01, out=rows[4])
+        rows[4] += beta * q01
+        np.multiply(alpha, -g10, out=rows[5])
+        np.multiply(alpha, p11, out=rows[6])
+        rows[6] += beta * q11
+        np.multiply(alpha, -g12, out=rows[7])
+        rows[8] = alpha
+        np.divide(k, s, out=k3)
+        k3 /= s                                                      # w / s^3
+        e_aa = a2 * self._moment(k3, 0)
+        e_as = a * s_ * self._moment(k3, 1)
+        e_ss = s2 * self._moment(k3, 2)
+        np.multiply(e_aa, p00, out=rows[9])
+        rows[9] += e_as * x00
+        rows[9] += e_ss * q00
+        np.multiply(e_aa, p01, out=rows[10])
+        rows[10] += e_as * x01
+        rows[10] += e_ss * q01
+        np.multiply(e_aa, g10, out=rows[11])
+        rows[11] += e_as * s0
+        np.negative(rows[11], out=rows[11])
+        np.multiply(e_aa, p11, out=rows[12])
+        rows[12] += e_as * x11
+        rows[12] += e_ss * q11
+        np.multiply(e_aa, g12, out=rows[13])
+        rows[13] += e_as * s1
+        np.negative(rows[13], out=rows[13])
+        rows[14] = e_aa
+        sums = (rows.reshape(-1, n_i) @ np.ones(n_i)).reshape(15, -1) @ geo.sum_matrix.T   # (rows, B)
+        grad = sums[:3].T
+        sym = [0, 1, 2, 1, 3, 4, 2, 4, 5]
+        m = sums[3:9].T[:, sym].reshape(-1, 3, 3)
+        extra = sums[9:15].T[:, sym].reshape(-1, 3, 3)
+        return geo.sum_matrix @ f_c, grad, m - extra, (extra if majorant else None)
 
     def tractions(self, u: np.ndarray):
         """Dissipated power (W) and torque on the moving ring about +z (N m) of
         every contact, at the final regularisation."""
-        v1, v2 = self.velocity(u)
-        n2 = np.multiply(v2, v2, out=self._n2)
-        n2 += (v1 * v1)[:, None, :]
-        scale = np.add(n2, self.geometry.eps2, out=self._sp)
-        np.sqrt(scale, out=scale)
-        np.divide(self.weight, scale, out=scale)                         # |traction on the ball| / |v|
-        power = np.einsum("cji,cji->c", scale, n2)
-        # the traction on the ring is minus that on the ball; arm . v = arm1 v1 + arm2 xi v2
-        lever = np.multiply(self.xi, v2, out=self._t)
-        lever *= self.arm2[:, None, :]
-        lever += (self.arm1 * v1)[:, None, :]
-        torque = -np.einsum("cji,cji->c", scale, lever)
+        a, s_ = self.velocity(u)
+        a2, s2 = a * a, s_ * s_
+        s = self._speed(a2, s2, self.geometry.eps2)
+        k = np.divide(self.weight, s, out=self._k)                       # |traction on the ball| / |v|
+        ga, gs = self._moment(k, 0) * a, self._moment(k, 1) * s_         # tractions . (A, S) directions
+        power = np.einsum("ci,ci->c", ga, a) + np.einsum("ci,ci->c", gs, s_)
+        # the traction on the ring is minus that on the ball
+        torque = -(np.einsum("ci,ci->c", ga, self.arm1) + np.einsum("ci,ci->c", gs, self.arm2))
         return power, torque
 
 
@@ -740,7 +765,8 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     quadratically near the minimum. ``theta`` starts at 1 for the balls marked
     ``safe`` (0 for the others), shrinks after each step that lowers the power
     by at least half the predicted amount, and grows for a ball whose step
-    fails (the step is then retried at once).
+    fails (the step is then retried at once). Every trial point is evaluated
+    with its derivatives, so an accepted step costs one evaluation.
 
     ``levels``: continuation in the regularisation, e.g. ``(100, 10)``: one
     step with ``eps`` 100 times, then one with 10 times the final one, then the
@@ -755,76 +781,61 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     schedule = [float(x) for x in levels] + [1.0]
     level = 0
     eps2 = contacts.geometry.eps2 * schedule[0] ** 2
-    n = u.shape[0]
+    n, m = u.shape
     theta = np.where(safe, _THETA_COLD, 0.0)
-    f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta > 0.0)))
+    f, g, h, extra = contacts.evaluate(u, eps2)
     scale = contacts.geometry.force_scale
-    eye = np.eye(4)
+    regular = 1e-13 * np.eye(m)
     iterations = 0
 
     def solve(a, rhs):
-        d = np.maximum(np.einsum("bii->b", a) / 4.0, 1e-300)
-        return np.linalg.solve(a + (1e-13 * d)[:, None, None] * eye, rhs[..., None])[..., 0]
+        d = np.maximum(np.einsum("bii->b", a) / m, 1e-300)
+        return np.linalg.solve(a + d[:, None, None] * regular, rhs[..., None])[..., 0]
 
-    def step(mask):
-        nonlocal h, extra
-        if not np.any(theta[mask] > 0.0):
-            return solve(h[mask], -g[mask])
-        if extra is None:
-            _, _, h, extra = contacts.evaluate(u, eps2, majorant=True)
-        return solve(h[mask] + theta[mask, None, None] * extra[mask], -g[mask])
+    def decrease(du):
+        slope = np.einsum("bk,bk->b", g, du)
+        return slope, -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
+
+    def residual():
+        return float(np.max(np.abs(g).max(axis=1) / scale))
 
     while True:
         final = level == len(schedule) - 1
-        residual = float(np.max(np.abs(g).max(axis=1) / scale))
+        newton = None
         if final:
             newton = solve(h, -g)
             if np.all(-np.einsum("bk,bk->b", g, newton) <= 2.0 * tol * f):
                 trial = u + newton
                 keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
-                return np.where(keep[:, None], trial, u), iterations + 1, residual, True
+                return np.where(keep[:, None], trial, u), iterations + 1, residual(), True
         if iterations >= max_iterations:
-            return u, iterations, residual, False
+            return u, iterations, residual(), False
         iterations += 1
-        du = step(np.ones(n, dtype=bool))
-        slope = np.einsum("bk,bk->b", g, du)
-        predicted = -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
-        accepted = np.zeros(n, dtype=bool)
+        du = newton if newton is not None and not np.any(theta) else solve(h + theta[:, None, None] * extra, -g)
+        slope, predicted = decrease(du)
         trial = u + du
-        f_t = f.copy()
-        fresh = None
-        for attempt in range(12):
-            derivatives = final and attempt == 0
-            f_new, g_t, h_t, x_t = contacts.evaluate(trial, eps2, derivatives=derivatives,
-                                                     majorant=bool(np.any(theta > 0.0)))
-            if derivatives:
-                fresh = (g_t, h_t, x_t)
-            actual = f - f_new
-            good = ~accepted & ((actual >= -1e-4 * slope) | (np.abs(actual) <= 1e-13 * np.abs(f)))
+        pending = np.ones(n, dtype=bool)
+        for _ in range(12):
+            f_t, g_t, h_t, x_t = contacts.evaluate(trial, eps2)
+            actual = f - f_t
+            good = pending & ((actual >= -1e-4 * slope) | (np.abs(actual) <= 1e-13 * np.abs(f)))
             very = good & (actual >= 0.5 * predicted)
             theta = np.where(very, np.where(theta > 1e-3, _THETA_DOWN * theta, 0.0), theta)
-            f_t = np.where(good, f_new, f_t)
-            accepted |= good
-            if np.all(accepted):
+            pending &= ~good
+            if not np.any(pending) or np.all(theta[pending] >= 1.0):   # done, or Weiszfeld failed: round-off
                 break
-            bad = ~accepted
-            if np.all(theta[bad] >= 1.0):        # the Weiszfeld step failed: round-off, stop there
-                trial[bad], f_t[bad] = u[bad], f[bad]
-                break
-            theta[bad] = np.minimum(1.0, np.maximum(_THETA_UP * theta[bad], _THETA_MIN_UP))
-            du[bad] = step(bad)
-            slope = np.einsum("bk,bk->b", g, du)
-            predicted = -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
-            trial[bad] = u[bad] + du[bad]
-        reuse = fresh is not None and attempt == 0
-        u = trial
+            theta[pending] = np.minimum(1.0, np.maximum(_THETA_UP * theta[pending], _THETA_MIN_UP))
+            du[pending] = solve(h[pending] + theta[pending, None, None] * extra[pending], -g[pending])
+            slope, predicted = decrease(du)
+            trial[pending] = u[pending] + du[pending]
+        if np.any(pending):                       # no step lowered their power: those balls stay
+            trial[pending] = u[pending]
+            f_t[pending], g_t[pending], h_t[pending], x_t[pending] = f[pending], g[pending], h[pending], extra[pending]
+        u, f, g, h, extra = trial, f_t, g_t, h_t, x_t
         if not final:
             level += 1
             eps2 = contacts.geometry.eps2 * schedule[level] ** 2
-        if reuse:
-            f, (g, h, extra) = f_t, fresh
-        else:
-            f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta > 0.0)))
+            f, g, h, extra = contacts.evaluate(u, eps2)
 
 
 def _check_number(name: str, value, minimum: float | None = None, strict: bool = False) -> float:
@@ -909,11 +920,11 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     geometry = _ContactSet(bearing, distribution, mu, speed, sliding_regularisation)
     n_balls = bearing.ball_count
     ls, big_r = geometry.length_scale, geometry.pitch_radius
-    scale_u = np.array([ls, ls, ls, big_r])
+    scale_u = np.array([ls, ls, big_r])                # solved: r w_r, r w_z, R w_c (w_t = 0)
     active = geometry.active
 
     iterations, residual, converged = 0, 0.0, True
-    u = np.zeros((active.size, 4))
+    u = np.zeros((active.size, 3))
     if active.size and mu > 0.0:
         contacts = _Contacts(geometry, quad)
         same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
@@ -923,7 +934,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
             state = initial.state if isinstance(initial, FrictionTorque) else np.asarray(initial, dtype=float)
             if state.shape != (n_balls, 4):
                 raise ValueError(f"initial: state of shape {state.shape}, expected ({n_balls}, 4) for this bearing")
-            u = state[active] * speed * scale_u
+            u = state[active][:, _SOLVED] * speed * scale_u
             cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
         if np.any(cold):
             u[cold] = geometry.initial_guess()[cold]
@@ -945,9 +956,9 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     orbital = np.zeros(n_balls)
     state = np.zeros((n_balls, 4))
     if active.size:
-        omega_ball[active] = u[:, :3] / ls
-        orbital[active] = u[:, 3] / big_r
-        state[active] = u / (speed * scale_u)
+        omega_ball[active[:, None], [0, 2]] = u[:, :2] / ls
+        orbital[active] = u[:, 2] / big_r
+        state[active[:, None], _SOLVED] = u / (speed * scale_u)
     if geometry.inactive.size:       # unloaded balls: nominal rolling, for the record
         from .assembly import cage_ratio
         orbital[geometry.inactive] = cage_ratio(bearing) * speed
@@ -967,7 +978,8 @@ def _spin_roll_ratio(geometry: _ContactSet, u: np.ndarray, n_balls: int) -> np.n
     out = np.zeros((n_balls, 4))
     if not geometry.active.size:
         return out
-    rel = -u[geometry.owner, :3] / geometry.length_scale          # raceway minus ball: W e_z - w
+    rel = np.zeros((geometry.ball_index.size, 3))                 # raceway minus ball: W e_z - w
+    rel[:, [0, 2]] = -u[geometry.owner, :2] / geometry.length_scale
     rel[:, 2] += geometry.ring_speed[:, 0]
     n_r, n_z = geometry.normal[:, 0], geometry.normal[:, 1]
     spin = rel[:, 0] * n_r + rel[:, 2] * n_z
