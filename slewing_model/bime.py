@@ -606,6 +606,10 @@ class BimeSolver:
         cached = self._reduced
         if not fresh and cached is not None and not np.array_equal(cached[0], idx):
             cached = self._update_reduced(cached, p, idx, active, mu)
+        if not fresh and cached is not None and not np.array_equal(cached[4], self.jacobian.reshape(-1, 5)[idx]):
+            # the ring turned since (set_rotation): W^-1 holds (the rings are axisymmetric and
+            # the balls keep their spacing), the coupling to (X, Y, Z, rx, ry) is rebuilt
+            cached = self._reduced_operator(idx, active, *cached[2:4], mu)
         if fresh or cached is None:
             a_inv = self._contact_compliance_blocks(p, active)
             w_mat = self.compliance[np.ix_(idx, idx)]         # (A^-1 + M)_aa

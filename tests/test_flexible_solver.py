@@ -68,3 +68,38 @@ def test_warm_start_reaches_the_cold_solution(bearing):
     warm = solver.solve(changed, initial=first)
     cold = solver.solve(changed)
     assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
+
+
+def test_operator_reused_across_a_rotation_reaches_the_cold_solution(bearing):
+    # after set_rotation the kept ring operator W^-1 is reused with the new Jacobian (the rings
+    # are axisymmetric): the warm solve must land on the cold solution at the new angle
+    from slewing_model import synthetic_errors
+
+    with_errors = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=4))
+    solver = BimeSolver(with_errors, synthetic_superelement(bearing.ball_count), rtol=1e-10)
+    previous = solver.solve(LOADS[1])
+    for psi in (0.01, 0.02, 0.5):
+        solver.set_rotation(psi)
+        warm = solver.solve(LOADS[1], initial=previous)
+        cold = BimeSolver(with_errors, synthetic_superelement(bearing.ball_count), psi=psi, rtol=1e-10).solve(LOADS[1])
+        assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
+        assert np.allclose(warm.displacement, cold.displacement, rtol=1e-8, atol=1e-14)
+        previous = warm
+
+
+def test_simulator_extrapolated_start_reaches_the_cold_solution(bearing):
+    # the simulator starts each solve from the last two states extrapolated: every step must
+    # still be the equilibrium of its own inputs, whatever the history
+    from slewing_model import synthetic_errors
+    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+
+    with_errors = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=4))
+    se = synthetic_superelement(bearing.ball_count)
+    sim = BearingSimulator(with_errors, se, SimulatorSettings(ring_model="flexible", friction_coefficient=0.0,
+                                                              tolerance=1e-10))
+    steps = [(Loads(Fz=5e4 + 1e3 * k, Mx=2e3 * k), 0.01 * k) for k in range(6)]
+    steps.append((Loads(Fx=-2e4, Fz=1e4, My=-1e4), 0.2))         # a jump: the extrapolation is poor here
+    for loads, psi in steps:
+        r = sim.step(loads, psi=psi, omega=0.1).distribution
+        cold = BimeSolver(sim.bearing, se, psi=psi, rtol=1e-10).solve(loads)
+        assert np.allclose(r.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
