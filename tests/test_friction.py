@@ -372,6 +372,16 @@ def test_warm_start_gives_the_same_torque_in_fewer_iterations(combined):
     assert warm.iterations < again.iterations
 
 
+@pytest.mark.parametrize("tol", [1e-3, 1e-4])
+def test_tolerance_bounds_the_torque_error_from_above(combined, preloaded, tol):
+    # the solve stops when the power is within tol of its minimum: the torque (power / speed)
+    # is then above the exact one by at most tol (the simulator uses 1e-4)
+    for bearing, dist in (combined, preloaded):
+        exact = friction_torque(bearing, dist, solve_quadrature=None, tol=1e-12).contact_part
+        loose = friction_torque(bearing, dist, solve_quadrature=None, tol=tol).contact_part
+        assert exact * (1 - 1e-12) <= loose <= exact * (1 + tol)
+
+
 def test_bad_input_is_refused_naming_the_field(axial):
     bearing, dist = axial
     for kwargs, field in ((dict(mu=-0.1), "mu"), (dict(omega=float("nan")), "omega"),
