@@ -72,8 +72,6 @@ DEFAULT_SOLVE_QUADRATURE = (12, 2)
 DEFAULT_SLIDING_REGULARISATION = 1e-3
 #: Default speed scale of the regularised Coulomb law near omega = 0, rad/s
 DEFAULT_OMEGA_REGULARISATION = 1e-4
-#: Regularisation continuation of a cold start (multiples of the final eps)
-SOLVE_LEVELS = ()
 
 #: sign of the (r, z) components of the contact normals of contacts 1..4
 #: (as :attr:`slewing_model.geometry.Bearing.contact_normals`)
@@ -548,27 +546,54 @@ class _ContactSet:
         self.contact_angle = arrays["contact_angle"]
         self.moving_ring = bearing.moving_ring
 
-    def initial_guess(self) -> np.ndarray:
-        """Scaled unknowns (B_active, 3) for a cold start: for each diagonal,
-        rolling without sliding at its two contact centres about an axis normal
-        to it (the classical two-contact kinematics); the two diagonals blended
-        in proportion to their loads."""
+    def initial_guesses(self) -> np.ndarray:
+        """Candidate scaled unknowns (2, B_active, 3) for a cold start, each a
+        rolling motion without sliding at contact centres:
+
+        0. about an axis normal to the more loaded diagonal, rolling at its two
+           contact centres (the classical two-contact kinematics);
+        1. about the axial direction (``w_r = 0``), rolling at the centres of
+           the outer and of the inner contacts (the motion of a symmetric
+           four-contact ball; measured, it stays near the equilibrium until one
+           diagonal carries about ten times the other).
+
+        For a ball with one loaded diagonal both are the first. (A blend of
+        the two diagonals' motions in proportion to their loads, tried too,
+        was slower overall.)"""
         q = self.contact_load[self.active]
         alpha = self.contact_angle[self.active]
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
         w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
-        guess = np.zeros((self.active.size, 3))
-        total = np.zeros(self.active.size)
+        diagonals = []
         for outer, sign in ((0, 1.0), (3, -1.0)):          # diagonal 1 (contacts 1, 3), diagonal 2 (4, 2)
             n_r, n_z = np.cos(alpha[:, outer]), sign * np.sin(alpha[:, outer])
             # v . t = 0 at the outer contact (normal n) and at the inner one (-n), w = w_g g, g = (-n_z, 0, n_r)
             w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
             w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
-            diag = np.stack([-w_g * n_z * ls, w_g * n_r * ls, w_c * big_r], axis=-1)
-            guess += q[:, outer, None] * diag
-            total += q[:, outer]
-        return guess / total[:, None]
+            diagonals.append(np.stack([-w_g * n_z * ls, w_g * n_r * ls, w_c * big_r], axis=-1))
+        q1, q2 = q[:, 0], q[:, 1]
+        heavier = np.where((q1 >= q2)[:, None], diagonals[0], diagonals[1])
+        # v . t = -r_r w_z - R w_c + W (R + r_r) = 0 at the outer (r_r > 0) and inner (r_r < 0) centres
+        r_o = rb * 0.5 * (np.cos(alpha[:, 0]) + np.cos(alpha[:, 3]))
+        r_i = -rb * 0.5 * (np.cos(alpha[:, 1]) + np.cos(alpha[:, 2]))
+        w_z = (w_i * (big_r + r_i) - w_o * (big_r + r_o)) / (r_i - r_o)
+        w_c = (w_o * (big_r + r_o) - r_o * w_z) / big_r
+        axial = np.stack([np.zeros_like(w_z), w_z * ls, w_c * big_r], axis=-1)
+        four = ((q1 > 0.0) & (q2 > 0.0))[:, None]
+        return np.stack([heavier, np.where(four, axial, heavier)])
+
+
+@dataclass(frozen=True)
+class _SubSet:
+    """What :class:`_Contacts` and :func:`_minimise` use of a :class:`_ContactSet`,
+    for some of its balls (:meth:`_Contacts.subset`)."""
+
+    owner: np.ndarray
+    sum_matrix: np.ndarray
+    eps2: np.ndarray
+    force_scale: np.ndarray
+    active: np.ndarray
 
 
 class _Contacts:
@@ -638,6 +663,27 @@ class _Contacts:
         self._products = (g10 * g10, g10 * g12, g12 * g12, s0 * s0, s0 * s1, s1 * s1,
                           2.0 * g10 * s0, g10 * s1 + s0 * g12, 2.0 * g12 * s1)
         self._rows = self._space.get("rows", (15,) + g10.shape)
+
+    def subset(self, balls: np.ndarray) -> "_Contacts":
+        """The same rule restricted to the contacts of some active balls
+        (their rows, in order): for the last iterations of a few balls."""
+        geo = self.geometry
+        rows = np.flatnonzero(np.isin(geo.owner, balls))
+        position = np.full(geo.active.size, -1)
+        position[balls] = np.arange(balls.size)
+        owner = position[geo.owner[rows]]
+        sum_matrix = np.zeros((balls.size, rows.size))
+        sum_matrix[owner, np.arange(rows.size)] = 1.0
+        sub = object.__new__(_Contacts)
+        sub.geometry = _SubSet(owner=owner, sum_matrix=sum_matrix, eps2=geo.eps2[rows],
+                               force_scale=geo.force_scale[balls], active=geo.active[balls])
+        for name in ("g10", "g12", "h1", "s0", "s1", "hs", "arm1", "arm2"):
+            setattr(sub, name, getattr(self, name)[rows])
+        sub.t2, sub.weight = self.t2, self.weight[:, rows]
+        sub._s, sub._k, sub._k3 = (np.empty_like(sub.weight) for _ in range(3))
+        sub._products = None
+        sub._space = _Workspace()
+        return sub
 
     def velocity(self, u: np.ndarray):
         """``A`` and ``S`` (C, I) for the scaled unknowns ``u`` (B_active, 3)."""
@@ -753,8 +799,7 @@ class _Contacts:
         return power, torque
 
 
-def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int, safe: np.ndarray,
-              levels=()):
+def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int, theta: np.ndarray):
     """Minimise the regularised dissipated power of every active ball (batched).
 
     Step ``du = -(H + theta (M - H))^-1 g`` per ball: ``theta = 1`` is the
@@ -762,27 +807,23 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     power however far from the minimum, where Newton's step (``theta = 0``)
     can overshoot by orders of magnitude (the power is nearly linear in some
     directions when every point slides); ``theta = 0`` converges
-    quadratically near the minimum. ``theta`` starts at 1 for the balls marked
-    ``safe`` (0 for the others), shrinks after each step that lowers the power
-    by at least half the predicted amount, and grows for a ball whose step
-    fails (the step is then retried at once). Every trial point is evaluated
-    with its derivatives, so an accepted step costs one evaluation.
-
-    ``levels``: continuation in the regularisation, e.g. ``(100, 10)``: one
-    step with ``eps`` 100 times, then one with 10 times the final one, then the
-    final ``eps``.
+    quadratically near the minimum. ``theta`` (B,) starts as given (1 for a
+    cold start, 0 for a warm one), shrinks after each step that lowers the
+    power by at least half the predicted amount, and grows for a ball whose
+    step fails (the step is then retried at once). Every trial point is
+    evaluated with its derivatives, so an accepted step costs one evaluation.
 
     Stopping rule: the Newton decrement ``g . H^-1 g`` of every ball is at
     most ``2 tol`` times its power (the power is then within ``tol`` of its
-    minimum); that last Newton step is taken where it lowers the power.
+    minimum); that last Newton step is taken where it lowers the power. When
+    at most a quarter of the balls are left after three iterations, they go on
+    alone (:meth:`_Contacts.subset`), the others take that last step.
 
     Returns ``(u, iterations, residual, converged)``; ``residual``: the largest
     force residual of a ball, relative to ``mu Q_max``, at the last evaluation."""
-    schedule = [float(x) for x in levels] + [1.0]
-    level = 0
-    eps2 = contacts.geometry.eps2 * schedule[0] ** 2
+    eps2 = contacts.geometry.eps2
     n, m = u.shape
-    theta = np.where(safe, _THETA_COLD, 0.0)
+    theta = np.array(theta, dtype=float)
     f, g, h, extra = contacts.evaluate(u, eps2)
     scale = contacts.geometry.force_scale
     regular = 1e-13 * np.eye(m)
@@ -800,18 +841,25 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
         return float(np.max(np.abs(g).max(axis=1) / scale))
 
     while True:
-        final = level == len(schedule) - 1
-        newton = None
-        if final:
-            newton = solve(h, -g)
-            if np.all(-np.einsum("bk,bk->b", g, newton) <= 2.0 * tol * f):
-                trial = u + newton
-                keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
-                return np.where(keep[:, None], trial, u), iterations + 1, residual(), True
+        newton = solve(h, -g)
+        done = -np.einsum("bk,bk->b", g, newton) <= 2.0 * tol * f
+        if np.all(done):
+            trial = u + newton
+            keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
+            return np.where(keep[:, None], trial, u), iterations + 1, residual(), True
         if iterations >= max_iterations:
             return u, iterations, residual(), False
+        left = np.flatnonzero(~done)
+        if iterations >= 3 and n >= 8 and 4 * left.size <= n:   # a long tail: the stragglers alone
+            res_done = float(np.max(np.abs(g[done]).max(axis=1) / scale[done]))
+            trial = np.where(done[:, None], u + newton, u)          # the last Newton step of the others
+            keep = done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
+            u = np.where(keep[:, None], trial, u)
+            u[left], more, res_left, converged = _minimise(contacts.subset(left), u[left], tol,
+                                                           max_iterations - iterations, theta[left])
+            return u, iterations + more, max(res_done, res_left), converged
         iterations += 1
-        du = newton if newton is not None and not np.any(theta) else solve(h + theta[:, None, None] * extra, -g)
+        du = newton if not np.any(theta) else solve(h + theta[:, None, None] * extra, -g)
         slope, predicted = decrease(du)
         trial = u + du
         pending = np.ones(n, dtype=bool)
@@ -832,10 +880,6 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
             trial[pending] = u[pending]
             f_t[pending], g_t[pending], h_t[pending], x_t[pending] = f[pending], g[pending], h[pending], extra[pending]
         u, f, g, h, extra = trial, f_t, g_t, h_t, x_t
-        if not final:
-            level += 1
-            eps2 = contacts.geometry.eps2 * schedule[level] ** 2
-            f, g, h, extra = contacts.evaluate(u, eps2)
 
 
 def _check_number(name: str, value, minimum: float | None = None, strict: bool = False) -> float:
@@ -937,10 +981,13 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
             u = state[active][:, _SOLVED] * speed * scale_u
             cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
         if np.any(cold):
-            u[cold] = geometry.initial_guess()[cold]
-        # cold balls: Weiszfeld-safe steps, and a regularisation continuation when all are cold
-        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations, safe=cold,
-                                                       levels=SOLVE_LEVELS if np.all(cold) else ())
+            # the candidate motion of least power, per ball
+            candidates = geometry.initial_guesses()
+            power = np.stack([solver.evaluate(c, geometry.eps2, derivatives=False)[0] for c in candidates])
+            u[cold] = np.take_along_axis(candidates, np.argmin(power, axis=0)[None, :, None], axis=0)[0][cold]
+        # cold balls start with Weiszfeld-safe steps
+        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations,
+                                                       theta=np.where(cold, _THETA_COLD, 0.0))
         power_c, torque_c = contacts.tractions(u)
     else:
         power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0

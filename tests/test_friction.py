@@ -420,7 +420,7 @@ def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
     geo = _ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
     contacts = _Contacts(geo, ellipse_quadrature(12, 2), workspace="test")
     rng = np.random.default_rng(5)
-    u = geo.initial_guess() * (1 + 0.01 * rng.standard_normal((geo.active.size, 3)))
+    u = geo.initial_guesses()[0] * (1 + 0.01 * rng.standard_normal((geo.active.size, 3)))
     eps2 = geo.eps2 * 100
     f, g, h, extra = contacts.evaluate(u, eps2)
     step = 1e-7 * np.abs(u).max()
@@ -437,3 +437,18 @@ def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
         du = 1e-2 * np.abs(u).max() * rng.standard_normal(u.shape)
         bound = f + np.einsum("bk,bk->b", g, du) + 0.5 * np.einsum("bk,bkl,bl->b", du, h + extra, du)
         assert np.all(contacts.evaluate(u + du, eps2, derivatives=False)[0] <= bound * (1 + 1e-12))
+
+
+def test_subset_of_balls_evaluates_as_the_whole(combined):
+    # the last iterations of a few balls run on their own contacts: same power, gradient, Hessians
+    from slewing_model.friction import _Contacts, _ContactSet
+
+    bearing, dist = combined
+    geo = _ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
+    contacts = _Contacts(geo, ellipse_quadrature(12, 2), workspace="test")
+    u = geo.initial_guesses()[1]
+    balls = np.array([0, 5, geo.active.size - 1])
+    whole = contacts.evaluate(u, geo.eps2)
+    part = contacts.subset(balls).evaluate(u[balls], geo.eps2[np.isin(geo.owner, balls)])
+    for w, p in zip(whole, part):
+        assert np.allclose(p, w[balls], rtol=1e-13, atol=0.0)
