@@ -1,6 +1,6 @@
 """The bearing FMU through fmpy: instantiation time, doStep time, memory over many steps.
 
-table3 with synthetic errors, flexible rings (coarse superelement), friction on; a slowly
+table3 with synthetic errors, flexible rings (fine superelement, the build default), friction on; a slowly
 varying load and a turning ring (Fz ramp with a moment, psi at 0.5 rad/s). The rigid
 model is measured in the same run as the baseline.
 

@@ -747,36 +747,25 @@ class _Contacts:
         np.multiply(ga, g12, out=rows[1])
         rows[1] += gs * s1
         np.negative(ga, out=rows[2])
-        # majorant M: entries 00, 01, 02, 11, 12, 22
-        np.multiply(alpha, p00, out=rows[3])
-        rows[3] += beta * q00
-        np.multiply(alpha, p01, out=rows[4])
-        rows[4] += beta * q01
-        np.multiply(alpha, -g10, out=rows[5])
-        np.multiply(alpha, p11, out=rows[6])
-        rows[6] += beta * q11
-        np.multiply(alpha, -g12, out=rows[7])
-        rows[8] = alpha
         np.divide(k, s, out=k3)
-        k3 /= s                                                      # w / s^3
+        k3 /= s                                                          # w / s^3
         e_aa = a2 * self._moment(k3, 0)
         e_as = a * s_ * self._moment(k3, 1)
         e_ss = s2 * self._moment(k3, 2)
-        np.multiply(e_aa, p00, out=rows[9])
-        rows[9] += e_as * x00
-        rows[9] += e_ss * q00
-        np.multiply(e_aa, p01, out=rows[10])
-        rows[10] += e_as * x01
-        rows[10] += e_ss * q01
-        np.multiply(e_aa, g10, out=rows[11])
-        rows[11] += e_as * s0
-        np.negative(rows[11], out=rows[11])
-        np.multiply(e_aa, p11, out=rows[12])
-        rows[12] += e_as * x11
-        rows[12] += e_ss * q11
-        np.multiply(e_aa, g12, out=rows[13])
-        rows[13] += e_as * s1
-        np.negative(rows[13], out=rows[13])
+        # rows 3..8: entries 00, 01, 02, 11, 12, 22 of M; rows 9..14: the same of M - H
+        for m_row, e_row, paa, pas, pss in ((3, 9, p00, x00, q00), (4, 10, p01, x01, q01), (6, 12, p11, x11, q11)):
+            np.multiply(alpha, paa, out=rows[m_row])
+            rows[m_row] += beta * pss
+            np.multiply(e_aa, paa, out=rows[e_row])
+            rows[e_row] += e_as * pas
+            rows[e_row] += e_ss * pss
+        for m_row, e_row, ga_k, gs_k in ((5, 11, g10, s0), (7, 13, g12, s1)):   # GA_2 = -1, GS_2 = 0
+            np.multiply(alpha, ga_k, out=rows[m_row])
+            np.negative(rows[m_row], out=rows[m_row])
+            np.multiply(e_aa, ga_k, out=rows[e_row])
+            rows[e_row] += e_as * gs_k
+            np.negative(rows[e_row], out=rows[e_row])
+        rows[8] = alpha
         rows[14] = e_aa
         sums = (rows.reshape(-1, n_i) @ np.ones(n_i)).reshape(15, -1) @ geo.sum_matrix.T   # (rows, B)
         grad = sums[:3].T
