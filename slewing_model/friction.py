@@ -708,10 +708,10 @@ class _Contacts:
             out += x[k] * self.t2[k] ** power
         return out
 
-    def evaluate(self, u: np.ndarray, eps2: np.ndarray, derivatives: bool = True, majorant: bool = True):
+    def evaluate(self, u: np.ndarray, eps2: np.ndarray, derivatives: bool = True):
         """Regularised dissipated power ``D = sum w s``, ``s = sqrt(A^2 + t^2 S^2 + eps^2)``,
         of every active ball (W); with ``derivatives`` also its gradient
-        (B, 3), its Hessian ``H`` (B, 3, 3) and, with ``majorant``, ``M - H``
+        (B, 3), its Hessian ``H`` (B, 3, 3) and ``M - H``
         where ``M = sum (w/s) G^T G >= H`` is the Hessian of the quadratic
         majorant of ``D`` at ``u`` (Weiszfeld), ``G`` the rows ``(GA, t GS)``,
         ``GA = (g10, g12, -1)``, ``GS = (s0, s1, 0)``.
@@ -772,7 +772,7 @@ class _Contacts:
         sym = [0, 1, 2, 1, 3, 4, 2, 4, 5]
         m = sums[3:9].T[:, sym].reshape(-1, 3, 3)
         extra = sums[9:15].T[:, sym].reshape(-1, 3, 3)
-        return geo.sum_matrix @ f_c, grad, m - extra, (extra if majorant else None)
+        return geo.sum_matrix @ f_c, grad, m - extra, extra
 
     def tractions(self, u: np.ndarray):
         """Dissipated power (W) and torque on the moving ring about +z (N m) of
