@@ -83,7 +83,8 @@ _IS_MOVING = {ring: np.isin(np.arange(4), [c - 1 for c in RING_CONTACTS[ring]]) 
 _SOLVED = [0, 2, 3]
 #: damping schedule of the Newton / Weiszfeld blend (see _minimise)
 _THETA_DOWN, _THETA_UP, _THETA_MIN_UP = 0.2, 10.0, 0.1
-_THETA_COLD = 1.0
+#: step lengths along the first Newton direction of a cold start (see _cold_start)
+_COLD_STEPS = (0.25, 0.5)
 
 
 # ---- quadrature over the Hertz ellipse -------------------------------------------------
@@ -655,6 +656,7 @@ class _Contacts:
         shape = (self.t2.size, geo.ball_index.size, quad.n_across)
         self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))
         self._s, self._k, self._k3 = (space.get(name, shape) for name in ("s", "k", "k3"))
+        self._ones = np.ones(quad.n_across)
         self._products = None
 
     def _prepare_derivatives(self) -> None:
@@ -682,6 +684,7 @@ class _Contacts:
         sub.t2, sub.weight = self.t2, self.weight[:, rows]
         sub._s, sub._k, sub._k3 = (np.empty_like(sub.weight) for _ in range(3))
         sub._products = None
+        sub._ones = self._ones
         sub._space = _Workspace()
         return sub
 
@@ -702,19 +705,21 @@ class _Contacts:
         return s
 
     def _moment(self, x, power):
-        """``sum_K x t^(2 power)`` (C, I)."""
-        out = x[0] * self.t2[0] ** power if power else x[0].copy()
+        """``sum_K x t^(2 power)`` (C, I); with one ``t^2`` and ``power = 0``, a view of ``x[0]``."""
+        if self.t2.size == 1:
+            return x[0] * self.t2[0] ** power if power else x[0]
+        out = x[0] * self.t2[0] ** power
         for k in range(1, self.t2.size):
             out += x[k] * self.t2[k] ** power
         return out
 
-    def evaluate(self, u: np.ndarray, eps2: np.ndarray, derivatives: bool = True):
+    def evaluate(self, u: np.ndarray, eps2: np.ndarray, derivatives: bool = True, majorant: bool = False):
         """Regularised dissipated power ``D = sum w s``, ``s = sqrt(A^2 + t^2 S^2 + eps^2)``,
         of every active ball (W); with ``derivatives`` also its gradient
-        (B, 3), its Hessian ``H`` (B, 3, 3) and ``M - H``
+        (B, 3) and its Hessian ``H`` (B, 3, 3); with ``majorant`` also ``M - H``
         where ``M = sum (w/s) G^T G >= H`` is the Hessian of the quadratic
         majorant of ``D`` at ``u`` (Weiszfeld), ``G`` the rows ``(GA, t GS)``,
-        ``GA = (g10, g12, -1)``, ``GS = (s0, s1, 0)``.
+        ``GA = (g10, g12, -1)``, ``GS = (s0, s1, 0)`` (None without it).
 
         In ``(A, S)``: ``ds = (A, t^2 S) / s``, and the Hessian of ``s`` is
         ``diag(1, t^2) / s - (A, t^2 S)(A, t^2 S)^T / s^3``, whose first part is
@@ -727,16 +732,18 @@ class _Contacts:
         a, s_ = self.velocity(u)
         a2, s2 = a * a, s_ * s_
         s = self._speed(a2, s2, eps2)
-        ws = np.multiply(self.weight, s, out=self._k)
-        n_i = ws.shape[2]
-        f_c = (ws.reshape(-1, n_i) @ np.ones(n_i)).reshape(ws.shape[:2]).sum(axis=0)   # BLAS: short axis
+        k = self._k
+        np.multiply(self.weight, s, out=k)
+        n_i = k.shape[2]
+        ones = self._ones
+        f_c = (k.reshape(-1, n_i) @ ones).reshape(k.shape[:2]).sum(axis=0)   # BLAS: short axis
         if not derivatives:
             return geo.sum_matrix @ f_c, None, None, None
         if self._products is None:
             self._prepare_derivatives()
         p00, p01, p11, q00, q01, q11, x00, x01, x11 = self._products
         g10, g12, s0, s1 = self.g10, self.g12, self.s0, self.s1
-        k, k3 = self._k, self._k3
+        k3 = self._k3
         np.divide(self.weight, s, out=k)                                 # w / s
         alpha, beta = self._moment(k, 0), self._moment(k, 1)
         rows = self._rows
@@ -749,30 +756,39 @@ class _Contacts:
         np.negative(ga, out=rows[2])
         np.divide(k, s, out=k3)
         k3 /= s                                                          # w / s^3
-        e_aa = a2 * self._moment(k3, 0)
-        e_as = a * s_ * self._moment(k3, 1)
-        e_ss = s2 * self._moment(k3, 2)
-        # rows 3..8: entries 00, 01, 02, 11, 12, 22 of M; rows 9..14: the same of M - H
-        for m_row, e_row, paa, pas, pss in ((3, 9, p00, x00, q00), (4, 10, p01, x01, q01), (6, 12, p11, x11, q11)):
-            np.multiply(alpha, paa, out=rows[m_row])
-            rows[m_row] += beta * pss
-            np.multiply(e_aa, paa, out=rows[e_row])
-            rows[e_row] += e_as * pas
-            rows[e_row] += e_ss * pss
-        for m_row, e_row, ga_k, gs_k in ((5, 11, g10, s0), (7, 13, g12, s1)):   # GA_2 = -1, GS_2 = 0
-            np.multiply(alpha, ga_k, out=rows[m_row])
-            np.negative(rows[m_row], out=rows[m_row])
-            np.multiply(e_aa, ga_k, out=rows[e_row])
-            rows[e_row] += e_as * gs_k
-            np.negative(rows[e_row], out=rows[e_row])
-        rows[8] = alpha
-        rows[14] = e_aa
-        sums = (rows.reshape(-1, n_i) @ np.ones(n_i)).reshape(15, -1) @ geo.sum_matrix.T   # (rows, B)
-        grad = sums[:3].T
+        e_aa = self._moment(k3, 0) * a2
+        e_as = self._moment(k3, 1) * a
+        e_as *= s_
+        e_ss = self._moment(k3, 2) * s2
+        # H = M - (M - H) per (C, I): h_aa GA GA^T + h_as (GA GS^T + GS GA^T) + h_ss GS GS^T
+        h_aa = alpha - e_aa
+        h_ss = beta - e_ss
+        # rows 3..8: entries 00, 01, 02, 11, 12, 22 of H; rows 9..14: the same of M - H
+        for row, paa, pas, pss in ((3, p00, x00, q00), (4, p01, x01, q01), (6, p11, x11, q11)):
+            np.multiply(h_aa, paa, out=rows[row])
+            rows[row] -= e_as * pas
+            rows[row] += h_ss * pss
+        for row, ga_k, gs_k in ((5, g10, s0), (7, g12, s1)):            # GA_2 = -1, GS_2 = 0
+            np.multiply(e_as, gs_k, out=rows[row])
+            rows[row] -= h_aa * ga_k
+        rows[8] = h_aa
+        n_rows = 9
+        if majorant:
+            n_rows = 15
+            for row, paa, pas, pss in ((9, p00, x00, q00), (10, p01, x01, q01), (12, p11, x11, q11)):
+                np.multiply(e_aa, paa, out=rows[row])
+                rows[row] += e_as * pas
+                rows[row] += e_ss * pss
+            for row, ga_k, gs_k in ((11, g10, s0), (13, g12, s1)):
+                np.multiply(e_aa, ga_k, out=rows[row])
+                rows[row] += e_as * gs_k
+                np.negative(rows[row], out=rows[row])
+            rows[14] = e_aa
+        sums = (rows[:n_rows].reshape(-1, n_i) @ ones).reshape(n_rows, -1) @ geo.sum_matrix.T   # (rows, B)
         sym = [0, 1, 2, 1, 3, 4, 2, 4, 5]
-        m = sums[3:9].T[:, sym].reshape(-1, 3, 3)
-        extra = sums[9:15].T[:, sym].reshape(-1, 3, 3)
-        return geo.sum_matrix @ f_c, grad, m - extra, extra
+        hessian = sums[3:9].T[:, sym].reshape(-1, 3, 3)
+        extra = sums[9:15].T[:, sym].reshape(-1, 3, 3) if majorant else None
+        return geo.sum_matrix @ f_c, sums[:3].T, hessian, extra
 
     def tractions(self, u: np.ndarray):
         """Dissipated power (W) and torque on the moving ring about +z (N m) of
@@ -788,7 +804,40 @@ class _Contacts:
         return power, torque
 
 
-def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int, theta: np.ndarray):
+def _solve(a: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """``a^-1 rhs`` for a stack of small symmetric systems (B, m, m), (B, m)."""
+    try:
+        return np.linalg.solve(a, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:                           # a singular H (not met): regularise
+        m = a.shape[-1]
+        d = np.maximum(np.einsum("bii->b", a) / m, 1e-300)
+        return np.linalg.solve(a + 1e-13 * d[:, None, None] * np.eye(m), rhs[..., None])[..., 0]
+
+
+def _cold_start(geometry: _ContactSet, contacts: _Contacts, u: np.ndarray, cold: np.ndarray) -> np.ndarray:
+    """Starting ball motions (scaled unknowns) for the balls marked ``cold``.
+
+    Per ball the candidate of least power (:meth:`_ContactSet.initial_guesses`),
+    then one Newton step from it, line-searched on the power over the lengths
+    ``0, 1/4, 1/2`` (:data:`_COLD_STEPS`): from a rolling motion the Newton
+    direction points at the minimum (measured: within a degree) but the full
+    step overshoots it about three times, because the power curves less there
+    than at the minimum. Costs four evaluations of the power and one of its
+    derivatives; the minimisation then starts with Newton steps."""
+    eps2 = geometry.eps2
+    candidates = geometry.initial_guesses()
+    power = np.stack([contacts.evaluate(c, eps2, derivatives=False)[0] for c in candidates])
+    best = np.take_along_axis(candidates, np.argmin(power, axis=0)[None, :, None], axis=0)[0]
+    start = np.where(cold[:, None], best, u)
+    f, g, h, _ = contacts.evaluate(start, eps2)
+    du = np.where(cold[:, None], _solve(h, -g), 0.0)
+    lengths = np.array((0.0,) + _COLD_STEPS)
+    power = np.stack([f] + [contacts.evaluate(start + t * du, eps2, derivatives=False)[0] for t in _COLD_STEPS])
+    return start + lengths[np.argmin(power, axis=0)][:, None] * du
+
+
+def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int, theta: np.ndarray,
+              floor: float | None = None):
     """Minimise the regularised dissipated power of every active ball (batched).
 
     Step ``du = -(H + theta (M - H))^-1 g`` per ball: ``theta = 1`` is the
@@ -796,42 +845,39 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     power however far from the minimum, where Newton's step (``theta = 0``)
     can overshoot by orders of magnitude (the power is nearly linear in some
     directions when every point slides); ``theta = 0`` converges
-    quadratically near the minimum. ``theta`` (B,) starts as given (1 for a
-    cold start, 0 for a warm one), shrinks after each step that lowers the
-    power by at least half the predicted amount, and grows for a ball whose
-    step fails (the step is then retried at once). Every trial point is
-    evaluated with its derivatives, so an accepted step costs one evaluation.
+    quadratically near the minimum. ``theta`` (B,) starts as given (0 for a
+    good start), shrinks after each step that lowers the power by at least
+    half the predicted amount, and grows for a ball whose step fails (the
+    step is then retried at once). Every trial point is evaluated with its
+    derivatives, so an accepted step costs one evaluation; ``M - H`` is
+    computed only while some ball has ``theta > 0``.
 
     Stopping rule: the Newton decrement ``g . H^-1 g`` of every ball is at
-    most ``2 tol`` times its power (the power is then within ``tol`` of its
-    minimum); that last Newton step is taken where it lowers the power. When
-    at most a quarter of the balls are left after three iterations, they go on
-    alone (:meth:`_Contacts.subset`), the others take that last step.
+    most ``tol (D_b + floor)``, ``D_b`` its power and ``floor`` the mean
+    power per ball (of this call, unless given): each ball's power is within
+    ``tol`` of the mean of its own power and the average one, so the total is
+    within ``tol`` of its minimum, and a ball that carries almost nothing is
+    not iterated to a relative accuracy that cannot show in the torque. That
+    last Newton step is taken where it lowers the power. When at most a
+    quarter of the balls are left after three iterations, they go on alone
+    (:meth:`_Contacts.subset`), the others take that last step.
 
     Returns ``(u, iterations, residual, converged)``; ``residual``: the largest
     force residual of a ball, relative to ``mu Q_max``, at the last evaluation."""
     eps2 = contacts.geometry.eps2
     n, m = u.shape
     theta = np.array(theta, dtype=float)
-    f, g, h, extra = contacts.evaluate(u, eps2)
+    f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta)))
     scale = contacts.geometry.force_scale
-    regular = 1e-13 * np.eye(m)
     iterations = 0
-
-    def solve(a, rhs):
-        d = np.maximum(np.einsum("bii->b", a) / m, 1e-300)
-        return np.linalg.solve(a + d[:, None, None] * regular, rhs[..., None])[..., 0]
-
-    def decrease(du):
-        slope = np.einsum("bk,bk->b", g, du)
-        return slope, -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
 
     def residual():
         return float(np.max(np.abs(g).max(axis=1) / scale))
 
     while True:
-        newton = solve(h, -g)
-        done = -np.einsum("bk,bk->b", g, newton) <= 2.0 * tol * f
+        newton = _solve(h, -g)
+        decrement = -np.einsum("bk,bk->b", g, newton)
+        done = decrement <= tol * (f + (f.mean() if floor is None else floor))
         if np.all(done):
             trial = u + newton
             keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
@@ -844,16 +890,26 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
             trial = np.where(done[:, None], u + newton, u)          # the last Newton step of the others
             keep = done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
             u = np.where(keep[:, None], trial, u)
-            u[left], more, res_left, converged = _minimise(contacts.subset(left), u[left], tol,
-                                                           max_iterations - iterations, theta[left])
+            u[left], more, res_left, converged = _minimise(
+                contacts.subset(left), u[left], tol, max_iterations - iterations, theta[left],
+                f.mean() if floor is None else floor)
             return u, iterations + more, max(res_done, res_left), converged
         iterations += 1
-        du = newton if not np.any(theta) else solve(h + theta[:, None, None] * extra, -g)
-        slope, predicted = decrease(du)
+        if np.any(theta):
+            if extra is None:                                       # theta rose after a Newton step
+                f, g, h, extra = contacts.evaluate(u, eps2, majorant=True)
+            du = _solve(h + theta[:, None, None] * extra, -g)
+            slope = np.einsum("bk,bk->b", g, du)
+            predicted = -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
+        else:
+            du, slope = newton, -decrement
+            predicted = 0.5 * decrement
+        du[done] = 0.0                                              # converged balls wait
+        slope[done] = predicted[done] = 0.0
         trial = u + du
         pending = np.ones(n, dtype=bool)
         for _ in range(12):
-            f_t, g_t, h_t, x_t = contacts.evaluate(trial, eps2)
+            f_t, g_t, h_t, x_t = contacts.evaluate(trial, eps2, majorant=bool(np.any(theta)))
             actual = f - f_t
             good = pending & ((actual >= -1e-4 * slope) | (np.abs(actual) <= 1e-13 * np.abs(f)))
             very = good & (actual >= 0.5 * predicted)
@@ -862,12 +918,20 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
             if not np.any(pending) or np.all(theta[pending] >= 1.0):   # done, or Weiszfeld failed: round-off
                 break
             theta[pending] = np.minimum(1.0, np.maximum(_THETA_UP * theta[pending], _THETA_MIN_UP))
-            du[pending] = solve(h[pending] + theta[pending, None, None] * extra[pending], -g[pending])
-            slope, predicted = decrease(du)
+            if extra is None:
+                f, g, h, extra = contacts.evaluate(u, eps2, majorant=True)
+            du[pending] = _solve(h[pending] + theta[pending, None, None] * extra[pending], -g[pending])
+            slope = np.einsum("bk,bk->b", g, du)
+            predicted = -(slope + 0.5 * np.einsum("bk,bkl,bl->b", du, h, du))
             trial[pending] = u[pending] + du[pending]
         if np.any(pending):                       # no step lowered their power: those balls stay
             trial[pending] = u[pending]
-            f_t[pending], g_t[pending], h_t[pending], x_t[pending] = f[pending], g[pending], h[pending], extra[pending]
+            f_t[pending], g_t[pending], h_t[pending] = f[pending], g[pending], h[pending]
+            if x_t is not None:
+                if extra is None:
+                    x_t = None
+                else:
+                    x_t[pending] = extra[pending]
         u, f, g, h, extra = trial, f_t, g_t, h_t, x_t
 
 
@@ -923,9 +987,12 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     initial : FrictionTorque or ndarray (B, 4), optional
         Warm start of the ball equilibrium: a previous result for this bearing.
     tol : float
-        Relative accuracy of the minimum dissipated power of every ball (Newton
-        decrement test). The torque error it leaves is one-sided and far
-        smaller (second order), below the quadrature error (~1e-3).
+        Relative accuracy of the minimum dissipated power, hence of the torque
+        (Newton decrement test): every ball's power is within ``tol`` of the
+        mean of its own power and the average power per ball, so the total is
+        within ``tol`` of its minimum. The torque error it leaves is one-sided
+        (the torque is never below the converged one), below the quadrature
+        error (~1e-3).
     max_iterations : int
 
     Returns
@@ -970,13 +1037,8 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
             u = state[active][:, _SOLVED] * speed * scale_u
             cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
         if np.any(cold):
-            # the candidate motion of least power, per ball
-            candidates = geometry.initial_guesses()
-            power = np.stack([solver.evaluate(c, geometry.eps2, derivatives=False)[0] for c in candidates])
-            u[cold] = np.take_along_axis(candidates, np.argmin(power, axis=0)[None, :, None], axis=0)[0][cold]
-        # cold balls start with Weiszfeld-safe steps
-        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations,
-                                                       theta=np.where(cold, _THETA_COLD, 0.0))
+            u = _cold_start(geometry, solver, u, cold)
+        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations, theta=np.zeros(active.size))
         power_c, torque_c = contacts.tractions(u)
     else:
         power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0
