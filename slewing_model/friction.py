@@ -820,9 +820,10 @@ def _cold_start(geometry: _ContactSet, contacts: _Contacts, u: np.ndarray, cold:
     Per ball the candidate of least power (:meth:`_ContactSet.initial_guesses`),
     then one Newton step from it, line-searched on the power over the lengths
     ``0, 1/4, 1/2`` (:data:`_COLD_STEPS`): from a rolling motion the Newton
-    direction points at the minimum (measured: within a degree) but the full
-    step overshoots it about three times, because the power curves less there
-    than at the minimum. Costs four evaluations of the power and one of its
+    direction points at the minimum (measured on table3's two-contact balls:
+    cosine 1.00 with the direction to it) but the full step overshoots it
+    about three times, because the power curves less there than at the
+    minimum. A ball near the 4 -> 2 contact transition keeps length 0. Costs four evaluations of the power and one of its
     derivatives; the minimisation then starts with Newton steps."""
     eps2 = geometry.eps2
     candidates = geometry.initial_guesses()
