@@ -837,8 +837,8 @@ def _cold_start(geometry: _ContactSet, contacts: _Contacts, u: np.ndarray, cold:
     return start + lengths[np.argmin(power, axis=0)][:, None] * du
 
 
-def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int, theta: np.ndarray,
-              floor: float | None = None):
+def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: int,
+              theta: np.ndarray | None = None, floor: float | None = None):
     """Minimise the regularised dissipated power of every active ball (batched).
 
     Step ``du = -(H + theta (M - H))^-1 g`` per ball: ``theta = 1`` is the
@@ -846,8 +846,8 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     power however far from the minimum, where Newton's step (``theta = 0``)
     can overshoot by orders of magnitude (the power is nearly linear in some
     directions when every point slides); ``theta = 0`` converges
-    quadratically near the minimum. ``theta`` (B,) starts as given (0 for a
-    good start), shrinks after each step that lowers the power by at least
+    quadratically near the minimum. ``theta`` (B,) starts as given (default
+    0: Newton), shrinks after each step that lowers the power by at least
     half the predicted amount, and grows for a ball whose step fails (the
     step is then retried at once). Every trial point is evaluated with its
     derivatives, so an accepted step costs one evaluation; ``M - H`` is
@@ -867,7 +867,7 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     force residual of a ball, relative to ``mu Q_max``, at the last evaluation."""
     eps2 = contacts.geometry.eps2
     n, m = u.shape
-    theta = np.array(theta, dtype=float)
+    theta = np.zeros(n) if theta is None else np.array(theta, dtype=float)
     f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta)))
     scale = contacts.geometry.force_scale
     iterations = 0
@@ -878,7 +878,8 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
     while True:
         newton = _solve(h, -g)
         decrement = -np.einsum("bk,bk->b", g, newton)
-        done = decrement <= tol * (f + (f.mean() if floor is None else floor))
+        share = f.mean() if floor is None else floor
+        done = decrement <= tol * (f + share)
         if np.all(done):
             trial = u + newton
             keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
@@ -891,9 +892,8 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
             trial = np.where(done[:, None], u + newton, u)          # the last Newton step of the others
             keep = done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
             u = np.where(keep[:, None], trial, u)
-            u[left], more, res_left, converged = _minimise(
-                contacts.subset(left), u[left], tol, max_iterations - iterations, theta[left],
-                f.mean() if floor is None else floor)
+            u[left], more, res_left, converged = _minimise(contacts.subset(left), u[left], tol,
+                                                           max_iterations - iterations, theta[left], share)
             return u, iterations + more, max(res_done, res_left), converged
         iterations += 1
         if np.any(theta):
@@ -928,11 +928,10 @@ def _minimise(contacts: _Contacts, u: np.ndarray, tol: float, max_iterations: in
         if np.any(pending):                       # no step lowered their power: those balls stay
             trial[pending] = u[pending]
             f_t[pending], g_t[pending], h_t[pending] = f[pending], g[pending], h[pending]
-            if x_t is not None:
-                if extra is None:
-                    x_t = None
-                else:
-                    x_t[pending] = extra[pending]
+            if x_t is not None and extra is not None:
+                x_t[pending] = extra[pending]
+            else:
+                x_t = None                                          # recomputed if a ball needs it
         u, f, g, h, extra = trial, f_t, g_t, h_t, x_t
 
 
@@ -1039,7 +1038,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
             cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
         if np.any(cold):
             u = _cold_start(geometry, solver, u, cold)
-        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations, theta=np.zeros(active.size))
+        u, iterations, residual, converged = _minimise(solver, u, tol, max_iterations)
         power_c, torque_c = contacts.tractions(u)
     else:
         power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0
