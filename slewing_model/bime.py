@@ -483,7 +483,8 @@ class BimeSolver:
                 fresh = last_residual is None or residual > REFRESH * last_residual
                 last_residual = residual
                 dq, dy = self._flexible_direction(point, f_scaled, mu, fresh)
-                slope = float(grad_q @ dq) - float((self.compliance @ (f - point.y)) @ dy)
+                m_dy = self.compliance @ dy       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
+                slope = float(grad_q @ dq) - float((f - point.y) @ m_dy)
             else:
                 dq, dy = self._rigid_direction(point, grad_q, mu), point.y
                 slope = float(grad_q @ dq)
@@ -491,11 +492,14 @@ class BimeSolver:
             if norm > trust:  # a step across a clearance is limited, then checked by the energy
                 dq, dy = dq * (trust / norm), dy * (trust / norm)
                 slope *= trust / norm
+                if flexible:
+                    m_dy = m_dy * (trust / norm)
 
             # backtracking line search on the total energy (convex)
             t = 1.0
             for _ in range(60):
-                trial = self._evaluate(point.qs + t * dq, point.y + t * dy if flexible else point.y, f_scaled)
+                trial = self._evaluate(point.qs + t * dq, point.y + t * dy if flexible else point.y, f_scaled,
+                                       None if not flexible else point.ring_motion + t * m_dy)
                 roundoff = 1e-12 * max(point.energy_scale, trial.energy_scale)
                 if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + roundoff:
                     break
@@ -511,18 +515,21 @@ class BimeSolver:
 
         return self._result(loads, point, iterations, residual)
 
-    def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray) -> "_Point":
-        """Contact terms and total energy at the unknowns ``(qs, y)``."""
+    def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray,
+                  my: np.ndarray | None = None) -> "_Point":
+        """Contact terms and total energy at the unknowns ``(qs, y)``; ``my``: ``M y`` if known
+        (along a search line it is linear in the step)."""
         e = self.assembly.separation + self.jacobian @ qs
         ring = 0.0
         if self.compliance is not None:
-            my = self.compliance @ y
+            if my is None:
+                my = self.compliance @ y
             e = e - my.reshape(e.shape)       # e_D = -M y: groove centres moved by ring deformation
             ring = 0.5 * float(y @ my)        # eq 15
         delta, q, force, energy, hess, n, length = self._contacts(e)
         work = float(f_scaled @ qs)
         # the total is a difference of larger terms: its roundoff scales with them
-        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work))
+        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work), my)
 
     def _rigid_direction(self, p: "_Point", grad_q: np.ndarray, mu: float) -> np.ndarray:
         """Newton step of the rigid model: ``(sum J^T A J) dq = -grad``."""
@@ -619,7 +626,7 @@ class BimeSolver:
                     w_mat[blocks + r, blocks + c] += a_inv[:, r, c]
             cached = self._reduced_operator(idx, active, a_inv, np.linalg.inv(w_mat), mu)
         _, active, a_inv, w_inv, ja, z_mat, schur_inv = cached
-        rhs = (a_inv @ p.force.reshape(-1, 2)[active][..., None]).ravel() + (self.compliance[idx] @ p.y)
+        rhs = (a_inv @ p.force.reshape(-1, 2)[active][..., None]).ravel() + p.ring_motion[idx]
         w_vec = w_inv @ rhs
         dq = schur_inv @ (f_scaled - ja.T @ w_vec)
         y_new[idx] = w_vec + z_mat @ dq
@@ -702,6 +709,7 @@ class _Point:
     length: np.ndarray
     total: float
     energy_scale: float
+    ring_motion: np.ndarray | None = None   # M y: the groove centres' relative motion from ring deformation (flexible)
 
 
 def _ring_index(n: int, slots: np.ndarray) -> np.ndarray:
