@@ -25,7 +25,7 @@ RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "bim
                    "friction", "simulator")
 
 
-def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False) -> Path:
+def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -38,7 +38,12 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         Ring support of the superelement.
     mesh : {"coarse", "fine"}
         Superelement mesh; "fine" (default) is within 0.5 % of a finer one, "coarse" is for tests.
+    fmi_version : {2, 3}
+        2 (default): FMI 2.0 with pythonfmu, per-ball results as scalars ``ball[i].Q1``...;
+        3: FMI 3.0 with pythonfmu3 (``fmu_src/SlewingBearing3.py``), per-ball results as arrays.
     """
+    if fmi_version not in (2, 3):
+        raise ValueError(f"fmi_version = {fmi_version!r}: must be 2 or 3")
     from pythonfmu import FmuBuilder
 
     from slewing_model import load_bearing
@@ -46,7 +51,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
 
     bearing = load_bearing(bearing_file)
     superelement = build_superelement(bearing, mesh=mesh, bc=bc, progress=progress)
-    output = Path(output) if output else ROOT / "build" / f"SlewingBearing_{Path(bearing_file).stem}.fmu"
+    stem = "SlewingBearing3" if fmi_version == 3 else "SlewingBearing"
+    output = Path(output) if output else ROOT / "build" / f"{stem}_{Path(bearing_file).stem}.fmu"
     output.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="slewing_fmu_") as tmp:
         tmp = Path(tmp)
@@ -60,13 +66,30 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         # where numpy lives in the building environment: the FMU's fallback when its host lacks numpy
         (tmp / "python_paths.json").write_text(json.dumps(sorted(set(site.getsitepackages()))))
         superelement.save(tmp / "superelement.npz")
+        if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
+            return _build_fmi3(output, [package, tmp / "bearing.json", tmp / "superelement.npz",
+                                        ROOT / "fmu_src" / "bearing_variables.py"])
         built = FmuBuilder.build_FMU(
             ROOT / "fmu_src" / "SlewingBearing.py", dest=output,
-            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz", tmp / "python_paths.json"],
+            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz", tmp / "python_paths.json",
+                           ROOT / "fmu_src" / "bearing_variables.py"],
             canGetAndSetFMUstate=True, canSerializeFMUstate=True,
             needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
         )
     return Path(built)
+
+
+def _build_fmi3(output: Path, project_files) -> Path:
+    """Package ``fmu_src/SlewingBearing3.py`` with pythonfmu3 (which writes ``<modelName>.fmu`` into a folder)."""
+    from pythonfmu3 import FmuBuilder as Fmu3Builder
+
+    with tempfile.TemporaryDirectory(prefix="slewing_fmu3_") as folder:
+        built = Fmu3Builder.build_FMU(ROOT / "fmu_src" / "SlewingBearing3.py", dest=folder,
+                                      project_files=project_files, needsExecutionTool=True,
+                                      canGetAndSetFMUState=True, canSerializeFMUState=True,
+                                      canHandleVariableCommunicationStepSize=True)
+        shutil.move(str(built), output)
+    return output
 
 
 def host_environment() -> dict[str, str]:
@@ -85,6 +108,8 @@ def main(argv=None) -> int:
     parser.add_argument("-o", "--output", help="FMU file to write")
     parser.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free")
     parser.add_argument("--mesh", choices=("coarse", "fine"), default="fine")
+    parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                        help="FMI 2.0 (default; per-ball scalars) or FMI 3.0 (pythonfmu3; per-ball arrays)")
     parser.add_argument("--host-env", action="store_true",
                         help="only print the environment a C/C++ host on Linux needs (LD_PRELOAD of libpython)")
     args = parser.parse_args(argv)
@@ -94,7 +119,8 @@ def main(argv=None) -> int:
         return 0
     if args.bearing is None:
         parser.error("the bearing definition is required")
-    path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True)
+    path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
+                      fmi_version=args.fmi_version)
     print(f"wrote {path}")
     return 0
 

@@ -49,43 +49,9 @@ from pythonfmu.default_experiment import DefaultExperiment
 from slewing_model import Bearing, Loads, NoEquilibriumError
 from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
 
-#: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
-UNITS = {
-    "N": (1, 1, -2, 0),
-    "N.m": (1, 2, -2, 0),
-    "m": (0, 1, 0, 0),
-    "rad": (0, 0, 0, 1),
-    "rad/s": (0, 0, -1, 1),
-    "Pa": (1, -1, -2, 0),
-    "1": (0, 0, 0, 0),
-}
-
-INPUTS = [  # name, unit, description
-    ("Fx", "N", "force on the moving ring along x"),
-    ("Fy", "N", "force on the moving ring along y"),
-    ("Fz", "N", "axial force on the moving ring, > 0 pushes the inner ring towards +z (loads contacts 1 and 3)"),
-    ("Mx", "N.m", "tilting moment on the moving ring about x"),
-    ("My", "N.m", "tilting moment on the moving ring about y"),
-    ("psi", "rad", "rotation angle of the moving ring"),
-    ("omega", "rad/s", "rotation speed of the moving ring"),
-]
-
-OUTPUTS = [  # name, unit, description
-    ("x", "m", "displacement of the moving ring along x"),
-    ("y", "m", "displacement of the moving ring along y"),
-    ("z", "m", "axial displacement of the moving ring"),
-    ("rx", "rad", "tilt of the moving ring about x"),
-    ("ry", "rad", "tilt of the moving ring about y"),
-    ("friction_torque", "N.m", "friction torque on the moving ring about z, opposing omega"),
-    ("friction_torque_magnitude", "N.m", "magnitude of the friction torque at full sliding"),
-    ("max_ball_load", "N", "largest ball-raceway contact load"),
-    ("max_contact_pressure", "Pa", "largest Hertz contact pressure"),
-    ("static_safety_factor", "1", "ISO 76 static safety factor (4200 MPa / p_max)^3"),
-]
-
-RING_MODELS = {1: "rigid", 2: "flexible"}
-MOVING_RINGS = {1: "inner", 2: "outer"}
-LOAD_FRAMES = {1: "fixed", 2: "rotating"}
+from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
+    BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, LOAD_FRAMES, MOVING_RINGS, OUTPUTS, REAL_PARAMETERS,
+    RING_MODELS, UNITS, choice_description, integer_default)
 
 
 class SlewingBearing(Fmi2Slave):
@@ -108,53 +74,42 @@ class SlewingBearing(Fmi2Slave):
             setattr(self, name, 0.0)
             self._real(name, unit, text, Fmi2Causality.input, Fmi2Variability.continuous)
         # parameters
-        self.preload = self.bearing.preload
-        self.friction_coefficient = 0.1
-        self.seal_torque = 0.0
-        self.tolerance = 1e-9
-        self.omega_regularisation = 1e-4
-        self.ring_model = 2
-        self.moving_ring = 1 if self.bearing.moving_ring == "inner" else 2
-        self.load_frame = 1
-        self._real("preload", "m", "ball preload (oversize; < 0 for clearance)", Fmi2Causality.parameter,
-                   Fmi2Variability.fixed)
-        self._real("friction_coefficient", "1", "Coulomb friction coefficient of the raceway contacts (0: off)",
-                   Fmi2Causality.parameter, Fmi2Variability.tunable)
-        self._real("seal_torque", "N.m", "load-independent friction torque (seals, grease)",
-                   Fmi2Causality.parameter, Fmi2Variability.tunable)
-        self._real("tolerance", "1", "relative tolerance of the load distribution solver",
-                   Fmi2Causality.parameter, Fmi2Variability.fixed)
-        self._real("omega_regularisation", "rad/s",
-                   "speed over which friction_torque rises to its full-sliding level (tanh); "
-                   "at least magnitude * step / inertia for an explicit coupling",
-                   Fmi2Causality.parameter, Fmi2Variability.tunable)
-        for name, choices, text in (("ring_model", RING_MODELS, "ring model"),
-                                    ("moving_ring", MOVING_RINGS, "ring the loads act on and that turns"),
-                                    ("load_frame", LOAD_FRAMES, "frame of the input loads")):
-            listing = ", ".join(f"{k} = {v}" for k, v in choices.items())
+        for name, unit, text, tunable, default in REAL_PARAMETERS:
+            setattr(self, name, self.bearing.preload if default is None else default)
+            self._real(name, unit, text, Fmi2Causality.parameter,
+                       Fmi2Variability.tunable if tunable else Fmi2Variability.fixed)
+        for name, choices, text in INTEGER_PARAMETERS:
+            setattr(self, name, integer_default(name, self.bearing))
             self.register_variable(Integer(name, causality=Fmi2Causality.parameter,
                                            variability=Fmi2Variability.fixed, initial=Fmi2Initial.exact,
-                                           description=f"{text}: {listing}"), nested=False)
+                                           description=choice_description(choices, text)), nested=False)
         # outputs
         for name, unit, text in OUTPUTS:
             setattr(self, name, 0.0)
             self._real(name, unit, text, Fmi2Causality.output, Fmi2Variability.continuous)
         self.balls_in_four_point_contact = 0
-        self.register_variable(Integer("balls_in_four_point_contact", causality=Fmi2Causality.output,
+        self.register_variable(Integer(COUNT_OUTPUT[0], causality=Fmi2Causality.output,
                                        variability=Fmi2Variability.discrete, initial=Fmi2Initial.calculated,
-                                       description="number of balls loaded on both diagonals"), nested=False)
+                                       description=COUNT_OUTPUT[1]), nested=False)
         self._q = [[0.0] * 4 for _ in range(n)]
         self._alpha = [[0.0, 0.0] for _ in range(n)]
+        self._d = [[0.0, 0.0] for _ in range(n)]
+        _, _, q_columns, _, _ = BALL_ARRAYS[0]
         for i in range(1, n + 1):
-            for c in range(4):
-                self._real(f"ball[{i}].Q{c + 1}", "N", f"contact load of ball {i}, contact {c + 1}",
+            for c, label in enumerate(q_columns):
+                self._real(f"ball[{i}].{label}", "N", f"contact load of ball {i}, contact {c + 1}",
                            Fmi2Causality.output, Fmi2Variability.continuous,
                            getter=lambda i=i, c=c: self._q[i - 1][c])
-            for k, label in enumerate(("alpha13", "alpha24")):
+            for k, label in enumerate(BALL_ARRAYS[1][2]):
                 self._real(f"ball[{i}].{label}", "rad",
                            f"loaded contact angle of ball {i}, diagonal {label[-2]}-{label[-1]}",
                            Fmi2Causality.output, Fmi2Variability.continuous,
                            getter=lambda i=i, k=k: self._alpha[i - 1][k])
+            for k, label in enumerate(BALL_ARRAYS[2][2]):
+                self._real(f"ball[{i}].{label}", "m",
+                           f"interference of ball {i}, diagonal {label[-2]}-{label[-1]} (< 0: gap)",
+                           Fmi2Causality.output, Fmi2Variability.continuous,
+                           getter=lambda i=i, k=k: self._d[i - 1][k])
         self.simulator: BearingSimulator | None = None
 
     # ---- variables ------------------------------------------------------------------
@@ -268,18 +223,19 @@ class SlewingBearing(Fmi2Slave):
         self.balls_in_four_point_contact = d.balls_in_four_point_contact
         self._q = d.contact_load.tolist()
         self._alpha = d.contact_angle[:, :2].tolist()
+        self._d = d.interference.tolist()
         return True
 
     # ---- FMU state -------------------------------------------------------------------
     def _get_fmu_state(self):
         state = {v.name: v.getter() for v in self.vars.values() if not v.name.startswith("ball[")}
-        state["_q"], state["_alpha"] = self._q, self._alpha
+        state["_q"], state["_alpha"], state["_d"] = self._q, self._alpha, self._d
         state["_simulator"] = None if self.simulator is None else self.simulator.get_state()
         return state
 
     def _set_fmu_state(self, state):
         state = dict(state)
-        self._q, self._alpha = state.pop("_q"), state.pop("_alpha")
+        self._q, self._alpha, self._d = state.pop("_q"), state.pop("_alpha"), state.pop("_d")
         simulator = state.pop("_simulator")
         for v in self.vars.values():
             if v.name in state and v.setter is not None:

@@ -1,0 +1,116 @@
+"""Variables of the slewing bearing FMU, shared by its FMI 2.0 and FMI 3.0 slaves.
+
+One table per kind of variable (name, SI unit, description), the parameters'
+defaults and choices, and the two checks both slaves make before they step
+(so that both refuse the same bad input with the same message). Plain data and
+the standard library only: no FMI library and no physics here.
+"""
+from __future__ import annotations
+
+import math
+
+#: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
+UNITS = {
+    "N": (1, 1, -2, 0),
+    "N.m": (1, 2, -2, 0),
+    "m": (0, 1, 0, 0),
+    "rad": (0, 0, 0, 1),
+    "rad/s": (0, 0, -1, 1),
+    "Pa": (1, -1, -2, 0),
+    "1": (0, 0, 0, 0),
+    "s": (0, 0, 1, 0),
+}
+
+INPUTS = [  # name, unit, description
+    ("Fx", "N", "force on the moving ring along x"),
+    ("Fy", "N", "force on the moving ring along y"),
+    ("Fz", "N", "axial force on the moving ring, > 0 pushes the inner ring towards +z (loads contacts 1 and 3)"),
+    ("Mx", "N.m", "tilting moment on the moving ring about x"),
+    ("My", "N.m", "tilting moment on the moving ring about y"),
+    ("psi", "rad", "rotation angle of the moving ring"),
+    ("omega", "rad/s", "rotation speed of the moving ring"),
+]
+
+OUTPUTS = [  # name, unit, description
+    ("x", "m", "displacement of the moving ring along x"),
+    ("y", "m", "displacement of the moving ring along y"),
+    ("z", "m", "axial displacement of the moving ring"),
+    ("rx", "rad", "tilt of the moving ring about x"),
+    ("ry", "rad", "tilt of the moving ring about y"),
+    ("friction_torque", "N.m", "friction torque on the moving ring about z, opposing omega"),
+    ("friction_torque_magnitude", "N.m", "magnitude of the friction torque at full sliding"),
+    ("max_ball_load", "N", "largest ball-raceway contact load"),
+    ("max_contact_pressure", "Pa", "largest Hertz contact pressure"),
+    ("static_safety_factor", "1", "ISO 76 static safety factor (4200 MPa / p_max)^3"),
+]
+
+#: integer output (FMI 2.0 Integer, FMI 3.0 Int32): name, description
+COUNT_OUTPUT = ("balls_in_four_point_contact", "number of balls loaded on both diagonals")
+
+#: real parameters: name, unit, description, tunable (else fixed), default (None: from the bearing definition)
+REAL_PARAMETERS = [
+    ("preload", "m", "ball preload (oversize; < 0 for clearance)", False, None),
+    ("friction_coefficient", "1", "Coulomb friction coefficient of the raceway contacts (0: off)", True, 0.1),
+    ("seal_torque", "N.m", "load-independent friction torque (seals, grease)", True, 0.0),
+    ("tolerance", "1", "relative tolerance of the load distribution solver", False, 1e-9),
+    ("omega_regularisation", "rad/s",
+     "speed over which friction_torque rises to its full-sliding level (tanh); "
+     "at least magnitude * step / inertia for an explicit coupling", True, 1e-4),
+]
+
+RING_MODELS = {1: "rigid", 2: "flexible"}
+MOVING_RINGS = {1: "inner", 2: "outer"}
+LOAD_FRAMES = {1: "fixed", 2: "rotating"}
+
+#: integer parameters: name, choices, description (the choices are listed after it)
+INTEGER_PARAMETERS = [
+    ("ring_model", RING_MODELS, "ring model"),
+    ("moving_ring", MOVING_RINGS, "ring the loads act on and that turns"),
+    ("load_frame", LOAD_FRAMES, "frame of the input loads"),
+]
+
+#: per-ball results: FMI 3.0 array name, unit, columns (FMI 2.0 scalar suffixes), description,
+#: and how the column is taken from slewing_model's LoadDistribution (attribute, first columns)
+BALL_ARRAYS = [
+    ("contact_load", "N", ("Q1", "Q2", "Q3", "Q4"), "contact load of each ball (axis 0) and contact 1..4 (axis 1)",
+     "contact_load"),
+    ("contact_angle", "rad", ("alpha13", "alpha24"),
+     "loaded contact angle of each ball (axis 0) and diagonal 1-3, 2-4 (axis 1)", "contact_angle"),
+    ("interference", "m", ("d13", "d24"),
+     "interference (total Hertz deflection; < 0: gap) of each ball (axis 0) and diagonal 1-3, 2-4 (axis 1)",
+     "interference"),
+]
+
+
+def integer_default(name: str, bearing) -> int:
+    """Default of an integer parameter for ``bearing`` (flexible rings, its moving ring, fixed frame)."""
+    if name == "ring_model":
+        return 2
+    if name == "moving_ring":
+        return 1 if bearing.moving_ring == "inner" else 2
+    return 1
+
+
+def choice_description(choices: dict, text: str) -> str:
+    return f"{text}: " + ", ".join(f"{k} = {v}" for k, v in choices.items())
+
+
+def check_choices(values: dict) -> dict:
+    """The integer parameters in ``values`` as the names of their choices; ValueError naming the
+    parameter, its value and the allowed values otherwise."""
+    names = {}
+    for name, choices, _ in INTEGER_PARAMETERS:
+        value = values[name]
+        if value not in choices:
+            raise ValueError(f"parameter {name} = {value}: must be one of "
+                             + ", ".join(f"{k} ({v})" for k, v in choices.items()))
+        names[name] = choices[value]
+    return names
+
+
+def check_inputs(values: dict) -> None:
+    """ValueError naming the first input of ``values`` that is not finite."""
+    for name, _, _ in INPUTS:
+        value = values[name]
+        if not math.isfinite(value):
+            raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
