@@ -2,57 +2,133 @@
 
 CSV format (SI units, header required)::
 
-    time,Fx,Fy,Fz,Mx,My[,Mz]
+    time,Fx,Fy,Fz,Mx,My[,Mz[,psi,omega]]
 
 ``Fx..My`` are the loads on the bearing's moving ring (N, N m) in the frame
 the FMU's ``load_frame`` parameter says; ``Mz`` (optional) is the moment about
 the bearing axis that the drive works against (aerodynamic and gravity
-pitching moment of a blade, aerodynamic yaw moment), N m. Values are
-interpolated linearly in time.
+pitching moment of a blade, aerodynamic yaw moment), N m: positive when it
+opposes a positive rotation, the sign :class:`slewing_drives.drive.ElectricDrive`
+takes as ``load_torque``. ``psi`` (rad) and ``omega`` (rad/s), optional, are
+the recorded motion of the moving ring (the pitch or yaw angle and its rate of
+an aero-elastic run, :func:`slewing_model.aeroelastic.bearing_loads`). Values
+are interpolated linearly in time. Lines starting with ``#`` are comments; a
+comment ``# load_frame = fixed`` (or ``rotating``) states the frame of the
+loads and is read back into :attr:`LoadSeries.load_frame`.
 """
 from __future__ import annotations
 
 import csv
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 COLUMNS = ("time", "Fx", "Fy", "Fz", "Mx", "My", "Mz")
+#: the header with the recorded motion
+MOTION_COLUMNS = COLUMNS + ("psi", "omega")
+LOAD_FRAMES = ("fixed", "rotating")
+_FRAME_COMMENT = re.compile(r"^#\s*load_frame\s*=\s*(\w+)\s*$")
 
 
 @dataclass(frozen=True)
 class LoadSeries:
-    """Loads against time.
+    """Loads (and optionally the ring's motion) against time.
 
     Attributes
     ----------
     time : ndarray (n,), s, strictly increasing
     loads : ndarray (n, 6)
-        Fx, Fy, Fz (N), Mx, My, Mz (N m).
+        Fx, Fy, Fz (N), Mx, My (N m) on the moving ring; Mz (N m), the moment
+        the drive works against (positive when it opposes positive rotation).
+    psi : ndarray (n,) or None, rad
+        Recorded angle of the moving ring (None: not recorded).
+    omega : ndarray (n,) or None, rad/s
+        Recorded speed of the moving ring.
+    load_frame : {"fixed", "rotating"} or None
+        Frame of ``Fx..My``: the fixed ring's, or the moving ring's (turned by
+        ``psi``; the FMU's and :class:`slewing_model.simulator.SimulatorSettings`'
+        ``load_frame``). None: not stated.
     """
 
     time: np.ndarray
     loads: np.ndarray
+    psi: np.ndarray | None = None
+    omega: np.ndarray | None = None
+    load_frame: str | None = None
+
+    def __post_init__(self):
+        if (self.psi is None) != (self.omega is None):
+            raise ValueError("psi and omega: give both or neither")
+        if self.load_frame is not None and self.load_frame not in LOAD_FRAMES:
+            raise ValueError(f"load_frame = {self.load_frame!r}: must be one of {', '.join(LOAD_FRAMES)} or None")
+        n = np.shape(self.time)[0]
+        if np.shape(self.loads) != (n, 6):
+            raise ValueError(f"loads: shape {np.shape(self.loads)}, expected ({n}, 6) for {n} times")
+        for name in ("psi", "omega"):
+            value = getattr(self, name)
+            if value is not None and np.shape(value) != (n,):
+                raise ValueError(f"{name}: shape {np.shape(value)}, expected ({n},)")
+
+    @property
+    def has_motion(self) -> bool:
+        """True when the series carries the recorded ``psi`` and ``omega``."""
+        return self.psi is not None
 
     def at(self, t: float) -> np.ndarray:
         """Loads (6,) at time ``t`` (held constant outside the series)."""
         return np.array([np.interp(t, self.time, self.loads[:, k]) for k in range(6)])
 
-    def write_csv(self, path) -> None:
+    def motion_at(self, t: float) -> tuple:
+        """``(psi, omega)`` at time ``t`` (rad, rad/s; held constant outside the series)."""
+        if not self.has_motion:
+            raise ValueError("this load series has no recorded motion (psi, omega)")
+        return float(np.interp(t, self.time, self.psi)), float(np.interp(t, self.time, self.omega))
+
+    def write_csv(self, path, comments=()) -> None:
+        """Write the CSV (header ``time,Fx,Fy,Fz,Mx,My,Mz`` plus ``psi,omega``
+        when recorded), after ``comments`` (lines, each written after ``# ``)
+        and the ``load_frame`` when it is stated."""
         with open(path, "w", newline="") as fh:
+            for line in comments:
+                fh.write(f"# {line}\n")
+            if self.load_frame is not None:
+                fh.write(f"# load_frame = {self.load_frame}\n")
             w = csv.writer(fh)
-            w.writerow(COLUMNS)
-            for t, row in zip(self.time, self.loads):
-                w.writerow([f"{t:.6f}"] + [f"{v:.6g}" for v in row])
+            if self.has_motion:
+                w.writerow(MOTION_COLUMNS)
+                for t, row, p, o in zip(self.time, self.loads, self.psi, self.omega):
+                    w.writerow([f"{t:.6f}"] + [f"{v:.6g}" for v in row] + [f"{p:.9g}", f"{o:.6g}"])
+            else:
+                w.writerow(COLUMNS)
+                for t, row in zip(self.time, self.loads):
+                    w.writerow([f"{t:.6f}"] + [f"{v:.6g}" for v in row])
 
     @classmethod
     def read_csv(cls, path) -> "LoadSeries":
+        """Read a CSV of either header (``time,Fx,Fy,Fz,Mx,My[,Mz]`` or with
+        ``psi,omega``); a missing ``Mz`` is 0."""
+        frame = None
         with open(path, newline="") as fh:
-            rows = [r for r in csv.reader(fh) if r and not r[0].startswith("#")]
+            rows = []
+            for r in csv.reader(fh):
+                if r and r[0].startswith("#"):
+                    m = _FRAME_COMMENT.match(",".join(r).strip())
+                    if m:
+                        frame = m.group(1)
+                        if frame not in LOAD_FRAMES:
+                            raise ValueError(f"{path}: load_frame = {frame!r}: must be one of {', '.join(LOAD_FRAMES)}")
+                    continue
+                if r:
+                    rows.append(r)
+        if not rows:
+            raise ValueError(f"{path}: no header line")
         header = [h.strip() for h in rows[0]]
-        if header[:6] != list(COLUMNS[:6]):
-            raise ValueError(f"{path}: header must start with {','.join(COLUMNS[:6])}, found {','.join(header)}")
+        allowed = (list(COLUMNS[:6]), list(COLUMNS), list(MOTION_COLUMNS))
+        if header not in allowed:
+            raise ValueError(f"{path}: header must be {','.join(COLUMNS[:6])}[,Mz] or {','.join(MOTION_COLUMNS)}, "
+                             f"found {','.join(header)}")
         data = []
         for n, row in enumerate(rows[1:], start=2):
             try:
@@ -61,11 +137,16 @@ class LoadSeries:
                 raise ValueError(f"{path}, line {n}: {row!r}: every value must be a number") from None
             if len(values) != len(header) or not all(math.isfinite(v) for v in values):
                 raise ValueError(f"{path}, line {n}: {len(header)} finite numbers expected")
-            data.append(values + [0.0] * (7 - len(values)))
+            data.append(values)
         data = np.array(data)
         if len(data) < 2 or np.any(np.diff(data[:, 0]) <= 0):
             raise ValueError(f"{path}: at least two rows with strictly increasing time are needed")
-        return cls(data[:, 0], data[:, 1:7])
+        loads = np.zeros((len(data), 6))
+        n_loads = min(len(header), 7) - 1                       # 5 without Mz, else 6
+        loads[:, :n_loads] = data[:, 1:1 + n_loads]
+        if len(header) == 9:
+            return cls(data[:, 0], loads, data[:, 7].copy(), data[:, 8].copy(), frame)
+        return cls(data[:, 0], loads, load_frame=frame)
 
 
 def synthetic_blade_root_loads(duration: float, *, dt: float = 0.01, seed: int = 0,

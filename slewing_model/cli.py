@@ -2,12 +2,16 @@
 
 ``slewing solve BEARING.toml [--fx N] [--fy N] [--fz N] [--mx Nm] [--my Nm] [--model rigid|flexible] [--json]``
 ``slewing superelement BEARING.toml [--mesh coarse|fine] [--bc free|clamped|frictionless] -o FILE``
+``slewing loads FILE.outb --bearing pitch|yaw [--blade K] [--mounting M] [--start s] [--end s] -o LOADS.csv``
 """
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import os
+import re
+import select
 import sys
 
 import numpy as np
@@ -131,18 +135,100 @@ def _add_superelement(sub, wanted: bool) -> None:
     p.set_defaults(func=command.run)
 
 
+def _add_loads(sub) -> None:
+    p = sub.add_parser("loads", help="pitch or yaw bearing loads from an OpenFAST/FAST output file (.out, .outb) "
+                                     "as a CSV load series (SI)")
+    p.add_argument("file", help="OpenFAST / FAST output file: .out text or .outb binary (FileID 1-4)")
+    p.add_argument("--bearing", choices=("pitch", "yaw"), required=True)
+    p.add_argument("--blade", type=int, default=1, metavar="K", help="blade whose pitch bearing (default 1)")
+    p.add_argument("--mounting", default=None,
+                   help="which way the bearing's +z axis points: pitch 'tip' (default) or 'hub', yaw 'up' (default) "
+                        "or 'down' (docs/openfast.md)")
+    p.add_argument("--frame", choices=("rotating", "fixed"), default="rotating",
+                   help="frame of Fx..My: the moving ring's (blade, nacelle; default) or the fixed ring's (hub, tower)")
+    p.add_argument("--source", default="auto",
+                   help="channels to use: pitch 'b' or 'c', yaw 'p' or 'n' (default: the first complete set)")
+    p.add_argument("--start", type=_finite_float, default=None, metavar="s", help="start of the time window")
+    p.add_argument("--end", type=_finite_float, default=None, metavar="s", help="end of the time window")
+    p.add_argument("-o", "--output", required=True, help="CSV to write: time,Fx,Fy,Fz,Mx,My,Mz,psi,omega (SI)")
+    p.set_defaults(func=_run_loads)
+
+
+def _run_loads(args) -> int:
+    from .aeroelastic import bearing_channels, bearing_loads
+    from .openfast import read_output
+
+    output = read_output(args.file)
+    series = bearing_loads(output, args.bearing, args.blade, args.mounting, args.start, args.end,
+                           frame=args.frame, source=args.source)
+    used = bearing_channels(output, args.bearing, args.blade, args.source)
+    what = f"pitch bearing of blade {args.blade}" if args.bearing == "pitch" else "yaw bearing"
+    mounting = args.mounting or ("tip" if args.bearing == "pitch" else "up")
+    rate = used["rate"] or f"the rate of {used['angle']}"
+    series.write_csv(args.output, comments=(
+        f"slewing loads: {what} from {args.file}",
+        f"channels: {', '.join(used['loads'])} ({used['frame']} frame), psi from {used['angle']}, omega from {rate}",
+        f"mounting = {mounting} (docs/openfast.md); SI units: N, N m, rad, rad/s; Mz opposes positive psi",
+    ))
+    print(f"wrote {args.output}: {what}, {series.time.size} rows, t = {series.time[0]:g} .. {series.time[-1]:g} s, "
+          f"{args.frame} frame, from {', '.join(used['loads'])} and {used['angle']}")
+    return 0
+
+
+#: a negative number argparse would take for an option (it only knows ``-5`` and ``-.5``, not ``-1e5``)
+_NEGATIVE_NUMBER = re.compile(r"^-((\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|inf|infinity|nan)$", re.IGNORECASE)
+
+
+def _attach_negative_numbers(argv: list) -> list:
+    """``--fz -1e5`` -> ``--fz=-1e5``, so that every numeric option takes a negative value."""
+    out = []
+    for i, token in enumerate(argv):
+        if token == "--":
+            return out + argv[i:]
+        previous = out[-1] if out else ""
+        if _NEGATIVE_NUMBER.match(token) and previous.startswith("--") and previous != "--" and "=" not in previous:
+            out[-1] = f"{previous}={token}"
+        else:
+            out.append(token)
+    return out
+
+
+def _stdout_is_broken() -> bool:
+    """True when nobody reads our standard output any more (a closed pipe)."""
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(event & select.POLLERR for _, event in poller.poll(0))
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
+    argv = _attach_negative_numbers(sys.argv[1:] if argv is None else list(argv))
     parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_solve(sub)
     _add_plot(sub)
     _add_superelement(sub, wanted=bool(argv) and argv[0] == "superelement")
+    _add_loads(sub)
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()
+        return code
+    except BrokenPipeError:
+        if not _stdout_is_broken():
+            raise
+        # the reader went away (`slewing solve ... | head`): stop quietly, with the status of a command
+        # ended by SIGPIPE; stdout goes to /dev/null so that the interpreter's last flush does not fail
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except (BearingDefinitionError, NoEquilibriumError, ValueError) as exc:
         print(f"slewing {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a file that cannot be read or written: one line naming it
+        reason = f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc)
+        print(f"slewing {args.command}: error: {reason}", file=sys.stderr)
         return 2
 
 
