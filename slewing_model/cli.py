@@ -203,6 +203,15 @@ def _stdout_is_broken() -> bool:
         return False
 
 
+def _add_batch(sub) -> None:
+    """``slewing batch STUDY.toml -o DIR [--workers N] [--scheduler ADDRESS]`` (slewing_model.study; Dask)."""
+    from .study import command
+
+    p = sub.add_parser("batch", help="run a study of many cases (load series x bearing variants) on Dask")
+    command.add_arguments(p)
+    p.set_defaults(func=command.run)
+
+
 def main(argv=None) -> int:
     argv = _attach_negative_numbers(sys.argv[1:] if argv is None else list(argv))
     parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
@@ -210,6 +219,7 @@ def main(argv=None) -> int:
     _add_solve(sub)
     _add_plot(sub)
     _add_superelement(sub, wanted=bool(argv) and argv[0] == "superelement")
+    _add_batch(sub)
     _add_loads(sub)
     args = parser.parse_args(argv)
     try:

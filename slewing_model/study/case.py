@@ -1,0 +1,242 @@
+"""One case of a study: a bearing variant stepped through a load series.
+
+:func:`run_case` is what a Dask worker runs. It takes everything it needs in its
+argument (the bearing, its superelement, the load series: no files, so a worker
+on another machine needs only the package), steps
+:class:`slewing_model.simulator.BearingSimulator` -- the simulator the FMU runs --
+through the series with the recorded motion, and returns the time series, the
+statistics and the per-ball load spectrum. A case that cannot be computed (a load
+beyond the bearing's capacity, no equilibrium, a bad input) comes back with its
+reason in ``status`` instead of raising, so that the other cases finish.
+
+Statistics (SI units)
+    ``friction_torque_mean``, ``friction_torque_max``, ``friction_torque_p99``: of the
+    full-sliding friction torque magnitude ``T`` (what the drive must overcome when it
+    moves), mean weighted by time (trapezoidal rule);
+    ``friction_energy``: ``integral |T omega| dt`` (J, trapezoidal rule), the work the
+    drive spends against friction over the motion; ``rotation``: ``integral |omega| dt``;
+    ``max_ball_load`` (N), ``max_contact_pressure`` (Pa), ``min_static_safety_factor``
+    (ISO 76); ``equivalent_ball_load``: the largest, over balls and diagonals, of the
+    cubic mean ``(sum v Q^3 / sum v)^(1/3)`` of the diagonal load ``Q`` weighted by
+    the ring rotation ``v = |omega| dt`` (by time when the ring stands still), the
+    dynamic equivalent load of the rolling-contact life formula.
+
+Load spectrum (for a life calculation)
+    Per ball and diagonal (``13``: contacts 1 and 3; ``24``: 2 and 4), the time and
+    the ring rotation spent with the diagonal load in each of ``histogram_bins``
+    equal bins from 0 to the case's largest diagonal load.
+"""
+from __future__ import annotations
+
+import math
+import os
+import socket
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .series import MotionSeries
+
+#: the columns of a case's time series
+TIMESERIES_COLUMNS = ("time", "psi", "omega", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "x", "y", "z", "rx", "ry",
+                      "friction_torque", "friction_torque_magnitude", "max_ball_load", "max_contact_pressure",
+                      "static_safety_factor", "balls_in_four_point_contact")
+STATISTICS = ("friction_torque_mean", "friction_torque_max", "friction_torque_p99", "friction_energy",
+              "max_ball_load", "max_contact_pressure", "min_static_safety_factor", "equivalent_ball_load",
+              "rotation", "duration", "steps")
+HISTOGRAM_COLUMNS = ("ball", "diagonal", "load_lower_N", "load_upper_N", "time_s", "rotation_rad")
+
+
+@dataclass(frozen=True)
+class CaseTask:
+    """What a worker needs to run one case (picklable, no file names).
+
+    Attributes
+    ----------
+    key : str
+    bearing : Bearing
+        As read from its file (with its own errors, if any).
+    superelement : Superelement or None
+        For ``variant["ring_model"] == "flexible"``; built once per bearing variant.
+    series : MotionSeries
+    variant : dict
+        ``ring_model``, ``preload_um``, ``friction_coefficient``, ``error_seed``, ``synthetic_errors``.
+    simulation : dict
+        See :data:`slewing_model.study.definition.SIMULATION_DEFAULTS`.
+    """
+
+    key: str
+    bearing: object
+    superelement: object
+    series: MotionSeries
+    variant: dict
+    simulation: dict
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    """What a case returns.
+
+    Attributes
+    ----------
+    key : str
+    status : str
+        ``"ok"`` or the error in one line.
+    elapsed : float, s
+        Wall time of the case on its worker.
+    worker : str
+        ``host:pid`` of the process that ran it.
+    timeseries : ndarray (n, len(TIMESERIES_COLUMNS)) or None
+    statistics : dict or None
+    histogram : ndarray (m, len(HISTOGRAM_COLUMNS)) or None
+    """
+
+    key: str
+    status: str
+    elapsed: float
+    worker: str
+    timeseries: np.ndarray | None = None
+    statistics: dict | None = None
+    histogram: np.ndarray | None = None
+
+
+def one_line(exc: BaseException) -> str:
+    """``Type: first line of the message``."""
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0] if text else ''}".rstrip(": ")
+
+
+def case_bearing(bearing, variant: dict):
+    """The bearing of a variant: the file's, or with the seeded synthetic errors."""
+    seed = variant.get("error_seed")
+    if seed is None:
+        return bearing
+    from ..errors import errors_from_table
+
+    params = variant.get("synthetic_errors")
+    if params is None:
+        source = (bearing.source or {}).get("errors", {}) if isinstance(bearing.source, dict) else {}
+        params = source.get("synthetic") if isinstance(source, dict) else None
+        if params is None:
+            raise ValueError(f"bearings.error_seeds = {seed}: the study gives no [bearings.synthetic_errors] and "
+                             f"the bearing file {bearing.name!r} has no [errors.synthetic] table")
+        params = {k: v for k, v in params.items() if k != "seed"}
+    errors = errors_from_table({"synthetic": {**params, "seed": int(seed)}}, ".", bearing.ball_count)
+    return bearing.with_errors(errors)
+
+
+def simulator_for(task: CaseTask):
+    """The :class:`BearingSimulator` of a case."""
+    from ..simulator import BearingSimulator, SimulatorSettings
+
+    v, s = task.variant, task.simulation
+    bearing = case_bearing(task.bearing, v)
+    settings = SimulatorSettings(
+        ring_model=v["ring_model"], moving_ring=s.get("moving_ring") or bearing.moving_ring,
+        load_frame=task.series.load_frame,
+        preload=None if v.get("preload_um") is None else v["preload_um"] * 1e-6,
+        friction_coefficient=v["friction_coefficient"], seal_torque=s["seal_torque_Nm"], tolerance=s["tolerance"],
+        omega_regularisation=s["omega_regularisation_rad_s"], friction_tolerance=s["friction_tolerance"])
+    return BearingSimulator(bearing, task.superelement if v["ring_model"] == "flexible" else None, settings)
+
+
+def run_case(task: CaseTask) -> CaseResult:
+    """Step one case through its series (see the module docstring). Never raises for a
+    case that cannot be computed: its ``status`` says why."""
+    from ..bime import Loads
+
+    start = time.perf_counter()
+    worker = f"{socket.gethostname()}:{os.getpid()}"
+    series = task.series
+    n = series.time.size
+    k = -1
+    try:
+        sim = simulator_for(task)
+        out = np.empty((n, len(TIMESERIES_COLUMNS)))
+        out[:, 0], out[:, 1], out[:, 2], out[:, 3:9] = series.time, series.psi, series.omega, series.loads
+        diagonal = np.empty((n, sim.bearing.ball_count, 2), dtype=np.float32)
+        for k in range(n):
+            r = sim.step(Loads.from_array(series.loads[k, :5]), float(series.psi[k]), float(series.omega[k]))
+            d = r.distribution
+            out[k, 9:14] = d.displacement
+            out[k, 14:] = (r.friction_torque, r.friction_torque_magnitude, d.max_ball_load, d.max_contact_pressure,
+                           d.static_safety_factor, d.balls_in_four_point_contact)
+            q = d.contact_load
+            diagonal[k, :, 0] = np.maximum(q[:, 0], q[:, 2])
+            diagonal[k, :, 1] = np.maximum(q[:, 1], q[:, 3])
+    except Exception as exc:  # noqa: BLE001 - every failure of a case is its result
+        where = f" at t = {series.time[k]:.6g} s (step {k + 1} of {n})" if k >= 0 else ""
+        return CaseResult(task.key, one_line(exc).replace(": ", f"{where}: ", 1) if where else one_line(exc),
+                          time.perf_counter() - start, worker)
+    stats, histogram = statistics(out, diagonal, task.simulation["histogram_bins"])
+    return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram)
+
+
+def time_weights(t: np.ndarray) -> np.ndarray:
+    """Trapezoidal-rule weights of samples at times ``t`` (they sum to ``t[-1] - t[0]``)."""
+    dt = np.diff(t)
+    w = np.zeros_like(t)
+    w[:-1] += dt / 2
+    w[1:] += dt / 2
+    return w
+
+
+def _nice_ceiling(x: float) -> float:
+    """The smallest of 1, 2, 2.5, 5 times a power of ten that is >= x (> 0)."""
+    if x <= 0:
+        return 1.0
+    p = 10.0 ** math.floor(math.log10(x))
+    for m in (1.0, 2.0, 2.5, 5.0, 10.0):
+        if m * p >= x * (1 - 1e-12):
+            return m * p
+    return 10.0 * p  # pragma: no cover
+
+
+def statistics(out: np.ndarray, diagonal: np.ndarray, bins: int) -> tuple[dict, np.ndarray]:
+    """Statistics and load spectrum of a stepped case (see the module docstring).
+
+    Parameters
+    ----------
+    out : ndarray (n, len(TIMESERIES_COLUMNS))
+    diagonal : ndarray (n, B, 2), N
+        Load of each ball's two diagonals at each step.
+    bins : int
+    """
+    col = {c: out[:, j] for j, c in enumerate(TIMESERIES_COLUMNS)}
+    w = time_weights(col["time"])
+    torque = col["friction_torque_magnitude"]
+    speed = np.abs(col["omega"])
+    duration = float(w.sum())
+    stats = {
+        "friction_torque_mean": float(np.dot(w, torque) / duration),
+        "friction_torque_max": float(torque.max()),
+        "friction_torque_p99": float(np.percentile(torque, 99)),
+        "friction_energy": float(np.dot(w, torque * speed)),
+        "max_ball_load": float(col["max_ball_load"].max()),
+        "max_contact_pressure": float(col["max_contact_pressure"].max()),
+        "min_static_safety_factor": float(col["static_safety_factor"].min()),
+        "rotation": float(np.dot(w, speed)),
+        "duration": duration,
+        "steps": int(out.shape[0]),
+    }
+    v = w * speed if np.dot(w, speed) > 0 else w
+    q = diagonal.astype(float)
+    cubic = np.einsum("k,kbd->bd", v, q ** 3) / v.sum()
+    stats["equivalent_ball_load"] = float(np.cbrt(cubic).max())
+
+    top = _nice_ceiling(float(q.max()))
+    edges = np.linspace(0.0, top, bins + 1)
+    index = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, bins - 1)        # (n, B, 2)
+    n, balls, _ = q.shape
+    time_at = np.zeros((balls, 2, bins))
+    rotation_at = np.zeros((balls, 2, bins))
+    b_idx = np.broadcast_to(np.arange(balls)[None, :, None], index.shape)
+    d_idx = np.broadcast_to(np.arange(2)[None, None, :], index.shape)
+    wk = np.broadcast_to(w[:, None, None], index.shape)
+    np.add.at(time_at, (b_idx, d_idx, index), wk)
+    np.add.at(rotation_at, (b_idx, d_idx, index), wk * speed[:, None, None])
+    b, d, j = np.nonzero(time_at > 0)
+    histogram = np.column_stack([b + 1, np.where(d == 0, 13, 24), edges[j], edges[j + 1], time_at[b, d, j],
+                                 rotation_at[b, d, j]])
+    return stats, histogram

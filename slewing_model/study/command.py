@@ -1,0 +1,31 @@
+"""``slewing batch STUDY.toml -o DIR [--workers N] [--scheduler ADDRESS]``: run a study."""
+from __future__ import annotations
+
+import sys
+
+
+def add_arguments(p) -> None:
+    p.add_argument("study", help="study file (TOML): load series x bearing variants")
+    p.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="output directory: summary.csv, cases/<key>/, figures/ (finished cases are skipped)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="worker processes of the embedded Dask LocalCluster (default: one per core)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="submit to an existing Dask cluster (e.g. tcp://host:8786) instead")
+    p.add_argument("--retry-failed", action="store_true", help="run again the cases that finished with an error")
+    p.add_argument("--no-figures", action="store_true", help="do not write figures/*.png")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args) -> int:
+    from .engine import run_study
+
+    report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
+                       progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures)
+    ok = report.cases - len(report.failed)
+    print(f"{report.cases} cases: {ok} ok, {len(report.failed)} failed; {len(report.ran)} run now "
+          f"({report.wall_time:.1f} s{', ' + report.cluster if report.cluster else ''}), "
+          f"{len(report.skipped)} already finished. Summary: {report.summary}")
+    for key, status in report.failed.items():
+        print(f"  {key}: {status}", file=sys.stderr)
+    return 0 if not report.failed else 1

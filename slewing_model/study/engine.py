@@ -1,0 +1,334 @@
+"""Running a study on Dask distributed, and its output directory.
+
+:func:`run_study` expands the study into cases, skips those already finished in
+the output directory (keyed by the case hash), reads every load series and bearing
+once, builds each flexible bearing's superelement once (on the client, through the
+on-disk cache of :func:`slewing_model.superelement.build_superelement`), and submits
+one task per case to a Dask cluster: by default an embedded ``LocalCluster`` of
+worker processes (one per core), or an existing cluster given by its scheduler
+address. Each task carries its bearing, superelement and load series, so workers
+need neither the files nor a superelement build. The client writes each result as
+it arrives; a worker that dies mid-run has its tasks rescheduled by Dask on the
+others.
+
+Output directory::
+
+    DIR/summary.csv                    one row per case (case, status, statistics, parameters)
+    DIR/cases/<key>/case.json          the case: name, load series, bearing variant, settings
+    DIR/cases/<key>/timeseries.csv     see slewing_model.study.case.TIMESERIES_COLUMNS (SI)
+    DIR/cases/<key>/ball_load_histogram.csv   ball, diagonal, load bin, time, rotation
+    DIR/cases/<key>/result.json        status, statistics, wall time, worker (written last)
+    DIR/figures/*.png                  see slewing_model.study.figures
+
+A case whose ``result.json`` exists is finished: a rerun skips it (failed cases
+too, unless ``retry_failed``). A case lost to the cluster itself (e.g. a task whose
+workers died more than Dask's ``allowed-failures`` times) is listed in the summary
+with that error but not marked finished, so a rerun tries it again.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import logging
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, one_line, run_case
+from .definition import Case, Study, load_study
+from .series import load_series
+
+REQUIRED_COLUMNS = ("case", "status", "friction_torque_mean", "friction_torque_max", "max_ball_load",
+                    "min_static_safety_factor")
+SUMMARY_COLUMNS = REQUIRED_COLUMNS + tuple(s for s in STATISTICS if s not in REQUIRED_COLUMNS) + (
+    "name", "load", "blade", "bearing", "ring_model", "preload_um", "friction_coefficient", "error_seed",
+    "elapsed_s", "worker")
+
+
+@dataclass
+class StudyReport:
+    """What :func:`run_study` did.
+
+    Attributes
+    ----------
+    cases : int
+    skipped : list of str
+        Keys of the cases found finished in the output directory.
+    ran : list of str
+        Keys of the cases computed now (ok or failed).
+    failed : dict
+        Key -> status of every case that is not ``ok`` (this run or before).
+    summary : str
+        Path of ``summary.csv``.
+    rows : list of dict
+        The rows of ``summary.csv``.
+    wall_time : float, s
+        From the first submission to the last result (0 when nothing was submitted).
+    cluster : str
+        What ran it.
+    """
+
+    cases: int
+    skipped: list = field(default_factory=list)
+    ran: list = field(default_factory=list)
+    failed: dict = field(default_factory=dict)
+    summary: str = ""
+    rows: list = field(default_factory=list)
+    wall_time: float = 0.0
+    cluster: str = ""
+
+
+def case_dir(out_dir: str, key: str) -> str:
+    return os.path.join(out_dir, "cases", key)
+
+
+def read_result(out_dir: str, key: str) -> dict | None:
+    """The ``result.json`` of a finished case, or None."""
+    path = os.path.join(case_dir(out_dir, key), "result.json")
+    try:
+        with open(path) as fh:
+            data = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    return data if data.get("key") == key else None
+
+
+def _write_json(path: str, data) -> None:
+    tmp = path + ".tmp"
+    with open(tmp, "w") as fh:
+        json.dump(data, fh, indent=1, sort_keys=True)
+    os.replace(tmp, path)
+
+
+def write_case(out_dir: str, case: Case, result: CaseResult) -> dict:
+    """Write a case's files (``result.json`` last: the mark that it is finished); return the record."""
+    folder = case_dir(out_dir, case.key)
+    os.makedirs(folder, exist_ok=True)
+    _write_json(os.path.join(folder, "case.json"), {"key": case.key, "index": case.index, "name": case.name,
+                                                    "load": case.load, "variant": case.variant,
+                                                    "simulation": case.simulation, "spec": case.spec})
+    if result.timeseries is not None:
+        np.savetxt(os.path.join(folder, "timeseries.csv"), result.timeseries, delimiter=",", fmt="%.10g",
+                   header=",".join(TIMESERIES_COLUMNS), comments="")
+    if result.histogram is not None:
+        np.savetxt(os.path.join(folder, "ball_load_histogram.csv"), result.histogram, delimiter=",",
+                   fmt=["%d", "%d", "%.6g", "%.6g", "%.10g", "%.10g"], header=",".join(HISTOGRAM_COLUMNS),
+                   comments="")
+    record = {"key": case.key, "name": case.name, "status": result.status, "elapsed_s": result.elapsed,
+              "worker": result.worker, "statistics": result.statistics}
+    _write_json(os.path.join(folder, "result.json"), record)
+    return record
+
+
+def summary_row(case: Case, record: dict | None, status: str | None = None) -> dict:
+    """One row of ``summary.csv``."""
+    v, load = case.variant, case.load
+    row = {c: "" for c in SUMMARY_COLUMNS}
+    row.update(case=case.key, name=case.name, load=load["name"], blade=load.get("blade", ""),
+               bearing=os.path.basename(v["file"]), ring_model=v["ring_model"],
+               preload_um="" if v["preload_um"] is None else v["preload_um"],
+               friction_coefficient=v["friction_coefficient"],
+               error_seed="" if v["error_seed"] is None else v["error_seed"])
+    if record is not None:
+        row.update(status=record["status"], elapsed_s=f"{record['elapsed_s']:.4g}", worker=record["worker"])
+        for k, value in (record.get("statistics") or {}).items():
+            if k in row:
+                row[k] = value if isinstance(value, int) else f"{value:.10g}"
+    if status is not None:
+        row["status"] = status
+    row["status"] = " ".join(str(row["status"]).split())   # one line
+    return row
+
+
+def write_summary(path: str, rows: list[dict]) -> None:
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=SUMMARY_COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, path)
+
+
+# ---- preparation on the client ---------------------------------------------------------------
+
+class _Prepared:
+    """Load series, bearings and superelements, each read or built once."""
+
+    def __init__(self, simulation: dict):
+        self.simulation = simulation
+        self._series: dict = {}
+        self._bearings: dict = {}
+        self._superelements: dict = {}
+
+    @staticmethod
+    def _once(cache: dict, key, make):
+        if key not in cache:
+            try:
+                cache[key] = (make(), None)
+            except Exception as exc:  # noqa: BLE001 - becomes the failure of the cases that need it
+                cache[key] = (None, exc)
+        value, error = cache[key]
+        if error is not None:
+            raise error
+        return value
+
+    def series(self, load: dict):
+        return self._once(self._series, json.dumps(load, sort_keys=True), lambda: load_series(load))
+
+    def bearing(self, path: str):
+        from ..geometry import load_bearing
+
+        return self._once(self._bearings, path, lambda: load_bearing(path))
+
+    def superelement(self, path: str):
+        def build():
+            try:
+                from ..superelement import build_superelement
+            except ImportError as exc:
+                raise ValueError(f"flexible rings need the superelement builder (scipy, scikit-fem): {exc}") from None
+            return build_superelement(self.bearing(path), mesh=self.simulation["mesh"], bc=self.simulation["bc"])
+
+        return self._once(self._superelements, path, build)
+
+    def task(self, case: Case) -> CaseTask:
+        v = case.variant
+        try:
+            bearing = self.bearing(v["file"])
+        except Exception as exc:  # noqa: BLE001
+            raise ValueError(f"bearing file: {exc}") from None
+        try:
+            series = self.series(case.load)
+        except Exception as exc:  # noqa: BLE001
+            raise ValueError(f"load series: {exc}") from None
+        superelement = self.superelement(v["file"]) if v["ring_model"] == "flexible" else None
+        return CaseTask(case.key, bearing, superelement, series, v, case.simulation)
+
+
+# ---- the run ------------------------------------------------------------------------------------
+
+def _client(workers: int | None, scheduler: str | None):
+    """A Dask client and what to close afterwards."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        if workers is not None:
+            raise ValueError(f"--workers {workers}: applies to the embedded cluster only, not with --scheduler")
+        client = Client(scheduler)
+        return client, [client], f"Dask cluster at {scheduler}"
+    n = (os.cpu_count() or 1) if workers is None else workers
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ValueError(f"--workers {workers!r}: must be a whole number >= 1")
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    client = Client(cluster)
+    return client, [client, cluster], f"embedded LocalCluster, {n} worker process{'es' if n > 1 else ''}"
+
+
+def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, workers: int | None = None,
+              scheduler: str | None = None, client=None, progress: bool = True, retry_failed: bool = False,
+              figures: bool = True, on_result=None) -> StudyReport:
+    """Run every case of a study that is not finished in ``out_dir``.
+
+    Parameters
+    ----------
+    study : Study or path
+        A :class:`~.definition.Study` or a study file.
+    out_dir : path
+        Output directory (created).
+    workers : int, optional
+        Worker processes of the embedded ``LocalCluster`` (default: one per core).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:8786``) to submit to instead.
+    client : distributed.Client, optional
+        An existing client (tests); neither ``workers`` nor ``scheduler`` then.
+    progress : bool
+        Show a progress bar over the cases.
+    retry_failed : bool
+        Run again the cases that finished with an error.
+    figures : bool
+        Write ``figures/*.png`` (needs matplotlib).
+    on_result : callable, optional
+        ``on_result(case, record, client)`` after each result is written (tests, monitoring).
+
+    Returns
+    -------
+    StudyReport
+    """
+    if not isinstance(study, Study):
+        study = load_study(study)
+    out_dir = os.fspath(out_dir)
+    os.makedirs(os.path.join(out_dir, "cases"), exist_ok=True)
+    cases = study.cases()
+    report = StudyReport(len(cases), summary=os.path.join(out_dir, "summary.csv"))
+    records: dict[str, dict] = {}
+    lost: dict[str, str] = {}
+    pending = []
+    for case in cases:
+        record = read_result(out_dir, case.key)
+        if record is not None and (record["status"] == "ok" or not retry_failed):
+            records[case.key] = record
+            report.skipped.append(case.key)
+        else:
+            pending.append(case)
+
+    prepared = _Prepared(study.simulation)
+    tasks = []
+    for case in pending:
+        try:
+            tasks.append((case, prepared.task(case)))
+        except Exception as exc:  # noqa: BLE001 - a bad file fails its cases, not the study
+            records[case.key] = write_case(out_dir, case, CaseResult(case.key, one_line(exc), 0.0, "client"))
+            report.ran.append(case.key)
+
+    if tasks:
+        from distributed import as_completed
+
+        owned = []
+        if client is None:
+            client, owned, report.cluster = _client(workers, scheduler)
+        else:
+            report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(cases), initial=len(cases) - len(tasks), desc=study.name, unit="case")
+        try:
+            by_key = {}
+            start = time.perf_counter()
+            futures = []
+            for case, task in tasks:
+                future = client.submit(run_case, task, key=f"slewing-case-{case.key}", pure=False)
+                by_key[future.key] = case
+                futures.append(future)
+            for future in as_completed(futures):
+                case = by_key[future.key]
+                try:
+                    result = future.result()
+                except Exception as exc:  # noqa: BLE001 - lost to the cluster: not marked finished
+                    lost[case.key] = f"not finished: {one_line(exc)}"
+                else:
+                    records[case.key] = write_case(out_dir, case, result)
+                    if on_result is not None:
+                        on_result(case, records[case.key], client)
+                report.ran.append(case.key)
+                future.release()
+                if bar is not None:
+                    bar.update(1)
+            report.wall_time = time.perf_counter() - start
+        finally:
+            if bar is not None:
+                bar.close()
+            for thing in owned:
+                thing.close()
+
+    report.rows = [summary_row(c, records.get(c.key), lost.get(c.key)) for c in cases]
+    report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
+    write_summary(report.summary, report.rows)
+    if figures:
+        from .figures import study_figures
+
+        study_figures(out_dir, cases, report.rows)
+    return report
