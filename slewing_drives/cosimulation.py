@@ -61,7 +61,7 @@ class ManoeuvreResult:
 
 def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, *, t_end: float, dt: float,
                   start_values: dict | None = None, friction: bool = True, progress: bool = False,
-                  logger=None) -> ManoeuvreResult:
+                  logger=None, coupling: str = "sequential") -> ManoeuvreResult:
     """Co-simulate ``drive`` with the bearing FMU under ``loads`` following ``command(t)`` (rad).
 
     Parameters
@@ -84,6 +84,22 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
     logger : callable, optional
         Called with every FMU log message (str); the last ones are also quoted
         in the error raised when the co-simulation fails.
+    coupling : {"sequential", "parallel", "parallel-zero-start"}
+        Order of the exchanges within a communication step.
+
+        * ``"sequential"`` (default): the bearing steps first, and the drive
+          uses the friction torque the bearing has just returned for this step
+          (Gauss-Seidel).
+        * ``"parallel"``: the drive and the bearing step side by side on the
+          values of the last communication point (Jacobi), as the SSP hosts
+          libcosim and ecos do: the drive uses the friction torque of the
+          bearing's previous step (at the first step, the one the bearing
+          returned after its initialisation with the first loads).
+        * ``"parallel-zero-start"``: ``"parallel"``, but every exchanged value
+          is 0 in the first step and during the bearing's initialisation (the
+          drive holds a load moment of 0), as fmpy 0.3.32's ``simulate_ssp``
+          does: it starts every connection at 0 and exchanges values only after
+          each step.
 
     Returns
     -------
@@ -112,11 +128,14 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
     time = np.arange(steps) * dt
     out = {name: np.empty(steps) for name in OUTPUTS}
     angle, speed, motor, ring, mz, cmd = (np.empty(steps) for _ in range(6))
+    if coupling not in ("sequential", "parallel", "parallel-zero-start"):
+        raise ValueError(f"coupling = {coupling!r}: must be 'sequential', 'parallel' or 'parallel-zero-start'")
+    zero_start = coupling == "parallel-zero-start"
     values = dict(start_values or {})
     if not friction:
         values.update(friction_coefficient=0.0, seal_torque=0.0)
     sim = ElectricDrive(drive)
-    sim.hold(loads.at(0.0)[5])
+    sim.hold(0.0 if zero_start else loads.at(0.0)[5])
     k = 0
     try:
         fmu.instantiate(loggingOn=True, callbacks=callbacks)
@@ -124,8 +143,12 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
         for name, value in values.items():
             (fmu.setInteger if types[name] == "Integer" else fmu.setReal)([refs[name]], [value])
         fmu.enterInitializationMode()
-        _set_inputs(fmu, refs, loads.at(0.0), sim.state.angle, sim.state.speed)
+        if not zero_start:
+            _set_inputs(fmu, refs, loads.at(0.0), sim.state.angle, sim.state.speed)
         fmu.exitInitializationMode()
+        held = 0.0  # parallel coupling: the bearing's friction torque at the last communication point
+        if coupling == "parallel":
+            held = fmu.getReal([refs["friction_torque_magnitude"]])[0]
         iterator = range(steps)
         if progress:
             from tqdm import tqdm
@@ -134,13 +157,17 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
         out_refs = [refs[n] for n in OUTPUTS]
         for k in iterator:
             t = time[k]
-            load = loads.at(t)
+            first_zero = zero_start and k == 0
+            load = np.zeros(6) if first_zero else loads.at(t)
             _set_inputs(fmu, refs, load, sim.state.angle, sim.state.speed)
             fmu.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
             for name, value in zip(OUTPUTS, fmu.getReal(out_refs)):
                 out[name][k] = value
-            cmd[k] = command(t)
-            s = sim.step(cmd[k], dt, load_torque=load[5], friction_torque=out["friction_torque_magnitude"][k])
+            cmd[k] = 0.0 if first_zero else command(t)
+            friction_torque = out["friction_torque_magnitude"][k]
+            if coupling != "sequential":
+                friction_torque, held = held, friction_torque
+            s = sim.step(cmd[k], dt, load_torque=load[5], friction_torque=friction_torque)
             angle[k], speed[k], motor[k], ring[k], mz[k] = (s.angle, s.speed, s.mean_motor_torque,
                                                            drive.torque_gain * s.mean_motor_torque, load[5])
         fmu.terminate()
