@@ -52,7 +52,7 @@ REAL_PARAMETERS = [
     ("preload", "m", "ball preload (oversize; < 0 for clearance)", False, None),
     ("friction_coefficient", "1", "Coulomb friction coefficient of the raceway contacts (0: off)", True, 0.1),
     ("seal_torque", "N.m", "load-independent friction torque (seals, grease)", True, 0.0),
-    ("tolerance", "1", "relative tolerance of the load distribution solver", False, 1e-9),
+    ("tolerance", "1", "relative tolerance of the load distribution solver (residual forces over the load scale)", False, 1e-7),
     ("omega_regularisation", "rad/s",
      "speed over which friction_torque rises to its full-sliding level (tanh); "
      "at least magnitude * step / inertia for an explicit coupling", True, 1e-4),

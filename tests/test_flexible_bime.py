@@ -7,6 +7,7 @@ from slewing_model import BimeSolver, Loads, load_bearing, solve
 from slewing_model.superelement import build_superelement
 
 from conftest import BEARINGS
+from statics import load_on_moving_ring
 
 
 @pytest.fixture(scope="module")
@@ -51,26 +52,10 @@ def test_axial_stiffness_clamped_near_rigid_free_softer(table1, table1_rings):
         assert z_free > 1.5 * z_rigid
 
 
-def _load_on_moving_ring(bearing, result):
-    """Forces and moments of the contacts on the moving (inner) ring, summed independently of the
-    solver from Q, the contact angles and the nominal groove-centre positions (eq 23 statics)."""
-    centres = bearing.groove_centres               # (4, 2) nominal (R, z)
-    phi = result.ball_angle
-    total = np.zeros(5)
-    for diagonal, (inner_contact, zsign) in enumerate(((3, 1.0), (2, -1.0))):
-        q, alpha = result.contact_load[:, diagonal], result.contact_angle[:, diagonal]
-        fr, fz = -q * np.cos(alpha), -zsign * q * np.sin(alpha)   # outer ring on inner ring
-        r, z = centres[inner_contact - 1]
-        fx, fy = fr * np.cos(phi), fr * np.sin(phi)
-        px, py = r * np.cos(phi), r * np.sin(phi)
-        total += [fx.sum(), fy.sum(), fz.sum(), (py * fz - z * fy).sum(), (z * fx - px * fz).sum()]
-    return -total  # the applied load balances the contact forces
-
-
 @pytest.mark.parametrize("loads", [Loads(Fz=3e4), Loads(Fx=2e4, Fz=1e4, Mx=2e3, My=-1e3)])
 def test_contact_forces_balance_the_applied_load(table3_errors, table3_free, loads):
     r = solve(table3_errors.with_preload(10e-6), loads, model="flexible", superelement=table3_free)
-    got = _load_on_moving_ring(table3_errors, r)
+    got = load_on_moving_ring(table3_errors, r)
     scale = np.abs(loads.as_array() * [1, 1, 1, 2 / 0.541, 2 / 0.541]).max()
     assert np.allclose(got * [1, 1, 1, 2 / 0.541, 2 / 0.541], loads.as_array() * [1, 1, 1, 2 / 0.541, 2 / 0.541],
                        atol=1e-6 * scale)
@@ -110,14 +95,14 @@ def test_radial_load_has_no_spurious_circumferential_stiffness(table3_errors, ta
     se = build_superelement(bearing, mesh="coarse", bc="free")
     for fx in (2e4, 4e4):
         r = solve(bearing, Loads(Fx=fx), model="flexible", superelement=se)
-        got = _load_on_moving_ring(bearing, r)
+        got = load_on_moving_ring(bearing, r)
         assert got[0] == pytest.approx(fx, rel=1e-6)
         assert abs(got[1]) < 1e-6 * fx and abs(r.displacement[1]) < 1e-9 * abs(r.displacement[0])
     # radial stiffness from two solutions equals the radial load over the displacement increment
     r1 = solve(bearing, Loads(Fx=2e4), model="flexible", superelement=se)
     r2 = solve(bearing, Loads(Fx=2.02e4), model="flexible", superelement=se)
     k_secant = (2.02e4 - 2e4) / (r2.displacement[0] - r1.displacement[0])
-    f1, f2 = _load_on_moving_ring(bearing, r1)[0], _load_on_moving_ring(bearing, r2)[0]
+    f1, f2 = load_on_moving_ring(bearing, r1)[0], load_on_moving_ring(bearing, r2)[0]
     assert (f2 - f1) / (r2.displacement[0] - r1.displacement[0]) == pytest.approx(k_secant, rel=1e-5)
 
 

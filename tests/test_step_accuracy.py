@@ -1,0 +1,81 @@
+"""The co-simulation step answers as exactly as a tight solve (issue 12: speed is not bought with accuracy).
+
+Short versions of the benchmark cases (`benchmarks/cases.py`: the 150-ball pitch bearing pitching
+under the blade-root series, the 180-ball yaw bearing yawing in bursts under the tower-top series,
+table3 with errors under a heavy combined load, turning) are stepped with the simulator's default
+settings, which are the FMU's, and every step is compared with a separate simulator solving the
+same inputs to tolerances near the round-off floor (:data:`TIGHT`, :data:`TIGHT_FRICTION`).
+The coarse superelement keeps the test short; the solver does not depend on the mesh.
+"""
+import sys
+
+import numpy as np
+import pytest
+
+from slewing_model import Loads, load_bearing
+from slewing_model.assembly import assemble
+from slewing_model.simulator import BearingSimulator, SimulatorSettings
+from slewing_model.superelement import build_superelement
+
+from conftest import ROOT
+from statics import load_on_moving_ring
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from cases import CASES  # noqa: E402
+
+#: relative accuracy asked of every output at every step, and the absolute floor of each output
+#: where it passes through zero (the tilts change sign; the torque is 0 while a yaw drive rests)
+RTOL = 1e-4
+FLOOR = {"z": 1e-9, "rx": 1e-9, "ry": 1e-9, "max_ball_load": 1e-3, "friction_torque": 1e-3}  # m, rad, N, N m
+STEPS = 60
+#: the reference: residuals near the round-off floor (~1e-12 of the load scale), ball equilibrium to 1e-9
+TIGHT, TIGHT_FRICTION = 1e-11, 1e-9
+
+
+def _settings(case, **options):
+    return SimulatorSettings(ring_model="flexible" if case.parameters["ring_model"] == 2 else "rigid",
+                             load_frame="rotating" if case.parameters["load_frame"] == 2 else "fixed", **options)
+
+
+def _outputs(result):
+    d = result.distribution
+    return {"z": d.displacement[2], "rx": d.displacement[3], "ry": d.displacement[4],
+            "max_ball_load": d.max_ball_load, "friction_torque": result.friction_torque}
+
+
+@pytest.fixture(scope="module", params=["pitch", "yaw", "table3_heavy"])
+def stepped(request):
+    """(case, bearing, fast results, tight results, psi) over STEPS steps of a benchmark case."""
+    case = CASES[request.param](STEPS)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    fast = BearingSimulator(bearing, superelement, _settings(case))
+    tight = BearingSimulator(bearing, superelement, _settings(case, tolerance=TIGHT, friction_tolerance=TIGHT_FRICTION))
+    results = []
+    for k in range(case.steps):
+        loads = Loads(*case.loads[k])
+        results.append((fast.step(loads, case.psi[k], case.omega[k]), tight.step(loads, case.psi[k], case.omega[k])))
+    return case, fast.bearing, results
+
+
+def test_every_step_matches_a_tight_solve(stepped):
+    case, _, results = stepped
+    for k, (fast, tight) in enumerate(results):
+        got, want = _outputs(fast), _outputs(tight)
+        for name, value in got.items():
+            assert abs(value - want[name]) <= RTOL * max(abs(want[name]), FLOOR[name]), (
+                f"{case.name}, step {k}: {name} = {value!r}, tight solve {want[name]!r}")
+
+
+def test_balls_balance_the_applied_load_at_every_step(stepped):
+    case, bearing, results = stepped
+    lever = np.array([1.0, 1.0, 1.0, 2.0, 2.0]) / [1.0, 1.0, 1.0, bearing.pitch_diameter, bearing.pitch_diameter]
+    for k, (fast, _) in enumerate(results):
+        d = fast.distribution
+        applied = d.loads.as_array() * lever                 # moments as forces at the pitch radius
+        centres = assemble(bearing, case.psi[k]).groove_centre
+        balance = load_on_moving_ring(bearing, d, centres) * lever
+        scale = np.abs(applied).max()
+        assert np.abs(balance - applied).max() <= 1e-6 * scale, (
+            f"{case.name}, step {k}: contact forces {balance} against applied {applied} (scale {scale:.3g} N)")
+
