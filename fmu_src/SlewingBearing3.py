@@ -95,6 +95,7 @@ class SlewingBearing3(Fmi3Slave):
                 getter=lambda name=name: self._arrays[name].ravel().tolist(),
                 setter=lambda values, name=name: self._set_array(name, values)), nested=False)
         self.simulator: BearingSimulator | None = None
+        self._refused = None  # (time, inputs, tunables) of the last refused step
 
     def _set_array(self, name, values):
         # pythonfmu3's own setter calls np.reshape(v, newshape=...), which numpy >= 2.4 refuses
@@ -150,28 +151,44 @@ class SlewingBearing3(Fmi3Slave):
             self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi3Status.error)
         return False
 
+    # A step is refused as by the FMI 2.0 slave: do_step returns False (fmi3Discard) with the
+    # reason logged as Discard, and the state stays the one before the step, so the host may
+    # restore a state and retry or go on with other inputs; the same step refused twice (same
+    # time, inputs and tunable parameters) cannot succeed and is logged as Error.
     def do_step(self, current_time: float, step_size: float) -> bool:
-        self.time = current_time + step_size
         if self.simulator is None and not self._build_simulator():
             return False
-        return self._update()
+        if not self._update(current_time):
+            return False
+        self.time = current_time + step_size
+        return True
 
-    def _update(self) -> bool:
-        """Solve for the current inputs; on bad input log why and return False (fmi3Discard)."""
+    def _update(self, current_time: float | None = None) -> bool:
+        """Solve for the current inputs; on bad input log why (Discard), keep the state and return False."""
+        sim = self.simulator
+        before = sim.get_state()
         try:
             check_inputs({name: getattr(self, name) for name, _, _ in INPUTS})
-            sim = self.simulator
             tunable = {"friction_coefficient": float(self.friction_coefficient), "seal_torque": float(self.seal_torque),
                        "omega_regularisation": float(self.omega_regularisation)}
             if any(getattr(sim.settings, k) != v for k, v in tunable.items()):
                 sim.tune(**tunable)
             result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
         except (ValueError, NoEquilibriumError) as exc:
-            self.log(f"{self.instance_name}: step refused: {exc}", Fmi3Status.error)
+            sim.set_state(before)  # the solver may have moved: back to the state before the step
+            key = (current_time, tuple(getattr(self, name) for name, _, _ in INPUTS),
+                   self.friction_coefficient, self.seal_torque, self.omega_regularisation)
+            if current_time is not None and key == self._refused:
+                self.log(f"{self.instance_name}: step at t = {current_time} refused again with the same inputs, "
+                         f"so it cannot succeed (change an input, or stop): {exc}", Fmi3Status.error)
+            else:
+                self.log(f"{self.instance_name}: step refused, state kept: {exc}", Fmi3Status.discard)
+            self._refused = key
             return False
         except Exception:  # never let a bug crash the host: report it
             self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi3Status.error)
             return False
+        self._refused = None
         d = result.distribution
         self.x, self.y, self.z, self.rx, self.ry = map(float, d.displacement)
         self.friction_torque = result.friction_torque
@@ -195,6 +212,7 @@ class SlewingBearing3(Fmi3Slave):
         state = dict(state)
         self._arrays = {k: np.asarray(v, dtype=float) for k, v in state.pop("_arrays").items()}
         simulator = state.pop("_simulator")
+        self._refused = None
         for v in self.vars.values():
             if v.name in state:
                 setattr(self, v.name, state[v.name])
