@@ -20,9 +20,7 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
-#: modules of slewing_model the FMU runs with (run-time part: numpy and the standard library)
-RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "bime", "ring_stiffness",
-                   "friction", "simulator")
+from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing_model the FMU runs with)
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2) -> Path:

@@ -17,10 +17,14 @@ from .friction import FrictionTorque, catalogue_torque, friction_torque
 
 __version__ = "0.1.0"
 
+#: the run-time part of the package (numpy and the standard library): the modules an FMU carries
+RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "bime", "blas", "ring_stiffness",
+                   "friction", "simulator")
+
 __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",
     "ManufacturingErrors", "RingErrorMap", "synthetic_errors",
     "BimeSolver", "LoadCapacityError", "LoadDistribution", "Loads", "NoEquilibriumError", "solve",
     "FrictionTorque", "catalogue_torque", "friction_torque",
-    "__version__",
+    "__version__", "RUNTIME_MODULES",
 ]

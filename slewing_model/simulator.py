@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .bime import BimeSolver, LoadDistribution, Loads
+from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
 from .geometry import Bearing
 
@@ -62,6 +63,11 @@ class SimulatorSettings:
         default before) the yaw bearing's torque was off by up to 1.8e-4 at some steps,
         where a four-contact ball stopped on a flat stretch of its power
         (``tests/test_step_accuracy.py``).
+    blas_threads : int or None
+        Threads of numpy's BLAS during a step (:func:`slewing_model.blas.blas_threads`;
+        restored after it); None leaves them as the process has them. Default 1: the
+        step's matrices have a few hundred rows, and a second thread that spins while
+        other processes share the cores makes steps several times slower.
     """
 
     ring_model: str = "flexible"
@@ -73,6 +79,7 @@ class SimulatorSettings:
     tolerance: float = 1e-7
     omega_regularisation: float = 1e-4
     friction_tolerance: float = 1e-5
+    blas_threads: int | None = 1
 
     def __post_init__(self):
         _choice("ring_model", self.ring_model, RING_MODELS)
@@ -85,6 +92,9 @@ class SimulatorSettings:
         for name in ("tolerance", "friction_tolerance"):
             if not 0 < getattr(self, name) < 1e-2:
                 raise ValueError(f"{name} = {getattr(self, name)!r}: must lie in (0, 0.01)")
+        if self.blas_threads is not None and (isinstance(self.blas_threads, bool) or not isinstance(
+                self.blas_threads, int) or self.blas_threads < 1):
+            raise ValueError(f"blas_threads = {self.blas_threads!r}: must be a whole number >= 1, or None")
         if self.preload is not None and not math.isfinite(self.preload):
             raise ValueError(f"preload = {self.preload!r}: must be finite")
 
@@ -178,16 +188,17 @@ class BearingSimulator:
                 raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
         if self.settings.load_frame == "rotating":
             loads = loads.rotated(psi)
-        if psi != self._psi or self._warm is None:
-            self.solver.set_rotation(psi)
-        distribution = self.solver.solve(loads, initial=self._predicted())
-        magnitude = self.settings.seal_torque
-        if self.settings.friction_coefficient > 0.0:
-            friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
-                                       omega=1.0, seal_torque=self.settings.seal_torque, initial=self._friction_warm,
-                                       tol=self.settings.friction_tolerance)
-            magnitude = friction.magnitude
-            self._friction_warm = friction.state
+        with blas_threads(self.settings.blas_threads):
+            if psi != self._psi or self._warm is None:
+                self.solver.set_rotation(psi)
+            distribution = self.solver.solve(loads, initial=self._predicted())
+            magnitude = self.settings.seal_torque
+            if self.settings.friction_coefficient > 0.0:
+                friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                           omega=1.0, seal_torque=self.settings.seal_torque,
+                                           initial=self._friction_warm, tol=self.settings.friction_tolerance)
+                magnitude = friction.magnitude
+                self._friction_warm = friction.state
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         self._previous, self._warm = self._warm, distribution.state
         self._psi = psi
