@@ -12,11 +12,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
-import site
+import subprocess
 import sys
 import sysconfig
 import tempfile
+import warnings
+import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
@@ -61,19 +64,18 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
             if source.exists():
                 shutil.copy2(source, package / source.name)
         (tmp / "bearing.json").write_text(json.dumps(bearing.to_dict()))
-        # where numpy lives in the building environment: the FMU's fallback when its host lacks numpy
-        (tmp / "python_paths.json").write_text(json.dumps(sorted(set(site.getsitepackages()))))
         superelement.save(tmp / "superelement.npz")
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
             return _build_fmi3(output, [package, tmp / "bearing.json", tmp / "superelement.npz",
                                         ROOT / "fmu_src" / "bearing_variables.py"])
         built = FmuBuilder.build_FMU(
             ROOT / "fmu_src" / "SlewingBearing.py", dest=output,
-            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz", tmp / "python_paths.json",
+            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz",
                            ROOT / "fmu_src" / "bearing_variables.py"],
             canGetAndSetFMUstate=True, canSerializeFMUstate=True,
             needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
         )
+    install_python_shim(built, "SlewingBearing", fmi_version=2)
     return Path(built)
 
 
@@ -90,14 +92,94 @@ def _build_fmi3(output: Path, project_files) -> Path:
     return output
 
 
-def host_environment() -> dict[str, str]:
-    """Environment a C or C++ host on Linux needs to run the FMU.
+# ---- the Linux binary: our layer in front of pythonfmu's (fmu_src/shim/) -------------------------
+SHIM_DIR = ROOT / "fmu_src" / "shim"
+#: C sources of the Linux binary, per FMI version: the FMI layer and the Python loader it calls
+SHIM_SOURCES = {2: ("fmi2_shim.c", "python_runtime.c")}
+#: folder of the Linux x86-64 binary in the FMU, per FMI version
+LINUX_BINARIES = {2: "binaries/linux64", 3: "binaries/x86_64-linux"}
+#: name our layer gives pythonfmu's binary (it loads it from its own folder)
+INNER_BINARY = "pythonfmu-export.so"
+#: the one file of the FMU that names the Python it needs (read by the layer and by the slave)
+PYTHON_RUNTIME_FILE = "python_runtime.txt"
+PYTHON_HOME_VARIABLE = "SLEWING_FMU_PYTHONHOME"
 
-    pythonfmu's binary is not linked to libpython, and numpy's C extensions need
-    libpython's symbols loaded globally; nothing inside the FMU can do that (even
-    ``ctypes`` is such an extension), so the host process must preload it."""
-    libpython = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("INSTSONAME")
-    return {"LD_PRELOAD": str(libpython)}
+
+def c_compiler() -> str:
+    """The C compiler that builds the FMU's Linux binary: ``$CC``, else ``cc`` or ``gcc``.
+
+    Raises RuntimeError naming what to install when there is none."""
+    for name in filter(None, (os.environ.get("CC"), "cc", "gcc")):
+        path = shutil.which(name)
+        if path:
+            return path
+    raise RuntimeError(
+        "building the FMU needs a C compiler for its Linux binary (the layer that loads Python in a C host): "
+        "none found ($CC, cc, gcc). On Debian or Ubuntu: apt-get install gcc libc6-dev "
+        "(`make` installs them when run as root).")
+
+
+def compile_shim(output, fmi_version=2) -> Path:
+    """Compile the FMU's Linux binary (``fmu_src/shim/``) into ``output``; returns its path.
+
+    No debugging information and no search path is written into it: the binary holds no
+    path of the building machine."""
+    try:
+        sources = [SHIM_DIR / name for name in SHIM_SOURCES[fmi_version]]
+    except KeyError:
+        raise ValueError(f"fmi_version = {fmi_version!r}: the Linux shim exists for FMI "
+                         + ", ".join(map(str, SHIM_SOURCES))) from None
+    output = Path(output)
+    command = [c_compiler(), "-shared", "-fPIC", "-O2", "-g0", "-fvisibility=hidden", "-Wall",
+               "-o", str(output), *map(str, sources), "-ldl", "-lpthread"]
+    run = subprocess.run(command, capture_output=True, text=True, cwd=SHIM_DIR)
+    if run.returncode != 0:
+        raise RuntimeError(f"compiling the FMU's Linux binary failed ({' '.join(command)}):\n{run.stderr}")
+    return output
+
+
+def python_runtime() -> dict[str, str]:
+    """The Python an FMU built here runs its model in, as written to ``resources/python_runtime.txt``:
+    ``version``, ``home`` (the installation's prefix), ``library`` (its libpython) and
+    ``environment`` (the prefix with numpy: a virtual environment, or the home)."""
+    libdir, soname = sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("INSTSONAME")
+    library = Path(libdir or "", soname or f"libpython{sys.version_info[0]}.{sys.version_info[1]}.so.1.0")
+    if not library.exists():
+        warnings.warn(f"this Python ({sys.base_prefix}) has no shared library ({library}): the FMU will run in "
+                      f"Python hosts (fmpy) only, unless {PYTHON_HOME_VARIABLE} names another Python", stacklevel=2)
+    return {"version": sys.version.split()[0], "home": sys.base_prefix, "library": str(library),
+            "environment": sys.prefix}
+
+
+def install_python_shim(fmu, model_identifier, fmi_version=2) -> None:
+    """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place).
+
+    pythonfmu's binary becomes ``INNER_BINARY``; ours, compiled here, takes the model
+    identifier's name and loads the Python named by ``resources/python_runtime.txt``
+    (written here) before it. The Windows binary is left as pythonfmu wrote it."""
+    fmu = Path(fmu)
+    folder = LINUX_BINARIES[fmi_version]
+    binary = f"{folder}/{model_identifier}.so"
+    runtime = "".join(f"{k}={v}\n" for k, v in python_runtime().items())
+    header = (f"# The Python this FMU runs its model in (written by build_fmu.py). On a machine where it\n"
+              f"# lives elsewhere, set {PYTHON_HOME_VARIABLE} to a Python installation or virtual environment\n"
+              f"# with numpy (same minor version), or edit this file.\n")
+    with tempfile.TemporaryDirectory(prefix="slewing_shim_") as tmp:
+        shim = compile_shim(Path(tmp) / f"{model_identifier}.so", fmi_version)
+        rewritten = Path(tmp) / "rewritten.fmu"
+        with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(rewritten, "w", zipfile.ZIP_DEFLATED) as dst:
+            names = src.namelist()
+            if binary not in names:
+                raise RuntimeError(f"{fmu} has no {binary}: is it a pythonfmu FMU of {model_identifier}?")
+            for info in src.infolist():
+                data = src.read(info.filename)
+                if info.filename == binary:
+                    dst.writestr(f"{folder}/{INNER_BINARY}", data)
+                elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
+                    dst.writestr(info, data)
+            dst.write(shim, binary)
+            dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}", header + runtime)
+        shutil.move(str(rewritten), fmu)
 
 
 def main(argv=None) -> int:
@@ -109,11 +191,15 @@ def main(argv=None) -> int:
     parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
                         help="FMI 2.0 (default; per-ball scalars) or FMI 3.0 (pythonfmu3; per-ball arrays)")
     parser.add_argument("--host-env", action="store_true",
-                        help="only print the environment a C/C++ host on Linux needs (LD_PRELOAD of libpython)")
+                        help="only print the Python an FMU built here needs (C/C++ hosts need no environment)")
     args = parser.parse_args(argv)
     if args.host_env:
-        for key, value in host_environment().items():
-            print(f"export {key}={value}")
+        runtime = python_runtime()
+        print("# A C or C++ host needs no environment: the FMU loads this Python itself "
+              f"(resources/{PYTHON_RUNTIME_FILE}):")
+        print("".join(f"#   {k} = {v}\n" for k, v in runtime.items()), end="")
+        print("# Where that Python is missing, name another one (installation or virtual environment with numpy):")
+        print(f"export {PYTHON_HOME_VARIABLE}={runtime['environment']}")
         return 0
     if args.bearing is None:
         parser.error("the bearing definition is required")

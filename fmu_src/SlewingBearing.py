@@ -19,23 +19,68 @@ import sys
 import traceback
 
 
+#: names the Python installation or virtual environment the FMU runs in (see README, "The FMU")
+PYTHON_HOME_VARIABLE = "SLEWING_FMU_PYTHONHOME"
+
+
+def _python_runtime() -> dict[str, str]:
+    """The Python the FMU was built for: ``python_runtime.txt`` beside this module (resources)."""
+    runtime = {}
+    try:
+        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "python_runtime.txt")) as fh:
+            for line in fh:
+                key, sep, value = line.strip().partition("=")
+                if sep and not key.startswith("#"):
+                    runtime[key] = value
+    except OSError:
+        pass
+    return runtime
+
+
+def _installation(prefix: str) -> str:
+    """The installation a prefix belongs to: itself, or for a virtual environment the one in its pyvenv.cfg."""
+    try:
+        with open(os.path.join(prefix, "pyvenv.cfg")) as fh:
+            for line in fh:
+                key, sep, value = line.partition("=")
+                if sep and key.strip() == "home":
+                    home = value.strip()
+                    return os.path.dirname(home) if os.path.basename(home) == "bin" else home
+    except OSError:
+        pass
+    return prefix
+
+
 def _find_numpy() -> None:
-    """The FMU runs in its host's Python: if numpy is not there, try the
-    site-packages of the environment that built the FMU (python_paths.json)."""
+    """Make numpy importable or raise ImportError saying what to install where.
+
+    The FMU runs in its host's Python: in a C host the one the FMU's Linux binary loaded
+    (``SLEWING_FMU_PYTHONHOME``, else the one named in ``python_runtime.txt``), in a Python
+    host the host's own. When numpy is missing and the named environment is a virtual
+    environment of this very Python, its site-packages are added to ``sys.path``."""
     try:
         import numpy  # noqa: F401
         return
     except ImportError:
         pass
-    here = os.path.dirname(os.path.abspath(__file__))
-    try:
-        with open(os.path.join(here, "python_paths.json")) as fh:
-            sys.path.extend(p for p in json.load(fh) if p not in sys.path)
-        import numpy  # noqa: F401
-    except (OSError, ImportError) as exc:
-        raise ImportError(
-            f"the slewing bearing FMU needs numpy in the Python {sys.version.split()[0]} that runs it "
-            f"({sys.executable}): install it there or add its site-packages to PYTHONPATH ({exc})") from None
+    runtime = _python_runtime()
+    environment = os.environ.get(PYTHON_HOME_VARIABLE) or runtime.get("environment")
+    minor = f"{sys.version_info[0]}.{sys.version_info[1]}"
+    if environment and os.path.realpath(_installation(environment)) == os.path.realpath(sys.base_prefix):
+        import site
+
+        site.addsitedir(os.path.join(environment, "lib", f"python{minor}", "site-packages"))
+        try:
+            import numpy  # noqa: F401
+            return
+        except ImportError:
+            pass
+    built = runtime.get("version", "?")
+    raise ImportError(
+        f"the slewing bearing FMU needs numpy in the Python that runs it, Python {sys.version.split()[0]} at "
+        f"{sys.prefix}: install numpy there ({sys.base_prefix}/bin/python{minor} -m pip install numpy, or the "
+        f"system's python3-numpy package), or set {PYTHON_HOME_VARIABLE} to a Python {minor} installation or "
+        f"virtual environment that has numpy (this FMU was built with Python {built})") from None
 
 
 _find_numpy()
@@ -111,6 +156,7 @@ class SlewingBearing(Fmi2Slave):
                            Fmi2Causality.output, Fmi2Variability.continuous,
                            getter=lambda i=i, k=k: self._d[i - 1][k])
         self.simulator: BearingSimulator | None = None
+        self._refused = None  # (time, inputs, tunables) of the last refused step
 
     # ---- variables ------------------------------------------------------------------
     def _real(self, name, unit, description, causality, variability, getter=None):
@@ -188,19 +234,27 @@ class SlewingBearing(Fmi2Slave):
             self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
         return False
 
+    # A step is refused (do_step returns False) with the reason logged as Discard: pythonfmu
+    # then returns fmi2Discard, and the FMU's Linux binary (fmu_src/shim) reports
+    # fmi2Terminated = false. The state stays the one before the step (FMI 2.0, 4.2.3:
+    # the master may restore a state and retry, or go on with other inputs). What leaves
+    # the instance unable to continue is logged as Error, and the binary returns fmi2Error.
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self.simulator is None and not self._build_simulator():
             return False
-        return self._update()
+        return self._update(current_time)
 
-    def _update(self) -> bool:
-        """Solve for the current inputs; on bad input log why and return False (fmi2Discard)."""
+    def _update(self, current_time: float | None = None) -> bool:
+        """Solve for the current inputs; on bad input log why (Discard), keep the state and
+        return False. The same step refused twice (same time, inputs and tunable parameters,
+        as a master that retries without changing anything does) cannot succeed: Error."""
+        sim = self.simulator
+        before = sim.get_state()
         try:
             for name, _, _ in INPUTS:
                 value = getattr(self, name)
                 if not math.isfinite(value):
                     raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
-            sim = self.simulator
             tunable = {"friction_coefficient": float(self.friction_coefficient),
                        "seal_torque": float(self.seal_torque),
                        "omega_regularisation": float(self.omega_regularisation)}
@@ -208,11 +262,20 @@ class SlewingBearing(Fmi2Slave):
                 sim.tune(**tunable)
             result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
         except (ValueError, NoEquilibriumError) as exc:
-            self.log(f"{self.instance_name}: step refused: {exc}", Fmi2Status.error)
+            sim.set_state(before)  # the solver may have moved: back to the state before the step
+            key = (current_time, tuple(getattr(self, name) for name, _, _ in INPUTS),
+                   self.friction_coefficient, self.seal_torque, self.omega_regularisation)
+            if current_time is not None and key == self._refused:
+                self.log(f"{self.instance_name}: step at t = {current_time} refused again with the same inputs, "
+                         f"so it cannot succeed (change an input, or stop): {exc}", Fmi2Status.error)
+            else:
+                self.log(f"{self.instance_name}: step refused, state kept: {exc}", Fmi2Status.discard)
+            self._refused = key
             return False
         except Exception:  # never let a bug crash the host: report it
             self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
             return False
+        self._refused = None
         d = result.distribution
         self.x, self.y, self.z, self.rx, self.ry = map(float, d.displacement)
         self.friction_torque = result.friction_torque
@@ -237,6 +300,7 @@ class SlewingBearing(Fmi2Slave):
         state = dict(state)
         self._q, self._alpha, self._d = state.pop("_q"), state.pop("_alpha"), state.pop("_d")
         simulator = state.pop("_simulator")
+        self._refused = None
         for v in self.vars.values():
             if v.name in state and v.setter is not None:
                 v.setter(state[v.name])

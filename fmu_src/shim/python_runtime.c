@@ -1,0 +1,315 @@
+/* Loading the Python that an FMU built with pythonfmu runs its model in (see python_runtime.h). */
+#define _GNU_SOURCE
+#include "python_runtime.h"
+
+#include <dlfcn.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <wchar.h>
+
+static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+static int python_ready = 0;
+
+static void message(char *err, size_t size, const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    vsnprintf(err, size, format, args);
+    va_end(args);
+}
+
+int python_runtime_binary_dir(const void *symbol, char *dir, size_t size, char *err, size_t errsize)
+{
+    Dl_info info;
+    char resolved[PATH_MAX];
+    if (!dladdr(symbol, &info) || !info.dli_fname || !realpath(info.dli_fname, resolved)) {
+        message(err, errsize, "the FMU cannot find its own binary (dladdr)");
+        return -1;
+    }
+    char *slash = strrchr(resolved, '/');
+    if (!slash || (size_t)(slash - resolved) >= size) {
+        message(err, errsize, "the FMU's binary path is too long: %s", resolved);
+        return -1;
+    }
+    *slash = '\0';
+    snprintf(dir, size, "%s", resolved);
+    return 0;
+}
+
+struct runtime_file {
+    char version[64];   /* X.Y.Z of the building Python */
+    char home[PATH_MAX];
+    char library[PATH_MAX + 64];
+    char path[PATH_MAX];
+    int found;
+};
+
+static void read_runtime_file(const char *binary_dir, struct runtime_file *rt)
+{
+    memset(rt, 0, sizeof *rt);
+    snprintf(rt->path, sizeof rt->path, "%s/../../resources/%s", binary_dir, PYTHON_RUNTIME_FILE);
+    FILE *fh = fopen(rt->path, "r");
+    if (!fh)
+        return;
+    rt->found = 1;
+    char line[PATH_MAX + 64];
+    while (fgets(line, sizeof line, fh)) {
+        line[strcspn(line, "\r\n")] = '\0';
+        char *eq = strchr(line, '=');
+        if (line[0] == '#' || !eq)
+            continue;
+        *eq = '\0';
+        const char *value = eq + 1;
+        if (!strcmp(line, "version"))
+            snprintf(rt->version, sizeof rt->version, "%s", value);
+        else if (!strcmp(line, "home"))
+            snprintf(rt->home, sizeof rt->home, "%s", value);
+        else if (!strcmp(line, "library"))
+            snprintf(rt->library, sizeof rt->library, "%s", value);
+    }
+    fclose(fh);
+}
+
+/* "3.11" from "3.11.7" or from "libpython3.11.so.1.0"; 0 if none */
+static int minor_version(const char *text, char *out, size_t size)
+{
+    const char *p = strstr(text, "python");
+    p = p ? p + 6 : text;
+    int major, minor;
+    if (sscanf(p, "%d.%d", &major, &minor) != 2)
+        return 0;
+    snprintf(out, size, "%d.%d", major, minor);
+    return 1;
+}
+
+static int exists(const char *path)
+{
+    return access(path, R_OK) == 0;
+}
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+/* The standard advice, appended to every failure: what to install and what to set. */
+static void advice(char *err, size_t size, const char *minor)
+{
+    size_t used = strlen(err);
+    message(err + used, size - used,
+            " This FMU runs its model in CPython %s with numpy, in the host's process: install that "
+            "CPython with its shared library (libpython%s.so.1.0) and numpy, then set %s to its prefix "
+            "(for example /usr) or to a virtual environment made from it, and %s to its libpython if that is not <prefix>/lib/ "
+            "nor on the system's library path.",
+            minor, minor, PYTHON_HOME_VARIABLE, PYTHON_LIBRARY_VARIABLE);
+}
+
+/* The Python home of `prefix`: the prefix itself, or for a virtual environment (pyvenv.cfg)
+ * the installation it was made from. */
+static void resolve_home(const char *prefix, char *home, size_t size)
+{
+    snprintf(home, size, "%s", prefix);
+    char cfg[PATH_MAX + 16];
+    snprintf(cfg, sizeof cfg, "%s/pyvenv.cfg", prefix);
+    FILE *fh = fopen(cfg, "r");
+    if (!fh)
+        return;
+    char line[PATH_MAX + 64];
+    while (fgets(line, sizeof line, fh)) {
+        line[strcspn(line, "\r\n")] = '\0';
+        char *eq = strchr(line, '=');
+        if (!eq)
+            continue;
+        char *key = line, *value = eq + 1;
+        *eq = '\0';
+        while (*key == ' ')
+            key++;
+        for (char *end = eq - 1; end >= key && *end == ' '; end--)
+            *end = '\0';
+        while (*value == ' ')
+            value++;
+        if (strcmp(key, "home"))
+            continue;
+        size_t n = strlen(value);  /* home = <installation>/bin */
+        if (n >= 4 && !strcmp(value + n - 4, "/bin"))
+            value[n - 4] = '\0';
+        snprintf(home, size, "%s", value);
+        break;
+    }
+    fclose(fh);
+}
+
+static int load_locked(const char *binary_dir, char *err, size_t errsize)
+{
+    if (python_ready)
+        return 0;
+    if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
+        /* a Python host (fmpy...) or a host linked to libpython: use its interpreter */
+        python_ready = 1;
+        return 0;
+    }
+    struct runtime_file rt;
+    read_runtime_file(binary_dir, &rt);
+    const char *env_home = getenv(PYTHON_HOME_VARIABLE);
+    const char *env_library = getenv(PYTHON_LIBRARY_VARIABLE);
+    if (env_home && !*env_home)
+        env_home = NULL;
+    if (env_library && !*env_library)
+        env_library = NULL;
+    char built_minor[16] = "3";
+    if (!minor_version(rt.version, built_minor, sizeof built_minor))
+        snprintf(built_minor, sizeof built_minor, "3.11");
+
+    if (!env_home && !rt.found) {
+        message(err, errsize, "%s is missing and %s is not set.", rt.path, PYTHON_HOME_VARIABLE);
+        advice(err, errsize, built_minor);
+        return -1;
+    }
+    char home_buffer[PATH_MAX];
+    if (env_home)
+        resolve_home(env_home, home_buffer, sizeof home_buffer);
+    const char *home = env_home ? home_buffer : rt.home;
+    const char *origin = env_home ? "set by " PYTHON_HOME_VARIABLE : "named in resources/" PYTHON_RUNTIME_FILE;
+
+    /* the library: explicit, under the home, or the system's one of the building minor version */
+    char library[PATH_MAX + 64];
+    if (env_library) {
+        snprintf(library, sizeof library, "%s", env_library);
+    } else if (env_home) {
+        snprintf(library, sizeof library, "%s/lib/libpython%s.so.1.0", home, built_minor);
+        if (!exists(library))
+            snprintf(library, sizeof library, "%s/lib/libpython%s.so", home, built_minor);
+        if (!exists(library))  /* e.g. Debian's /usr/lib/x86_64-linux-gnu, through the loader's search */
+            snprintf(library, sizeof library, "libpython%s.so.1.0", built_minor);
+    } else {
+        snprintf(library, sizeof library, "%s", rt.library);
+    }
+    if (strchr(library, '/') && !exists(library)) {
+        message(err, errsize, "the Python library %s (%s) does not exist on this machine.", library,
+                env_library ? "set by " PYTHON_LIBRARY_VARIABLE : origin);
+        advice(err, errsize, built_minor);
+        return -1;
+    }
+
+    /* check the home before the library is loaded: a wrong home aborts the process in Py_Initialize */
+    char minor[16];
+    if (!minor_version(base_name(library), minor, sizeof minor))
+        snprintf(minor, sizeof minor, "%s", built_minor);
+    char stdlib[PATH_MAX + 64];
+    snprintf(stdlib, sizeof stdlib, "%s/lib/python%s/encodings/__init__.py", home, minor);
+    if (!exists(stdlib)) {
+        message(err, errsize, "the Python home %s (%s) holds no standard library of Python %s (%s is missing).",
+                home, origin, minor, stdlib);
+        advice(err, errsize, built_minor);
+        return -1;
+    }
+
+    void *handle = dlopen(library, RTLD_NOW | RTLD_GLOBAL);
+    if (!handle) {
+        message(err, errsize, "cannot load the Python library %s: %s.", library, dlerror());
+        advice(err, errsize, built_minor);
+        return -1;
+    }
+    const char *(*get_version)(void) = (const char *(*)(void))dlsym(handle, "Py_GetVersion");
+    char loaded[16] = "?";
+    if (!get_version || !minor_version(get_version(), loaded, sizeof loaded) || strcmp(loaded, minor)) {
+        dlclose(handle);  /* nothing has bound to it yet */
+        message(err, errsize, "%s is Python %s, but the home %s is Python %s.", library, loaded, home, minor);
+        advice(err, errsize, built_minor);
+        return -1;
+    }
+    /* the home: through the API where it exists (no change to the host's environment) */
+    void (*set_home)(const wchar_t *) = (void (*)(const wchar_t *))dlsym(handle, "Py_SetPythonHome");
+    wchar_t *(*decode)(const char *, size_t *) = (wchar_t * (*)(const char *, size_t *)) dlsym(handle, "Py_DecodeLocale");
+    wchar_t *whome = decode ? decode(home, NULL) : NULL;
+    if (set_home && whome)
+        set_home(whome);  /* kept: Python keeps the pointer */
+    else
+        setenv("PYTHONHOME", home, 1);
+    void (*set_program)(const wchar_t *) = (void (*)(const wchar_t *))dlsym(handle, "Py_SetProgramName");
+    char program[PATH_MAX + 64];
+    snprintf(program, sizeof program, "%s/bin/python%s", home, minor);
+    wchar_t *wprogram = decode && exists(program) ? decode(program, NULL) : NULL;
+    if (set_program && wprogram)
+        set_program(wprogram);  /* sys.executable: the Python named, not the first on PATH */
+    /* Start Python here, once, without its signal handlers (the host keeps Ctrl-C), and release
+     * the GIL for pythonfmu's PyGILState calls. pythonfmu then finds it started and never
+     * finalises it: numpy cannot be imported again after a finalisation. */
+    void (*initialize)(int) = (void (*)(int))dlsym(handle, "Py_InitializeEx");
+    void *(*save_thread)(void) = (void *(*)(void))dlsym(handle, "PyEval_SaveThread");
+    if (!initialize || !save_thread) {
+        message(err, errsize, "%s lacks Py_InitializeEx or PyEval_SaveThread.", library);
+        return -1;
+    }
+    initialize(0);
+    save_thread();
+    python_ready = 1;  /* libpython stays loaded: the handle is never closed */
+    return 0;
+}
+
+int python_runtime_load(const char *binary_dir, char *err, size_t errsize)
+{
+    pthread_mutex_lock(&lock);
+    int status = load_locked(binary_dir, err, errsize);
+    pthread_mutex_unlock(&lock);
+    return status;
+}
+
+static void *binary_handle = NULL;
+
+/* At the process's exit (or when the host unloads this library), release pythonfmu's hold on
+ * the interpreter before the C runtime destroys pythonfmu's static objects.
+ *
+ * pythonfmu 0.7.0 keeps its interpreter holder in a static std::shared_ptr. Its binary holds
+ * STB_GNU_UNIQUE symbols, so dlclose never unloads it: it is always torn down at exit, where
+ * glibc runs the static destructors (exit's handlers) before the ELF destructors (_dl_fini).
+ * The shared_ptr is destroyed first, freeing its block when no instance is left, and then
+ * pythonfmu's ELF destructor, finalizePythonInterpreter(), assigns nullptr to that destroyed
+ * object: it decrements a count inside the freed block, which corrupts the heap ("free():
+ * corrupted unsorted chunks", "corrupted double-linked list"; valgrind: invalid read in
+ * finalizePythonInterpreter of a block freed by __run_exit_handlers). Whether the process
+ * then aborts depends on the heap's layout: seen as a sporadic abort at the end of a run.
+ *
+ * Registered after pythonfmu's binary was loaded, this handler runs before its static
+ * destructors: it calls finalizePythonInterpreter() while the holder is alive, which empties
+ * it; the static destructor and the ELF destructor then find it empty and do nothing.
+ * Python is not finalised (we started it, or the host did), so this is safe to run early. */
+static void release_binary(void)
+{
+    pthread_mutex_lock(&lock);
+    if (binary_handle) {
+        void (*finalize)(void) = (void (*)(void))dlsym(binary_handle, "finalizePythonInterpreter");
+        if (finalize)
+            finalize();
+    }
+    binary_handle = NULL;
+    pthread_mutex_unlock(&lock);
+}
+
+void *python_runtime_open_binary(const char *binary_dir, const char *name, char *err, size_t errsize)
+{
+    char path[PATH_MAX + 256];
+    snprintf(path, sizeof path, "%s/%s", binary_dir, name);
+    pthread_mutex_lock(&lock);
+    if (!binary_handle) {
+        binary_handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+        if (!binary_handle)
+            message(err, errsize, "cannot load %s: %s", path, dlerror());
+        else
+            atexit(release_binary);  /* registered after pythonfmu's static objects: runs before them */
+    }
+    void *handle = binary_handle;
+    pthread_mutex_unlock(&lock);
+    return handle;
+}
+
+int python_runtime_binary_open(void)
+{
+    return binary_handle != NULL;
+}

@@ -1,0 +1,319 @@
+/* A minimal FMI 2.0 co-simulation host, for tests/test_fmu_hosts.py.
+ *
+ *   host FMU_DIR MODEL_IDENTIFIER GUID SCENARIO VR... [CYCLES]
+ *
+ * FMU_DIR is the unzipped FMU; VR are the value references of the inputs
+ * Fx Fy Fz Mx My psi omega followed by those of the outputs to print. The binary is
+ * loaded with dlopen(RTLD_NOW | RTLD_LOCAL): no preload, nothing global. Lines printed:
+ *
+ *   <label> <step> <output values, %.17g>     outputs after a step
+ *   status <label> <step> <doStep status> <terminated> <lastSuccessfulTime>
+ *   log <status> <category> <message>         the FMU's log (logging on)
+ *   error <text>                              a failed call (exit status 1)
+ *
+ * Scenarios: basic (steps, state get/set/serialize, free, dlclose and reload), two (two
+ * instances interleaved), nan (a NaN input at step 3 then valid steps, beside an undisturbed
+ * instance), stress (CYCLES x: load, two instances, a refused step, free, dlclose).
+ */
+#include <dlfcn.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef void *fmi2Component;
+typedef void *fmi2FMUstate;
+typedef unsigned int fmi2ValueReference;
+typedef int fmi2Status; /* 0 OK, 1 Warning, 2 Discard, 3 Error, 4 Fatal */
+typedef struct {
+    void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void (*stepFinished)(void *, fmi2Status);
+    void *componentEnvironment;
+} fmi2CallbackFunctions;
+
+typedef struct {
+    void *handle;
+    fmi2Component (*instantiate)(const char *, int, const char *, const char *, const fmi2CallbackFunctions *, int, int);
+    void (*freeInstance)(fmi2Component);
+    fmi2Status (*setup)(fmi2Component, int, double, double, int, double);
+    fmi2Status (*enterInit)(fmi2Component);
+    fmi2Status (*exitInit)(fmi2Component);
+    fmi2Status (*terminate)(fmi2Component);
+    fmi2Status (*setReal)(fmi2Component, const fmi2ValueReference *, size_t, const double *);
+    fmi2Status (*getReal)(fmi2Component, const fmi2ValueReference *, size_t, double *);
+    fmi2Status (*doStep)(fmi2Component, double, double, int);
+    fmi2Status (*getState)(fmi2Component, fmi2FMUstate *);
+    fmi2Status (*setState)(fmi2Component, fmi2FMUstate);
+    fmi2Status (*freeState)(fmi2Component, fmi2FMUstate *);
+    fmi2Status (*stateSize)(fmi2Component, fmi2FMUstate, size_t *);
+    fmi2Status (*serialize)(fmi2Component, fmi2FMUstate, char *, size_t);
+    fmi2Status (*deserialize)(fmi2Component, const char *, size_t, fmi2FMUstate *);
+    fmi2Status (*getBooleanStatus)(fmi2Component, int, int *);
+    fmi2Status (*getRealStatus)(fmi2Component, int, double *);
+} Fmu;
+
+static char binary[PATH_MAX], resources[PATH_MAX + 16], guid[256];
+static fmi2ValueReference inputs[7], outputs[64];
+static size_t n_outputs;
+static const double H = 0.01;
+
+static void logger(void *env, const char *name, fmi2Status status, const char *category, const char *message, ...)
+{
+    (void)env;
+    (void)name;
+    char text[8192];
+    va_list args;
+    va_start(args, message);
+    vsnprintf(text, sizeof text, message, args);
+    va_end(args);
+    for (char *p = text; *p; p++)  /* one line per message */
+        if (*p == '\n')
+            *p = '|';
+    printf("log %d %s %s\n", status, category ? category : "-", text);
+    fflush(stdout);
+}
+
+static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+
+static void fail(const char *what)
+{
+    printf("error %s\n", what);
+    fflush(stdout);
+    exit(1);
+}
+
+#define CHECK(call)                        \
+    do {                                   \
+        if ((call) != 0)                   \
+            fail(#call);                   \
+    } while (0)
+
+static void *symbol(void *handle, const char *name)
+{
+    void *f = dlsym(handle, name);
+    if (!f)
+        fail(name);
+    return f;
+}
+
+static void load(Fmu *fmu)
+{
+    fmu->handle = dlopen(binary, RTLD_NOW | RTLD_LOCAL);
+    if (!fmu->handle) {
+        printf("error dlopen: %s\n", dlerror());
+        exit(1);
+    }
+    *(void **)&fmu->instantiate = symbol(fmu->handle, "fmi2Instantiate");
+    *(void **)&fmu->freeInstance = symbol(fmu->handle, "fmi2FreeInstance");
+    *(void **)&fmu->setup = symbol(fmu->handle, "fmi2SetupExperiment");
+    *(void **)&fmu->enterInit = symbol(fmu->handle, "fmi2EnterInitializationMode");
+    *(void **)&fmu->exitInit = symbol(fmu->handle, "fmi2ExitInitializationMode");
+    *(void **)&fmu->terminate = symbol(fmu->handle, "fmi2Terminate");
+    *(void **)&fmu->setReal = symbol(fmu->handle, "fmi2SetReal");
+    *(void **)&fmu->getReal = symbol(fmu->handle, "fmi2GetReal");
+    *(void **)&fmu->doStep = symbol(fmu->handle, "fmi2DoStep");
+    *(void **)&fmu->getState = symbol(fmu->handle, "fmi2GetFMUstate");
+    *(void **)&fmu->setState = symbol(fmu->handle, "fmi2SetFMUstate");
+    *(void **)&fmu->freeState = symbol(fmu->handle, "fmi2FreeFMUstate");
+    *(void **)&fmu->stateSize = symbol(fmu->handle, "fmi2SerializedFMUstateSize");
+    *(void **)&fmu->serialize = symbol(fmu->handle, "fmi2SerializeFMUstate");
+    *(void **)&fmu->deserialize = symbol(fmu->handle, "fmi2DeSerializeFMUstate");
+    *(void **)&fmu->getBooleanStatus = symbol(fmu->handle, "fmi2GetBooleanStatus");
+    *(void **)&fmu->getRealStatus = symbol(fmu->handle, "fmi2GetRealStatus");
+}
+
+static void unload(Fmu *fmu)
+{
+    if (dlclose(fmu->handle) != 0)
+        fail("dlclose");
+}
+
+static fmi2Component start(Fmu *fmu, const char *name)
+{
+    fmi2Component c = fmu->instantiate(name, 1 /* co-simulation */, guid, resources, &callbacks, 0, 1);
+    if (!c)
+        fail("fmi2Instantiate");
+    CHECK(fmu->setup(c, 0, 0.0, 0.0, 0, 0.0));
+    CHECK(fmu->enterInit(c));
+    CHECK(fmu->exitInit(c));
+    return c;
+}
+
+static void stop(Fmu *fmu, fmi2Component c)
+{
+    CHECK(fmu->terminate(c));
+    fmu->freeInstance(c);
+}
+
+/* inputs of step k: a slow load ramp and rotation; scale multiplies the loads */
+static void set_inputs(Fmu *fmu, fmi2Component c, int k, double scale, int nan_fz)
+{
+    double u[7] = {8e3 * scale, -3e3 * scale, (3e4 + 1e3 * k) * scale, 1.5e3 * scale, -2.5e3 * scale,
+                   0.4 + 0.01 * k, 0.05};
+    if (nan_fz)
+        u[2] = NAN;
+    CHECK(fmu->setReal(c, inputs, 7, u));
+}
+
+static void print_outputs(Fmu *fmu, fmi2Component c, const char *label, int k)
+{
+    double y[64];
+    CHECK(fmu->getReal(c, outputs, n_outputs, y));
+    printf("%s %d", label, k);
+    for (size_t i = 0; i < n_outputs; i++)
+        printf(" %.17g", y[i]);
+    printf("\n");
+    fflush(stdout);
+}
+
+static fmi2Status step(Fmu *fmu, fmi2Component c, int k, double scale, int nan_fz)
+{
+    set_inputs(fmu, c, k, scale, nan_fz);
+    return fmu->doStep(c, k * H, H, 1);
+}
+
+static void step_ok(Fmu *fmu, fmi2Component c, const char *label, int k, double scale)
+{
+    if (step(fmu, c, k, scale, 0) != 0)
+        fail("fmi2DoStep");
+    print_outputs(fmu, c, label, k);
+}
+
+static void print_status(Fmu *fmu, fmi2Component c, const char *label, int k, fmi2Status status)
+{
+    int terminated = -1;
+    double last = NAN;
+    CHECK(fmu->getBooleanStatus(c, 3 /* fmi2Terminated */, &terminated));
+    CHECK(fmu->getRealStatus(c, 2 /* fmi2LastSuccessfulTime */, &last));
+    printf("status %s %d %d %d %.17g\n", label, k, status, terminated, last);
+    fflush(stdout);
+}
+
+static void basic(void)
+{
+    Fmu fmu;
+    load(&fmu);
+    fmi2Component c = start(&fmu, "basic");
+    for (int k = 0; k < 3; k++)
+        step_ok(&fmu, c, "run", k, 1.0);
+    fmi2FMUstate state = NULL;
+    CHECK(fmu.getState(c, &state));
+    size_t size = 0;
+    CHECK(fmu.stateSize(c, state, &size));
+    char *bytes = malloc(size);
+    CHECK(fmu.serialize(c, state, bytes, size));
+    for (int k = 3; k < 6; k++)
+        step_ok(&fmu, c, "run", k, 1.0);
+    CHECK(fmu.setState(c, state));
+    for (int k = 3; k < 6; k++)
+        step_ok(&fmu, c, "replay", k, 1.0);
+    fmi2FMUstate restored = NULL;
+    CHECK(fmu.deserialize(c, bytes, size, &restored));
+    CHECK(fmu.setState(c, restored));
+    for (int k = 3; k < 6; k++)
+        step_ok(&fmu, c, "deserialized", k, 1.0);
+    CHECK(fmu.freeState(c, &restored));
+    CHECK(fmu.freeState(c, &state));
+    free(bytes);
+    stop(&fmu, c);
+    unload(&fmu);
+    /* free and reload: a new instance of the reloaded binary starts afresh */
+    load(&fmu);
+    c = start(&fmu, "reloaded");
+    for (int k = 0; k < 6; k++)
+        step_ok(&fmu, c, "reload", k, 1.0);
+    stop(&fmu, c);
+    unload(&fmu);
+}
+
+static void two(void)
+{
+    Fmu fmu;
+    load(&fmu);
+    fmi2Component a = start(&fmu, "a"), b = start(&fmu, "b");
+    for (int k = 0; k < 6; k++) {
+        step_ok(&fmu, a, "a", k, 1.0);
+        step_ok(&fmu, b, "b", k, 2.0);
+    }
+    stop(&fmu, a);
+    stop(&fmu, b);
+    unload(&fmu);
+}
+
+static void nan_step(void)
+{
+    Fmu fmu;
+    load(&fmu);
+    fmi2Component undisturbed = start(&fmu, "undisturbed"), disturbed = start(&fmu, "disturbed");
+    for (int k = 0; k < 8; k++) {
+        if (k == 3) {  /* the disturbed instance gets a NaN; the undisturbed one skips this step */
+            fmi2Status status = step(&fmu, disturbed, k, 1.0, 1);
+            print_status(&fmu, disturbed, "disturbed", k, status);
+            print_outputs(&fmu, disturbed, "after_refusal", k);
+            continue;
+        }
+        step_ok(&fmu, undisturbed, "undisturbed", k, 1.0);
+        step_ok(&fmu, disturbed, "disturbed", k, 1.0);
+    }
+    print_status(&fmu, disturbed, "disturbed", 8, 0);
+    stop(&fmu, undisturbed);
+    stop(&fmu, disturbed);
+    unload(&fmu);
+}
+
+static void stress(int cycles)
+{
+    for (int cycle = 0; cycle < cycles; cycle++) {
+        Fmu fmu;
+        load(&fmu);
+        fmi2Component a = start(&fmu, "a"), b = start(&fmu, "b");
+        for (int k = 0; k < 3; k++) {
+            if (step(&fmu, a, k, 1.0, 0) != 0 || step(&fmu, b, k, 2.0, 0) != 0)
+                fail("fmi2DoStep");
+        }
+        if (step(&fmu, b, 3, 1.0, 1) != 2)  /* refused, then freed right away */
+            fail("NaN step not discarded");
+        print_outputs(&fmu, a, "cycle", cycle);
+        stop(&fmu, a);
+        fmu.freeInstance(b);
+        unload(&fmu);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 6 + 7) {
+        fprintf(stderr, "usage: host FMU_DIR MODEL_IDENTIFIER GUID SCENARIO VR_INPUTS(7) VR_OUTPUTS... [--cycles N]\n");
+        return 2;
+    }
+    snprintf(binary, sizeof binary, "%s/binaries/linux64/%s.so", argv[1], argv[2]);
+    snprintf(resources, sizeof resources, "file://%s/resources", argv[1]);
+    snprintf(guid, sizeof guid, "%s", argv[3]);
+    const char *scenario = argv[4];
+    int cycles = 3;
+    for (int i = 0; i < 7; i++)
+        inputs[i] = (fmi2ValueReference)strtoul(argv[5 + i], NULL, 10);
+    for (int i = 12; i < argc && n_outputs < 64; i++) {
+        if (!strcmp(argv[i], "--cycles") && i + 1 < argc) {
+            cycles = atoi(argv[++i]);
+            continue;
+        }
+        outputs[n_outputs++] = (fmi2ValueReference)strtoul(argv[i], NULL, 10);
+    }
+    if (!strcmp(scenario, "basic"))
+        basic();
+    else if (!strcmp(scenario, "two"))
+        two();
+    else if (!strcmp(scenario, "nan"))
+        nan_step();
+    else if (!strcmp(scenario, "stress"))
+        stress(cycles);
+    else
+        fail("unknown scenario");
+    printf("done\n");
+    return 0;
+}
