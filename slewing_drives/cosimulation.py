@@ -202,7 +202,8 @@ def _set_inputs(fmu, refs, load, psi, omega):
 def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: ManoeuvreResult | None = None,
                    title: str = "") -> None:
     """Four panels: angle and command, motor torque and its limit, bearing friction torque and
-    its share of the drive torque, maximum ball load and static safety factor."""
+    its share of the motors' torque at the ring while they drive the ring (:func:`friction_share`),
+    maximum ball load and static safety factor."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -225,14 +226,16 @@ def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: Manoeuvre
     ax[1].legend(loc="best")
     ax[2].plot(r.time, r.friction_torque / 1e3, label="bearing friction torque (full sliding)")
     ax[2].set_ylabel("friction [kN m]")
+    # the share of the motors' torque at the ring that the bearing friction takes, while the motors drive
+    # the ring through the friction (at most 100 % by construction)
     share = ax[2].twinx()
-    moving = np.abs(r.speed) > 1e-3 * r.params.rate_limit
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(moving, 100 * r.friction_torque / np.maximum(np.abs(r.ring_torque), 1e-9), np.nan)
-    share.plot(r.time, ratio, "g", lw=0.8, label="share of the drive torque (moving)")
-    share.set_ylabel("share [%]", color="g")
-    share.set_ylim(0, 150)
-    ax[2].legend(loc="upper left")
+    share.plot(r.time, friction_share(r), "g", lw=0.8,
+               label="friction / motors' ring torque while they drive the ring [%] (right axis)")
+    share.set_ylabel("friction share of ring torque [%]", color="g")
+    share.set_ylim(0, 130)  # room above 100 % for the legend
+    lines, labels = ax[2].get_legend_handles_labels()
+    more, more_labels = share.get_legend_handles_labels()
+    ax[2].legend(lines + more, labels + more_labels, loc="upper left", fontsize=8)
     ax[3].plot(r.time, r.outputs["max_ball_load"] / 1e3, label="max ball load")
     ax[3].set_ylabel("max ball load [kN]")
     sf = ax[3].twinx()
@@ -243,6 +246,17 @@ def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: Manoeuvre
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def friction_share(result: ManoeuvreResult) -> np.ndarray:
+    """Bearing friction torque over the torque of the drive's motors at the ring, %, at every step the
+    motors drive the ring through the friction: the ring moves (speed above 1e-3 of the rate limit) and
+    the ring torque acts in the direction of motion and is at least the friction torque. NaN elsewhere
+    (at rest, or where the load moment moves the ring and the ratio would say nothing)."""
+    moving = np.abs(result.speed) > 1e-3 * result.params.rate_limit
+    pushing = result.ring_torque * np.sign(result.speed) >= result.friction_torque
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(moving & pushing, 100 * result.friction_torque / np.abs(result.ring_torque), np.nan)
 
 
 def summary_table(with_friction: ManoeuvreResult, without: ManoeuvreResult | None = None) -> str:
