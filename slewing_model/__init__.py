@@ -19,7 +19,7 @@ __version__ = "0.1.0"
 
 #: the run-time part of the package (numpy and the standard library): the modules an FMU carries
 RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "bime", "blas", "ring_stiffness",
-                   "friction", "simulator")
+                   "friction", "friction_kernel", "simulator")
 
 __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",

@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE, evaluate_points
 from .geometry import RING_CONTACTS, Bearing
 
 #: Default Coulomb coefficient of the ball-raceway contacts. Slewing bearings
@@ -625,8 +626,10 @@ class _Contacts:
     raceway's speed (``omega`` or 0), ``c = R e_r`` the ball centre and ``r``
     the point on the bent surface relative to it."""
 
-    def __init__(self, geometry: _ContactSet, quad: EllipseQuadrature, workspace: str = "fine"):
+    def __init__(self, geometry: _ContactSet, quad: EllipseQuadrature, workspace: str = "fine",
+                 compiled: bool = False):
         geo = self.geometry = geometry
+        self.compiled = compiled           # evaluate with the compiled loop (friction_kernel)
         ls, big_r = geo.length_scale, geo.pitch_radius
         rb, rd, n_r, n_z, ring_speed = geo.rb, geo.rd, geo.n_r, geo.n_z, geo.ring_speed
         u_nodes, t2, weight = quad.across_nodes, quad.along_squared, quad.folded_weight
@@ -651,7 +654,7 @@ class _Contacts:
         # lever arm of the moving ring's torque: e_z x (c + r) . v = arm1 v1 + arm2 t^2 S
         self.arm1 = np.where(geo.moving, big_r + r_r, 0.0)
         self.arm2 = np.where(geo.moving, -t2_r * half, 0.0)
-        self.t2 = t2
+        self.t2 = np.array(t2, dtype=float)          # writable (the compiled loop takes no read-only arrays)
         space = self._space = _workspace(workspace)
         shape = (self.t2.size, geo.ball_index.size, quad.n_across)
         self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))
@@ -685,6 +688,7 @@ class _Contacts:
         sub._s, sub._k, sub._k3 = (np.empty_like(sub.weight) for _ in range(3))
         sub._products = None
         sub._ones = self._ones
+        sub.compiled = self.compiled
         sub._space = _Workspace()
         return sub
 
@@ -727,8 +731,16 @@ class _Contacts:
         ``M = alpha GA GA^T + beta GS GS^T`` and
         ``M - H = e_aa GA GA^T + e_as (GA GS^T + GS GA^T) + e_ss GS GS^T``
         with ``alpha = sum w/s``, ``beta = sum w t^2/s``, ``e_aa = A^2 sum w/s^3``,
-        ``e_as = A S sum w t^2/s^3``, ``e_ss = S^2 sum w t^4/s^3``."""
+        ``e_as = A S sum w t^2/s^3``, ``e_ss = S^2 sum w t^4/s^3``.
+
+        With ``compiled`` the same sums come from one compiled loop
+        (:func:`slewing_model.friction_kernel.evaluate_points`)."""
         geo = self.geometry
+        if self.compiled:
+            f, g, h, x = evaluate_points(np.ascontiguousarray(u, dtype=float), geo.owner, geo.sum_matrix.shape[0],
+                                         self.g10, self.g12, self.h1, self.s0, self.s1, self.hs, self.weight, self.t2,
+                                         np.ravel(eps2), derivatives, majorant)
+            return (f, g, h, x if majorant else None) if derivatives else (f, None, None, None)
         a, s_ = self.velocity(u)
         a2, s2 = a * a, s_ * s_
         s = self._speed(a2, s2, eps2)
@@ -951,7 +963,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
                     omega_regularisation: float = DEFAULT_OMEGA_REGULARISATION, quadrature=DEFAULT_QUADRATURE,
                     solve_quadrature=DEFAULT_SOLVE_QUADRATURE,
                     sliding_regularisation: float = DEFAULT_SLIDING_REGULARISATION, initial=None,
-                    tol: float = 1e-5, max_iterations: int = 60) -> FrictionTorque:
+                    tol: float = 1e-5, max_iterations: int = 60, kernel: str = "auto") -> FrictionTorque:
     """Friction torque of the bearing for a load distribution (full sliding, slow speed).
 
     Parameters
@@ -994,6 +1006,12 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
         (the torque is never below the converged one), below the quadrature
         error (~1e-3).
     max_iterations : int
+    kernel : {"auto", "numpy", "compiled"}
+        How the power and its derivatives are summed over the quadrature points:
+        numpy array operations, or one compiled loop
+        (:mod:`slewing_model.friction_kernel`, needs numba); "auto" takes the
+        compiled loop where numba is installed. Both give the same results to
+        round-off.
 
     Returns
     -------
@@ -1013,6 +1031,11 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     omega = _check_number("omega", omega)
     sliding_regularisation = _check_number("sliding_regularisation", sliding_regularisation, 0.0, strict=True)
     tol = _check_number("tol", tol, 0.0, strict=True)
+    if kernel not in ("auto", "numpy", "compiled"):
+        raise ValueError(f"kernel = {kernel!r}: must be 'auto', 'numpy' or 'compiled'")
+    if kernel == "compiled" and not COMPILED_AVAILABLE:
+        raise ValueError("kernel = 'compiled' needs numba, which is not installed in this Python")
+    compiled = kernel == "compiled" or (kernel == "auto" and COMPILED_AVAILABLE)
     quad = _quadrature(quadrature)
     solve_quad = quad if solve_quadrature is None else _quadrature(solve_quadrature)
     seal = seal_torque_of(bearing, seal_torque, seal_torque_per_length, seal_length)
@@ -1026,9 +1049,9 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     iterations, residual, converged = 0, 0.0, True
     u = np.zeros((active.size, 3))
     if active.size and mu > 0.0:
-        contacts = _Contacts(geometry, quad)
+        contacts = _Contacts(geometry, quad, compiled=compiled)
         same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
-        solver = contacts if same else _Contacts(geometry, solve_quad, workspace="solve")
+        solver = contacts if same else _Contacts(geometry, solve_quad, workspace="solve", compiled=compiled)
         cold = np.ones(active.size, dtype=bool)
         if initial is not None:
             state = initial.state if isinstance(initial, FrictionTorque) else np.asarray(initial, dtype=float)

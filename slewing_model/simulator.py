@@ -68,6 +68,10 @@ class SimulatorSettings:
         restored after it); None leaves them as the process has them. Default 1: the
         step's matrices have a few hundred rows, and a second thread that spins while
         other processes share the cores makes steps several times slower.
+    friction_kernel : {"auto", "numpy", "compiled"}
+        How the friction model sums over its quadrature points (``kernel`` of
+        :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loop
+        where numba is installed, numpy otherwise; the results are the same to round-off.
     """
 
     ring_model: str = "flexible"
@@ -80,11 +84,13 @@ class SimulatorSettings:
     omega_regularisation: float = 1e-4
     friction_tolerance: float = 1e-5
     blas_threads: int | None = 1
+    friction_kernel: str = "auto"
 
     def __post_init__(self):
         _choice("ring_model", self.ring_model, RING_MODELS)
         _choice("moving_ring", self.moving_ring, ("inner", "outer"))
         _choice("load_frame", self.load_frame, LOAD_FRAMES)
+        _choice("friction_kernel", self.friction_kernel, ("auto", "numpy", "compiled"))
         for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation", "friction_tolerance"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
@@ -196,7 +202,8 @@ class BearingSimulator:
             if self.settings.friction_coefficient > 0.0:
                 friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
                                            omega=1.0, seal_torque=self.settings.seal_torque,
-                                           initial=self._friction_warm, tol=self.settings.friction_tolerance)
+                                           initial=self._friction_warm, tol=self.settings.friction_tolerance,
+                                           kernel=self.settings.friction_kernel)
                 magnitude = friction.magnitude
                 self._friction_warm = friction.state
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)

@@ -1,0 +1,104 @@
+"""The per-point loop of the friction model, compiled with numba where it is installed.
+
+:meth:`slewing_model.friction._Contacts.evaluate` sums the regularised dissipated power
+``D = sum w s``, ``s = sqrt(A^2 + t^2 S^2 + eps^2)``, its gradient and its Hessian (and the
+Weiszfeld majorant ``M - H``) over the quadrature points of every loaded contact, per ball.
+With numpy that is some sixty array operations per evaluation, each a few microseconds of
+call overhead for a few thousand points: for a 150-ball bearing the overhead, not the
+arithmetic, sets the time. :func:`evaluate_points` is the same sum as one compiled loop
+over contacts, across-groove nodes and folded along-groove nodes.
+
+numba is optional (it is not part of the FMU's run-time requirements): without it
+:data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
+results to round-off (``tests/test_friction_kernel.py``). The loop is compiled when this
+module is imported (eager signatures), so that the compile time lands in the FMU's
+instantiation, never in a step.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+try:  # optional: the compiled path
+    import numba
+except ImportError:  # pragma: no cover - exercised by the fallback test in a subprocess
+    numba = None
+
+AVAILABLE = numba is not None
+
+_SIGNATURE = ("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
+              "f8[:, :], i8[:], i8, f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :, :], "
+              "f8[:], f8[:], b1, b1)")
+
+
+def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, eps2, derivatives, majorant):
+    """Power (B,), gradient (B, 3), Hessian (B, 3, 3) and ``M - H`` (B, 3, 3) of the balls.
+
+    ``u`` (B, 3) the balls' scaled unknowns; ``owner`` (C,) the ball of each contact; the
+    coefficients (C, I) of the sliding velocity ``A = g10 u0 + g12 u1 + h1 - u2``,
+    ``S = s0 u0 + s1 u1 + hs``; ``weight`` (K, C, I) the quadrature weights times ``mu Q``;
+    ``t2`` (K,) the folded ``t^2``; ``eps2`` (C,) the squared regularisation. Without
+    ``derivatives`` only the power is summed (the others come back zero), without
+    ``majorant`` ``M - H`` comes back zero. The formulas are those of ``_Contacts.evaluate``."""
+    n_contacts, n_across = g10.shape
+    n_along = t2.shape[0]
+    power = np.zeros(n_balls)
+    gradient = np.zeros((n_balls, 3))
+    hessian = np.zeros((n_balls, 3, 3))
+    extra = np.zeros((n_balls, 3, 3))
+    for c in range(n_contacts):
+        b = owner[c]
+        u0, u1, u2 = u[b, 0], u[b, 1], u[b, 2]
+        e2 = eps2[c]
+        for i in range(n_across):
+            a = g10[c, i] * u0 + g12[c, i] * u1 + (h1[c, i] - u2)
+            s_ = s0[c, i] * u0 + s1[c, i] * u1 + hs[c, i]
+            a2, s2 = a * a, s_ * s_
+            total = 0.0
+            alpha = beta = m0 = m1 = m2 = 0.0
+            for k in range(n_along):
+                speed = math.sqrt(a2 + t2[k] * s2 + e2)
+                w = weight[k, c, i]
+                total += w * speed
+                if derivatives:
+                    ws = w / speed                      # w / s
+                    alpha += ws
+                    beta += ws * t2[k]
+                    ws3 = ws / speed / speed            # w / s^3
+                    m0 += ws3
+                    m1 += ws3 * t2[k]
+                    m2 += ws3 * t2[k] * t2[k]
+            power[b] += total
+            if not derivatives:
+                continue
+            ga_0, ga_1 = g10[c, i], g12[c, i]           # GA = (g10, g12, -1), GS = (s0, s1, 0)
+            gs_0, gs_1 = s0[c, i], s1[c, i]
+            grad_a, grad_s = alpha * a, beta * s_       # dD/dA, dD/dS
+            gradient[b, 0] += grad_a * ga_0 + grad_s * gs_0
+            gradient[b, 1] += grad_a * ga_1 + grad_s * gs_1
+            gradient[b, 2] -= grad_a
+            e_aa, e_as, e_ss = m0 * a2, m1 * a * s_, m2 * s2
+            h_aa, h_ss = alpha - e_aa, beta - e_ss
+            # H = h_aa GA GA^T - e_as (GA GS^T + GS GA^T) + h_ss GS GS^T
+            hessian[b, 0, 0] += h_aa * ga_0 * ga_0 - e_as * 2.0 * ga_0 * gs_0 + h_ss * gs_0 * gs_0
+            hessian[b, 0, 1] += h_aa * ga_0 * ga_1 - e_as * (ga_0 * gs_1 + gs_0 * ga_1) + h_ss * gs_0 * gs_1
+            hessian[b, 1, 1] += h_aa * ga_1 * ga_1 - e_as * 2.0 * ga_1 * gs_1 + h_ss * gs_1 * gs_1
+            hessian[b, 0, 2] += e_as * gs_0 - h_aa * ga_0
+            hessian[b, 1, 2] += e_as * gs_1 - h_aa * ga_1
+            hessian[b, 2, 2] += h_aa
+            if majorant:  # M - H = e_aa GA GA^T + e_as (GA GS^T + GS GA^T) + e_ss GS GS^T
+                extra[b, 0, 0] += e_aa * ga_0 * ga_0 + e_as * 2.0 * ga_0 * gs_0 + e_ss * gs_0 * gs_0
+                extra[b, 0, 1] += e_aa * ga_0 * ga_1 + e_as * (ga_0 * gs_1 + gs_0 * ga_1) + e_ss * gs_0 * gs_1
+                extra[b, 1, 1] += e_aa * ga_1 * ga_1 + e_as * 2.0 * ga_1 * gs_1 + e_ss * gs_1 * gs_1
+                extra[b, 0, 2] -= e_aa * ga_0 + e_as * gs_0
+                extra[b, 1, 2] -= e_aa * ga_1 + e_as * gs_1
+                extra[b, 2, 2] += e_aa
+    for b in range(n_balls):                            # the lower triangles
+        for r, c in ((1, 0), (2, 0), (2, 1)):
+            hessian[b, r, c] = hessian[b, c, r]
+            extra[b, r, c] = extra[b, c, r]
+    return power, gradient, hessian, extra
+
+
+evaluate_points = numba.njit(_SIGNATURE, cache=True, nogil=True)(_evaluate_points) if AVAILABLE else None

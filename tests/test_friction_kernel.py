@@ -1,0 +1,134 @@
+"""The compiled friction loop (numba) and its numpy fallback give the same results.
+
+The compiled loop (:mod:`slewing_model.friction_kernel`) is optional: the FMU runs where
+numba is not installed, with the numpy code. These tests compare both paths term by term
+(power, gradient, Hessian, Weiszfeld majorant) and on whole friction torques, cold and
+warm-started, and run the library and the FMU in a Python where numba cannot be imported.
+"""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from slewing_model import Loads, friction_torque, load_bearing, solve
+from slewing_model.friction import _Contacts, _ContactSet, ellipse_quadrature
+from slewing_model.friction_kernel import AVAILABLE
+
+from conftest import BEARINGS, ROOT
+
+needs_numba = pytest.mark.skipif(not AVAILABLE, reason="numba is not installed: only the numpy path exists here")
+
+#: a Python prelude that makes numba impossible to import, as on a host without it
+NO_NUMBA = """
+import sys
+class _NoNumba:
+    def find_spec(self, name, path=None, target=None):
+        if name == "numba" or name.startswith("numba."):
+            raise ImportError("numba is not installed (blocked by the test)")
+sys.meta_path.insert(0, _NoNumba())
+"""
+
+
+def _distributions():
+    """Load distributions of every kind: two-contact (axial), four-contact (idling with
+    preload), mixed (combined load with errors)."""
+    table3 = load_bearing(BEARINGS / "table3.toml")
+    errors = load_bearing(BEARINGS / "table3_errors.toml").with_preload(10e-6)
+    return [(table3, solve(table3, Loads(Fz=3e5))),
+            (table3.with_preload(20e-6), solve(table3.with_preload(20e-6))),
+            (errors, solve(errors, Loads(Fx=2e4, Fz=5e4, Mx=4e3), psi=0.3))]
+
+
+@needs_numba
+@pytest.mark.parametrize("case", range(3))
+@pytest.mark.parametrize("quadrature", [(12, 2), (20, 4)])
+def test_compiled_sums_equal_the_numpy_sums(case, quadrature):
+    bearing, distribution = _distributions()[case]
+    geometry = _ContactSet(bearing, distribution, 0.1, 1.0, 1e-3)
+    quad = ellipse_quadrature(*quadrature)
+    numpy_path = _Contacts(geometry, quad, workspace="kernel-test")
+    compiled = _Contacts(geometry, quad, workspace="kernel-test-compiled", compiled=True)
+    rng = np.random.default_rng(case)
+    start = geometry.initial_guesses()[0]
+    for u in (start, start * (1.0 + 0.3 * rng.standard_normal(start.shape))):
+        want = numpy_path.evaluate(u, geometry.eps2, majorant=True)
+        got = compiled.evaluate(u, geometry.eps2, majorant=True)
+        for name, a, b in zip(("power", "gradient", "hessian", "majorant"), got, want):
+            scale = np.abs(b).max()
+            assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * scale), name
+        power_only = compiled.evaluate(u, geometry.eps2, derivatives=False)
+        assert power_only[1] is None and np.allclose(power_only[0], want[0], rtol=1e-12)
+    # a subset of the balls (the stragglers' path) keeps the compiled loop
+    balls = np.arange(0, geometry.active.size, 3)
+    sub_np, sub_c = numpy_path.subset(balls), compiled.subset(balls)
+    eps2 = geometry.eps2[np.isin(geometry.owner, balls)]
+    assert np.allclose(sub_c.evaluate(start[balls], eps2)[2], sub_np.evaluate(start[balls], eps2)[2], rtol=1e-12,
+                       atol=1e-12 * np.abs(sub_np.evaluate(start[balls], eps2)[2]).max())
+
+
+@needs_numba
+@pytest.mark.parametrize("case", range(3))
+def test_compiled_torque_equals_the_numpy_torque(case):
+    bearing, distribution = _distributions()[case]
+    cold = {k: friction_torque(bearing, distribution, kernel=k) for k in ("numpy", "compiled")}
+    assert cold["compiled"].magnitude == pytest.approx(cold["numpy"].magnitude, rel=1e-12)
+    assert cold["compiled"].iterations == cold["numpy"].iterations
+    assert np.allclose(cold["compiled"].state, cold["numpy"].state, rtol=1e-9, atol=1e-12)
+    # warm-started from a slightly different state, as every co-simulation step is
+    warm = {k: friction_torque(bearing, distribution, kernel=k, initial=cold["numpy"].state * 1.01)
+            for k in ("numpy", "compiled")}
+    assert warm["compiled"].magnitude == pytest.approx(warm["numpy"].magnitude, rel=1e-12)
+
+
+def test_unknown_kernel_is_refused():
+    bearing, distribution = _distributions()[0]
+    with pytest.raises(ValueError, match="kernel = 'fortran'"):
+        friction_torque(bearing, distribution, kernel="fortran")
+
+
+def _run(code: str) -> dict:
+    out = subprocess.run([sys.executable, "-c", NO_NUMBA + code], capture_output=True, text=True, cwd=ROOT,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_library_without_numba_gives_the_same_torque():
+    bearing, distribution = _distributions()[2]
+    here = friction_torque(bearing, distribution).magnitude          # compiled where numba is here
+    there = _run("""
+import json
+from slewing_model import Loads, friction_torque, load_bearing, solve
+from slewing_model.friction_kernel import AVAILABLE
+b = load_bearing("examples/bearings/table3_errors.toml").with_preload(10e-6)
+d = solve(b, Loads(Fx=2e4, Fz=5e4, Mx=4e3), psi=0.3)
+try:
+    friction_torque(b, d, kernel="compiled")
+    refused = ""
+except ValueError as exc:
+    refused = str(exc)
+print(json.dumps({"available": AVAILABLE, "torque": friction_torque(b, d).magnitude, "refused": refused}))
+""")
+    assert there["available"] is False
+    assert "needs numba" in there["refused"]
+    assert there["torque"] == pytest.approx(here, rel=1e-12)
+
+
+def test_fmu_without_numba_gives_the_same_outputs(table3_fmu):
+    from fmpy import simulate_fmu
+
+    names = ["z", "rx", "friction_torque", "max_ball_load"]
+    start = {"Fz": 4e4, "Mx": 2e3, "psi": 0.2, "omega": 0.5}
+    here = simulate_fmu(str(table3_fmu), stop_time=0.05, step_size=0.01, start_values=start, output=names)
+    there = _run(f"""
+import json
+from fmpy import simulate_fmu
+r = simulate_fmu({str(table3_fmu)!r}, stop_time=0.05, step_size=0.01, start_values={start!r}, output={names!r})
+import slewing_model.friction_kernel as k
+print(json.dumps({{"available": k.AVAILABLE, **{{n: float(r[n][-1]) for n in {names!r}}}}}))
+""")
+    assert there.pop("available") is False
+    for name in names:
+        assert there[name] == pytest.approx(float(here[name][-1]), rel=1e-9, abs=1e-15), name
