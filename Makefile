@@ -14,6 +14,12 @@ $(STAMP): pyproject.toml
 	    apt-get update -qq && apt-get install -y -qq libtbb12 >/dev/null; \
 	  else echo "note: libtbb12 is missing and cannot be installed here (not root): the ecos host test will be skipped"; fi; \
 	fi
+	@# a C compiler (gcc, libc6-dev): build_fmu.py compiles the FMU's Linux binary (fmu_src/shim)
+	@if ! printf 'int main(void){return 0;}\n' | $${CC:-cc} -x c - -o /dev/null 2>/dev/null; then \
+	  if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -qq && apt-get install -y -qq gcc libc6-dev >/dev/null; \
+	  else echo "error: no working C compiler and not root: install gcc and libc6-dev, or building the FMU fails"; fi; \
+	fi
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[all]"

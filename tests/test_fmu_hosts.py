@@ -280,3 +280,13 @@ def test_the_fmu_holds_no_path_of_the_building_machine_outside_its_python_file(t
     assert named["version"] == sys.version.split()[0]
     assert Path(named["home"]) == Path(sys.base_prefix) and Path(named["environment"]) == Path(sys.prefix)
     assert Path(named["library"]).exists() and Path(named["library"]).name.startswith("libpython")
+
+
+def test_building_without_a_c_compiler_fails_with_what_to_install(monkeypatch):
+    sys.path.insert(0, str(ROOT))
+    import build_fmu
+
+    monkeypatch.setenv("PATH", "/nonexistent")
+    monkeypatch.setenv("CC", "no-such-compiler")
+    with pytest.raises(RuntimeError, match="needs a C compiler.*apt-get install gcc libc6-dev"):
+        build_fmu.compile_shim(Path(tempfile.gettempdir()) / "never_written.so")
