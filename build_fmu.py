@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Build the slewing bearing FMU (FMI 2.0 co-simulation) for one bearing definition.
 
-    python build_fmu.py BEARING.toml [-o FILE.fmu] [--bc free|clamped|frictionless] [--mesh coarse|fine]
+    python build_fmu.py BEARING.toml [-o FILE.fmu] [--bc free|clamped|frictionless] [--mesh coarse|fine] [--fmi-version 2|3]
 
 Builds (or takes from the cache) the ring superelement, then packages with
 pythonfmu: the slave ``fmu_src/SlewingBearing.py``, the run-time modules of
