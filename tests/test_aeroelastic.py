@@ -27,6 +27,12 @@ def _output(time, columns: dict, units: dict, path="memory.outb") -> OutputFile:
     return OutputFile(path, channels["Time"], channels, {"Time": "s"} | units)
 
 
+def _blade_output(t, b, pitch) -> OutputFile:
+    """b-frame loads (kN, kN m) and BldPitch1 (deg) as an in-memory file."""
+    return _output(t, dict(zip(B_FRAME, b.T)) | {"BldPitch1": pitch},
+                   dict(zip(B_FRAME, LOAD_UNITS)) | {"BldPitch1": "deg"})
+
+
 def _blade_run(n=301, seed=7):
     """A blade-root record in the b frame (kN, kN m) with the pitch moving over 0..15 deg."""
     rng = np.random.default_rng(seed)
@@ -134,7 +140,7 @@ def test_c_frame_and_b_frame_files_of_the_same_run_give_the_same_bearing_loads(t
 
 def test_the_fixed_frame_is_the_rotating_one_turned_by_psi_as_the_simulator_does():
     t, pitch, b = _blade_run(n=50)
-    out = _output(t, dict(zip(B_FRAME, b.T)) | {"BldPitch1": pitch}, dict(zip(B_FRAME, LOAD_UNITS)) | {"BldPitch1": "deg"})
+    out = _blade_output(t, b, pitch)
     for mounting in ("tip", "hub"):
         rot = bearing_loads(out, "pitch", 1, mounting, frame="rotating")
         fixed = bearing_loads(out, "pitch", 1, mounting, frame="fixed")
@@ -275,7 +281,7 @@ def test_latin1_text_file_is_converted_to_si(tmp_path):
 
 def test_time_window_keeps_the_rate_of_the_whole_record():
     t, pitch, b = _blade_run()
-    out = _output(t, dict(zip(B_FRAME, b.T)) | {"BldPitch1": pitch}, dict(zip(B_FRAME, LOAD_UNITS)) | {"BldPitch1": "deg"})
+    out = _blade_output(t, b, pitch)
     whole, part = bearing_loads(out, "pitch"), bearing_loads(out, "pitch", t_start=10.0, t_end=20.0)
     keep = (t >= 10.0 - 1e-9) & (t <= 20.0 + 1e-9)
     assert part.time[0] == pytest.approx(10.0) and part.time[-1] == pytest.approx(20.0)
@@ -304,7 +310,7 @@ def test_missing_channel_is_named_with_the_file(tmp_path):
 def test_non_finite_channel_and_bad_options_are_refused():
     t, pitch, b = _blade_run(n=20)
     b[7, 4] = np.nan
-    out = _output(t, dict(zip(B_FRAME, b.T)) | {"BldPitch1": pitch}, dict(zip(B_FRAME, LOAD_UNITS)) | {"BldPitch1": "deg"})
+    out = _blade_output(t, b, pitch)
     with pytest.raises(OpenFastFormatError, match=f"RootMyb1 is not finite .* at t = {t[7]:g} s"):
         bearing_loads(out, "pitch")
     for kwargs, message in (({"bearing": "tower"}, "bearing = 'tower'"), ({"mounting": "up"}, "mounting = 'up'"),
@@ -316,7 +322,7 @@ def test_non_finite_channel_and_bad_options_are_refused():
 
 def test_load_series_csv_round_trip_with_motion_and_frame(tmp_path):
     t, pitch, b = _blade_run(n=25)
-    out = _output(t, dict(zip(B_FRAME, b.T)) | {"BldPitch1": pitch}, dict(zip(B_FRAME, LOAD_UNITS)) | {"BldPitch1": "deg"})
+    out = _blade_output(t, b, pitch)
     series = bearing_loads(out, "pitch", frame="fixed")
     series.write_csv(tmp_path / "loads.csv", comments=["a comment"])
     text = (tmp_path / "loads.csv").read_text().splitlines()
