@@ -263,8 +263,8 @@ class SlewingBearing(Fmi2Slave):
             result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
         except (ValueError, NoEquilibriumError) as exc:
             sim.set_state(before)  # the solver may have moved: back to the state before the step
-            key = (current_time, tuple(getattr(self, name) for name, _, _ in INPUTS),
-                   self.friction_coefficient, self.seal_torque, self.omega_regularisation)
+            key = repr((current_time, [getattr(self, name) for name, _, _ in INPUTS],  # repr: NaN equals NaN
+                        self.friction_coefficient, self.seal_torque, self.omega_regularisation))
             if current_time is not None and key == self._refused:
                 self.log(f"{self.instance_name}: step at t = {current_time} refused again with the same inputs, "
                          f"so it cannot succeed (change an input, or stop): {exc}", Fmi2Status.error)

@@ -290,3 +290,26 @@ def test_building_without_a_c_compiler_fails_with_what_to_install(monkeypatch):
     monkeypatch.setenv("CC", "no-such-compiler")
     with pytest.raises(RuntimeError, match="needs a C compiler.*apt-get install gcc libc6-dev"):
         build_fmu.compile_shim(Path(tempfile.gettempdir()) / "never_written.so")
+
+
+def test_a_master_repeating_a_refused_step_unchanged_gets_an_error_not_an_endless_loop(table3_fmu, tmp_path):
+    # fmpy's simulate_fmu retries a discarded step at the same time with the same inputs; the
+    # second refusal of the very same step is fmi2Error, logged even with logging off
+    script = tmp_path / "retry.py"
+    script.write_text(f"""
+import numpy as np
+from fmpy import simulate_fmu
+t = np.linspace(0, 0.1, 11)
+data = np.zeros(len(t), dtype=[("time", float), ("Fz", float)])
+data["time"], data["Fz"] = t, 3e4
+data["Fz"][5:] = np.nan
+try:
+    simulate_fmu({str(table3_fmu)!r}, stop_time=0.1, step_size=0.01, input=data, output=["z"])
+    print("FINISHED")
+except Exception as exc:
+    print("RAISED", exc)
+""")
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert "RAISED fmi2DoStep failed with status 3 (error)" in run.stdout, run.stdout + run.stderr
+    assert "step at t = 0.05 refused again with the same inputs, so it cannot succeed" in run.stdout + run.stderr
+    assert "input Fz = nan" in run.stdout + run.stderr
