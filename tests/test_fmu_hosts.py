@@ -313,3 +313,38 @@ except Exception as exc:
     assert "RAISED fmi2DoStep failed with status 3 (error)" in run.stdout, run.stdout + run.stderr
     assert "step at t = 0.05 refused again with the same inputs, so it cannot succeed" in run.stdout + run.stderr
     assert "input Fz = nan" in run.stdout + run.stderr
+
+
+def test_an_overload_refused_inside_the_solver_leaves_no_trace(table3_fmu):
+    # unlike a NaN, caught before the solve, an overload fails inside the Newton solver, which has
+    # moved: the slave restores the state of before the step
+    md = read_model_description(str(table3_fmu))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    unzipped = extract(str(table3_fmu))
+    outputs = {}
+    try:
+        for label in ("undisturbed", "disturbed"):
+            slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier="SlewingBearing",
+                              instanceName=label)
+            slave.instantiate()
+            slave.setupExperiment(startTime=0.0)
+            slave.enterInitializationMode()
+            slave.exitInitializationMode()
+            out = []
+            for k in range(6):
+                if k == 3 and label == "disturbed":
+                    slave.setReal([refs["Fz"]], [5e7])
+                    with pytest.raises(Exception, match="status 2"):
+                        slave.doStep(k * H, H)
+                    continue
+                if k == 3:
+                    continue
+                slave.setReal([refs[n] for n in INPUTS], host_inputs(k))
+                slave.doStep(k * H, H)
+                out.append(slave.getReal([refs[n] for n in OUTPUTS]))
+            outputs[label] = out
+            slave.terminate()
+            slave.freeInstance()
+    finally:
+        shutil.rmtree(unzipped, ignore_errors=True)
+    assert outputs["disturbed"] == outputs["undisturbed"]
