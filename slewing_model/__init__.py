@@ -18,8 +18,9 @@ from .friction import FrictionTorque, catalogue_torque, friction_torque
 __version__ = "0.1.0"
 
 #: the run-time part of the package (numpy and the standard library): the modules an FMU carries
-RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "bime", "blas", "ring_stiffness",
-                   "friction", "friction_kernel", "simulator")
+RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "distribution", "ring_stiffness",
+                   "ring_compliance", "reduced_operator", "bime", "blas", "ellipse_quadrature", "contact_friction",
+                   "ball_kinematics", "friction_kernel", "catalogue", "friction_studies", "friction", "simulator")
 
 __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",

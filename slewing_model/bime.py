@@ -37,231 +37,35 @@ Stopping rule
     scale ``max(|F|, |M|/(dm/2), max contact load)``, and, for flexible
     rings, the contact forces felt by the rings equal the Hertz forces to the
     same tolerance.
+
+Where the pieces live
+    :mod:`slewing_model.distribution` (the loads and the result),
+    :mod:`slewing_model.ring_compliance` (``G`` and ``M`` from the superelements),
+    :mod:`slewing_model.reduced_operator` (the reduced Newton operator, kept between
+    iterations and steps and updated when contacts open or close); this module holds the
+    energy, its derivatives and the Newton iteration.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
+from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
+    DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
+)
 from .geometry import RING_CONTACTS, Bearing
+from .reduced_operator import assemble_operator, newton_step, reduced_operator, update_operator
+from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
 
-LOAD_FIELDS = ("Fx", "Fy", "Fz", "Mx", "My")
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
 #: residual by less than this factor (benchmarks/bench_flexible.py measured the choice)
 REFRESH = 0.25
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
-DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
-
-
-class NoEquilibriumError(RuntimeError):
-    """No equilibrium exists for the load (or the solver could not find one)."""
-
-
-class LoadCapacityError(NoEquilibriumError):
-    """The load is beyond what the raceways can carry (truncated contact ellipse)."""
-
-
-@dataclass(frozen=True)
-class Loads:
-    """External load on the moving ring, fixed frame, SI units.
-
-    Attributes
-    ----------
-    Fx, Fy, Fz : float, N
-        Force; ``Fz > 0`` pushes the moving (inner) ring towards +z and loads
-        diagonal 1 (contacts 1 and 3).
-    Mx, My : float, N m
-        Tilting moment about the x and y axes (right hand).
-    """
-
-    Fx: float = 0.0
-    Fy: float = 0.0
-    Fz: float = 0.0
-    Mx: float = 0.0
-    My: float = 0.0
-
-    def __post_init__(self):
-        for name in LOAD_FIELDS:
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ValueError(f"load {name} = {value!r}: must be a number")
-            if not math.isfinite(value):
-                raise ValueError(f"load {name} = {value!r}: must be finite (not NaN or infinite)")
-
-    @classmethod
-    def from_paper(cls, axial: float = 0.0, radial: float = 0.0, tilting_moment: float = 0.0,
-                   direction: float = 0.0) -> "Loads":
-        """The paper's load set (eqs 19, 22): axial ``Fa`` (N, along +z), radial
-        ``Fr`` (N) in the direction ``phi_r`` (rad) and tilting moment ``Mt``
-        (N m) about the axis perpendicular to it, ``(-sin phi_r, cos phi_r)``."""
-        c, s = math.cos(direction), math.sin(direction)
-        return cls(radial * c, radial * s, axial, -tilting_moment * s, tilting_moment * c)
-
-    @classmethod
-    def from_array(cls, values) -> "Loads":
-        return cls(*[float(v) for v in values])
-
-    def as_array(self) -> np.ndarray:
-        return np.array([self.Fx, self.Fy, self.Fz, self.Mx, self.My])
-
-    def rotated(self, angle: float) -> "Loads":
-        """The same load turned by ``angle`` (rad) about z (e.g. from the
-        moving ring's own frame to the fixed frame)."""
-        c, s = math.cos(angle), math.sin(angle)
-        return Loads(c * self.Fx - s * self.Fy, s * self.Fx + c * self.Fy, self.Fz,
-                     c * self.Mx - s * self.My, s * self.Mx + c * self.My)
-
-
-@dataclass(frozen=True)
-class LoadDistribution:
-    """Result of a BIME solve. Arrays are per ball (axis 0) and per contact 1..4
-    or per diagonal 1, 2 (axis 1). SI units.
-
-    Attributes
-    ----------
-    model : str
-        ``"rigid"`` or ``"flexible"``.
-    loads : Loads
-    displacement : ndarray (5,)
-        Moving ring (X, Y, Z in m; rx, ry in rad).
-    ball_angle : ndarray (B,), rad
-    contact_load : ndarray (B, 4), N
-        ``Q`` of contacts 1..4 (``Q1 = Q3``, ``Q2 = Q4``).
-    contact_angle : ndarray (B, 4), rad
-        Loaded contact angle of each contact (that of its diagonal).
-    interference : ndarray (B, 2), m
-        ``delta_tot`` of diagonals 1 and 2 (negative: a gap).
-    contact_deflection : ndarray (B, 4), m
-        Share ``delta_i = (Q/K_i)^(2/3)`` of each contact.
-    ring_displacement : ndarray (B, 4, 2) or None, m
-        (R, z) displacement of the groove centre of contacts 1..4 by ring
-        deformation (flexible model).
-    semi_axis_a, semi_axis_b : ndarray (B, 4), m
-        Hertz ellipse across the groove and along the rolling direction.
-    contact_pressure : ndarray (B, 4), Pa
-        Maximum Hertz pressure of each contact.
-    truncated : ndarray (B, 4) of bool
-        Edge loading: the contact ellipse runs over the groove edge (its
-        pressure is then higher than Hertz's, which assumes an untruncated ellipse).
-    energy : float, J
-        Total potential energy (eq 20).
-    iterations : int
-    residual : float
-        Largest force residual at the end, relative to the load scale.
-    state : ndarray
-        Solver unknowns, for a warm start (:meth:`BimeSolver.solve` ``initial``).
-    """
-
-    model: str
-    loads: Loads
-    displacement: np.ndarray
-    ball_angle: np.ndarray
-    contact_load: np.ndarray
-    contact_angle: np.ndarray
-    interference: np.ndarray
-    contact_deflection: np.ndarray
-    ring_displacement: np.ndarray | None
-    semi_axis_a: np.ndarray
-    semi_axis_b: np.ndarray
-    contact_pressure: np.ndarray
-    truncated: np.ndarray
-    energy: float
-    iterations: int
-    residual: float
-    state: np.ndarray = field(repr=False)
-
-    @property
-    def max_ball_load(self) -> float:
-        """Largest contact load, N."""
-        return float(self.contact_load.max())
-
-    @property
-    def max_contact_pressure(self) -> float:
-        """Largest Hertz pressure, Pa."""
-        return float(self.contact_pressure.max())
-
-    @property
-    def static_safety_factor(self) -> float:
-        """ISO 76 static safety factor ``(4200 MPa / p_max)^3`` (load ratio, as
-        ``C0 / P0``: Hertz pressure grows with the cube root of the load);
-        infinite for an unloaded bearing."""
-        p = self.max_contact_pressure
-        return math.inf if p <= 0.0 else (ISO76_PRESSURE_LIMIT / p) ** 3
-
-    @property
-    def truncated_contacts(self) -> int:
-        """Number of contacts whose ellipse runs over the groove edge (edge loading)."""
-        return int(np.count_nonzero(self.truncated))
-
-    @property
-    def balls_in_four_point_contact(self) -> int:
-        """Number of balls whose both diagonals carry load."""
-        return int(np.count_nonzero(np.all(self.interference > 0.0, axis=1)))
-
-    def to_dict(self) -> dict:
-        """Plain JSON-ready data (the ``slewing solve --json`` object)."""
-        d = {
-            "model": self.model,
-            "loads": {k: getattr(self.loads, k) for k in LOAD_FIELDS},
-            "displacement": dict(zip(DISPLACEMENT_FIELDS, map(float, self.displacement))),
-            "Q": self.contact_load.tolist(),
-            "contact_angle": self.contact_angle.tolist(),
-            "interference": self.interference.tolist(),
-            "ball_angle": self.ball_angle.tolist(),
-            "contact_pressure": self.contact_pressure.tolist(),
-            "max_ball_load": self.max_ball_load,
-            "max_contact_pressure": self.max_contact_pressure,
-            "static_safety_factor": self.static_safety_factor,
-            "balls_in_four_point_contact": self.balls_in_four_point_contact,
-            "truncated_contacts": self.truncated_contacts,
-            "energy": self.energy,
-            "iterations": self.iterations,
-        }
-        if self.ring_displacement is not None:
-            d["ring_displacement"] = self.ring_displacement.tolist()
-        return d
-
-
-def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
-    """Pseudo-inverse of a symmetric block-circulant matrix given by its first
-    block row (B, m, m), returned dense. Inverts block by block in the harmonic
-    (DFT) basis, dropping the null space (a free ring's rigid-body modes)."""
-    n, m, _ = first_row.shape
-    blocks = np.fft.fft(first_row, axis=0)  # block j = sum_k C_k exp(-2 pi i j k / B)
-    top = max(np.abs(np.linalg.eigvalsh(0.5 * (b + b.conj().T))).max() for b in blocks)
-    inv = np.empty_like(blocks)
-    for j, b in enumerate(blocks):
-        w, v = np.linalg.eigh(0.5 * (b + b.conj().T))
-        keep = np.abs(w) > rcond * top
-        inv[j] = (v[:, keep] / w[keep]) @ v[:, keep].conj().T
-    row = np.fft.ifft(inv, axis=0).real  # first block row of the pseudo-inverse
-    k = (np.arange(n)[None, :] - np.arange(n)[:, None]) % n
-    return row[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
-
-
-def ring_compliances(superelement) -> dict[str, np.ndarray]:
-    """``G`` (4B, 4B) of each ring: its compliance at its groove centres, the
-    pseudo-inverse of its superelement (a free ring's rigid modes dropped)."""
-    return {name: _pseudo_inverse_circulant(np.asarray(getattr(superelement, name).first_row, dtype=float))
-            for name in ("outer", "inner")}
-
-
-def contact_compliance(rings: dict[str, np.ndarray]) -> np.ndarray:
-    """``M`` (4B, 4B): the combined compliance of both rings seen by the contacts,
-    ordered like the relative vectors ``e`` (ball, diagonal, (r, z)).
-
-    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` from :func:`ring_compliances`."""
-    n = rings["outer"].shape[0] // 4
-    total = 0.0
-    for name, slots in (("outer", OUTER_SLOT), ("inner", INNER_SLOT)):
-        index = _ring_index(n, slots)
-        total = total + rings[name][np.ix_(index, index)]
-    return total
 
 
 class BimeSolver:
@@ -380,8 +184,8 @@ class BimeSolver:
         if flexible:
             d_out, d_in = np.asarray(x[5:5 + 4 * n]), np.asarray(x[5 + 4 * n:])
             # relative vector of diagonal k: + inner groove centre - outer groove centre
-            p_out = _ring_selector(n, OUTER_SLOT)
-            p_in = _ring_selector(n, INNER_SLOT)
+            p_out = ring_selector(n, OUTER_SLOT)
+            p_in = ring_selector(n, INNER_SLOT)
             e = e + (p_in @ d_in - p_out @ d_out).reshape(e.shape)
             jac_full = np.concatenate([jac.reshape(-1, 5), -p_out, p_in], axis=1)
         else:
@@ -537,71 +341,9 @@ class BimeSolver:
         h = jac.reshape(-1, 5).T @ (p.hess.reshape(-1, 2, 2) @ jac.reshape(-1, 2, 5)).reshape(-1, 5)
         return np.linalg.solve(h + mu * np.eye(5), -grad_q)
 
-    def _contact_compliance_blocks(self, p: "_Point", active: np.ndarray) -> np.ndarray:
-        """``A^-1`` (n_active, 2, 2): compliance of the active diagonals' springs at ``p``."""
-        n = p.n.reshape(-1, 2)[active]
-        nn = n[:, :, None] * n[:, None, :]
-        delta = p.delta.ravel()[active]
-        k_normal = 1.5 * self.assembly.stiffness.ravel()[active] * np.sqrt(delta)
-        return nn / k_normal[:, None, None] + (p.length.ravel()[active] / p.q.ravel()[active])[:, None, None] * (
-            np.eye(2) - nn)
-
-    def _reduced_operator(self, idx, active, a_inv, w_inv, mu):
-        """Everything a Newton step needs from ``W^-1 = (A^-1 + M)_aa^-1``."""
-        ja = self.jacobian.reshape(-1, 5)[idx]
-        z_mat = w_inv @ ja
-        schur_inv = np.linalg.inv(ja.T @ z_mat + mu * np.eye(5))
-        self._reduced = (idx, active, a_inv, w_inv, ja, z_mat, schur_inv)
-        return self._reduced
-
-    def _update_reduced(self, cached, p: "_Point", idx, active, mu):
-        """Follow a change of the active contacts by a low-rank update of ``W^-1``.
-
-        Dropping rows: ``(W_kk)^-1 = P - Q S^-1 Q^T`` from the blocks of the old
-        inverse; adding rows (bordering): with ``X = W_kk^-1 B`` and the Schur
-        complement ``C - B^T X``. O(n^2 r) instead of O(n^3) for r changed rows.
-        The kept rows and columns move as slices (:func:`_move_block`).
-        Returns None (rebuild) when many contacts changed."""
-        old_idx, _, old_a_inv, w_inv = cached[:4]
-        keep = np.isin(old_idx, idx)
-        added = ~np.isin(idx, old_idx)
-        changed = int((~keep).sum() + added.sum())
-        if changed > 0.25 * idx.size:
-            return None
-        kept_idx = old_idx[keep]
-        if not keep.all():  # drop the contacts that opened
-            q_mat = w_inv[:, ~keep]
-            w_inv = _move_block(w_inv - q_mat @ np.linalg.solve(q_mat[~keep], q_mat.T), np.flatnonzero(keep),
-                                np.arange(kept_idx.size), kept_idx.size)
-        a_inv = old_a_inv[keep[::2]]
-        if added.any():  # border with the contacts that closed
-            new_idx = idx[added]
-            new_diagonals = np.zeros_like(active)
-            new_diagonals[new_idx[::2] // 2] = True
-            new_a_inv = self._contact_compliance_blocks(p, new_diagonals)
-            b_mat = self.compliance[np.ix_(kept_idx, new_idx)]
-            c_mat = self.compliance[np.ix_(new_idx, new_idx)]
-            blocks = np.arange(0, new_idx.size, 2)
-            for r in range(2):
-                for c in range(2):
-                    c_mat[blocks + r, blocks + c] += new_a_inv[:, r, c]
-            x_mat = w_inv @ b_mat
-            schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
-            xs = x_mat @ schur
-            at_kept, at_new = np.flatnonzero(~added), np.flatnonzero(added)   # places in the sorted idx
-            w_inv = _move_block(w_inv + xs @ x_mat.T, np.arange(kept_idx.size), at_kept, idx.size)
-            w_inv[np.ix_(at_kept, at_new)] = -xs
-            w_inv[np.ix_(at_new, at_kept)] = -xs.T
-            w_inv[np.ix_(at_new, at_new)] = schur
-            merged = np.empty((idx.size // 2, 2, 2))
-            merged[at_kept[::2] // 2] = a_inv
-            merged[at_new[::2] // 2] = new_a_inv
-            a_inv = merged
-        return self._reduced_operator(idx, active, a_inv, w_inv, mu)
-
     def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float, fresh: bool):
         """Newton step of the flexible model, reduced to the active contacts
-        (module docstring): returns the increments of ``qs`` and ``y``.
+        (:mod:`slewing_model.reduced_operator`): returns the increments of ``qs`` and ``y``.
 
         The reduced operator ``(A^-1 + M)_aa^-1`` is kept and reused (a modified
         Newton step with the contact stiffness ``A`` of an earlier iterate, which
@@ -610,35 +352,23 @@ class BimeSolver:
         slows. Between warm-started solves of slowly changing loads (the FMU's
         steps) an iteration then costs matrix-vector products only.
         """
-        dw = self.bearing.ball_diameter
-        active = (p.delta > 1e-15 * dw).ravel()
-        idx = np.flatnonzero(np.repeat(active, 2))
-        y_new = np.zeros_like(p.y)
-        if idx.size == 0:
+        active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
+        rows = np.flatnonzero(np.repeat(active, 2))
+        if rows.size == 0:
             self._reduced = None
-            return np.linalg.solve(mu * np.eye(5), f_scaled), y_new - p.y
-        cached = self._reduced
-        if not fresh and cached is not None and not np.array_equal(cached[0], idx):
-            cached = self._update_reduced(cached, p, idx, active, mu)
-        if not fresh and cached is not None and not np.array_equal(cached[4], self.jacobian.reshape(-1, 5)[idx]):
+            return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
+        stiffness, op = self.assembly.stiffness, self._reduced
+        if not fresh and op is not None and not np.array_equal(op.rows, rows):
+            op = update_operator(op, p, self.compliance, stiffness, self.jacobian, rows, active, mu)
+        if not fresh and op is not None and not np.array_equal(op.jacobian, self.jacobian.reshape(-1, 5)[rows]):
             # the ring turned since (set_rotation): W^-1 holds (the rings are axisymmetric and
             # the balls keep their spacing), the coupling to (X, Y, Z, rx, ry) is rebuilt
-            cached = self._reduced_operator(idx, active, *cached[2:4], mu)
-        if fresh or cached is None:
-            a_inv = self._contact_compliance_blocks(p, active)
-            w_mat = self.compliance[np.ix_(idx, idx)]         # (A^-1 + M)_aa
-            blocks = np.arange(0, idx.size, 2)
-            for r in range(2):
-                for c in range(2):
-                    w_mat[blocks + r, blocks + c] += a_inv[:, r, c]
-            cached = self._reduced_operator(idx, active, a_inv, np.linalg.inv(w_mat), mu)
-        _, active, a_inv, w_inv, ja, z_mat, schur_inv = cached
-        rhs = (a_inv @ p.force.reshape(-1, 2)[active][..., None]).ravel() + p.ring_motion[idx]
-        w_vec = w_inv @ rhs
-        dq = schur_inv @ (f_scaled - ja.T @ w_vec)
-        y_new[idx] = w_vec + z_mat @ dq
+            op = reduced_operator(rows, active, op.contact_compliance, op.inverse, self.jacobian, mu)
+        if fresh or op is None:
+            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)
+        self._reduced = op
+        dq, y_new = newton_step(op, p, f_scaled)
         return dq, y_new - p.y
-
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float) -> LoadDistribution:
         a = self.assembly
@@ -717,39 +447,6 @@ class _Point:
     total: float
     energy_scale: float
     ring_motion: np.ndarray | None = None   # M y: the groove centres' relative motion from ring deformation (flexible)
-
-
-def _move_block(source: np.ndarray, rows: np.ndarray, places: np.ndarray, size: int) -> np.ndarray:
-    """A new (size, size) matrix whose rows and columns ``places`` hold ``source[np.ix_(rows, rows)]``
-    (both increasing); the others are left to the caller.
-
-    Copied run by run, a run being rows that follow each other in both: when a few contacts
-    open or close there are a few runs, and slices copy at memory speed where numpy's
-    fancy indexing of a matrix copies element by element (ten times slower here)."""
-    out = np.empty((size, size))
-    cut = np.flatnonzero((np.diff(rows) != 1) | (np.diff(places) != 1)) + 1
-    if cut.size > 16:                         # many runs: one fancy copy is cheaper than many slices
-        out[np.ix_(places, places)] = source[np.ix_(rows, rows)]
-        return out
-    runs = [(rows[a], places[a], b - a) for a, b in zip(np.r_[0, cut], np.r_[cut, rows.size])]
-    for r0, p0, n in runs:
-        for c0, q0, m in runs:
-            out[p0:p0 + n, q0:q0 + m] = source[r0:r0 + n, c0:c0 + m]
-    return out
-
-
-def _ring_index(n: int, slots: np.ndarray) -> np.ndarray:
-    """Ring DOF (paper eq 14 order) of every entry of the relative vectors
-    ``e`` in (ball, diagonal, (r, z)) order; ``slots`` is the ring's contact
-    slot of diagonals 1 and 2."""
-    return (4 * np.arange(n)[:, None, None] + 2 * slots[None, :, None] + np.arange(2)[None, None, :]).ravel()
-
-
-def _ring_selector(n: int, slots: np.ndarray) -> np.ndarray:
-    """(4B, 4B) 0/1 matrix taking a ring's DOFs to the order of ``e``."""
-    p = np.zeros((4 * n, 4 * n))
-    p[np.arange(4 * n), _ring_index(n, slots)] = 1.0
-    return p
 
 
 def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid", superelement=None,

@@ -1,31 +1,38 @@
 """The per-point loop of the friction model, compiled with numba where it is installed.
 
-:meth:`slewing_model.friction._Contacts.evaluate` sums the regularised dissipated power
+:meth:`slewing_model.ball_kinematics.ContactPoints.evaluate` sums the regularised dissipated power
 ``D = sum w s``, ``s = sqrt(A^2 + t^2 S^2 + eps^2)``, its gradient and its Hessian (and the
 Weiszfeld majorant ``M - H``) over the quadrature points of every loaded contact, per ball.
 With numpy that is some sixty array operations per evaluation, each a few microseconds of
 call overhead for a few thousand points: for a 150-ball bearing the overhead, not the
-arithmetic, sets the time. :func:`evaluate_points` is the same sum as one compiled loop
+arithmetic, sets the time. :func:`_evaluate_points`, compiled, is the same sum as one loop
 over contacts, across-groove nodes and folded along-groove nodes.
 
 numba is optional (it is not part of the FMU's run-time requirements): without it
 :data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
-results to round-off (``tests/test_friction_kernel.py``). The loop is compiled when this
-module is imported (eager signatures), so that the compile time lands in the FMU's
-instantiation, never in a step.
+results to round-off (``tests/test_friction_kernel.py``). The loop is compiled when first
+asked for (:func:`compiled_evaluate_points`), which the simulator does when it is built, so
+that the compile time lands in the FMU's instantiation, never in a step.
 """
 from __future__ import annotations
 
+import functools
+import importlib.util
 import math
 
 import numpy as np
 
-try:  # optional: the compiled path
-    import numba
-except ImportError:  # pragma: no cover - exercised by the fallback test in a subprocess
-    numba = None
 
-AVAILABLE = numba is not None
+def _numba_installed() -> bool:
+    try:
+        return importlib.util.find_spec("numba") is not None
+    except (ImportError, ValueError):
+        return False
+
+
+#: numba can be imported here (it is imported, and the loop compiled, only when first asked for:
+#: importing numba also imports scipy, which the run-time part does not otherwise need)
+AVAILABLE = _numba_installed()
 
 _SIGNATURE = ("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
               "f8[:, :], i8[:], i8, f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :, :], "
@@ -40,7 +47,7 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
     ``S = s0 u0 + s1 u1 + hs``; ``weight`` (K, C, I) the quadrature weights times ``mu Q``;
     ``t2`` (K,) the folded ``t^2``; ``eps2`` (C,) the squared regularisation. Without
     ``derivatives`` only the power is summed (the others come back zero), without
-    ``majorant`` ``M - H`` comes back zero. The formulas are those of ``_Contacts.evaluate``."""
+    ``majorant`` ``M - H`` comes back zero. The formulas are those of ``ContactPoints.evaluate``."""
     n_contacts, n_across = g10.shape
     n_along = t2.shape[0]
     power = np.zeros(n_balls)
@@ -101,4 +108,13 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
     return power, gradient, hessian, extra
 
 
-evaluate_points = numba.njit(_SIGNATURE, cache=True, nogil=True)(_evaluate_points) if AVAILABLE else None
+@functools.lru_cache(maxsize=1)
+def compiled_evaluate_points():
+    """The compiled :func:`_evaluate_points` (numba, eager signature, numba's on-disk cache).
+
+    The first call compiles (about a second) or loads it from the cache;
+    :class:`slewing_model.simulator.BearingSimulator` makes that call when it is built, so
+    that it lands in the FMU's instantiation and never in a step."""
+    import numba
+
+    return numba.njit(_SIGNATURE, cache=True, nogil=True)(_evaluate_points)

@@ -19,6 +19,8 @@ import numpy as np
 from .bime import BimeSolver, LoadDistribution, Loads
 from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
+from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE, compiled_evaluate_points
+from .reduced_operator import ReducedOperator
 from .geometry import Bearing
 
 RING_MODELS = ("rigid", "flexible")
@@ -164,6 +166,8 @@ class BearingSimulator:
         self.bearing = bearing
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
                                  rtol=s.tolerance)
+        if s.friction_kernel != "numpy" and COMPILED_AVAILABLE:
+            compiled_evaluate_points()     # compiled (or loaded from numba's cache) now, not in a step
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
@@ -225,8 +229,9 @@ class BearingSimulator:
         """Everything that affects the next step: the warm start, the rotation and
         the solver's reused Newton operator (numpy arrays, not copied: they are
         never changed in place). :func:`encode_state` makes it JSON data."""
-        return {"warm": self._warm, "previous": self._previous, "psi": self._psi, "operator": self.solver._reduced,
-                "friction": self._friction_warm}
+        operator = self.solver._reduced
+        return {"warm": self._warm, "previous": self._previous, "psi": self._psi,
+                "operator": None if operator is None else operator.as_tuple(), "friction": self._friction_warm}
 
     def set_state(self, state: dict) -> None:
         """Restore :meth:`get_state` (or its :func:`decode_state`)."""
@@ -234,7 +239,7 @@ class BearingSimulator:
         self._previous = None if state.get("previous") is None else np.asarray(state["previous"], dtype=float)
         self._psi = float(state["psi"])
         self.solver.set_rotation(self._psi)
-        self.solver._reduced = None if state["operator"] is None else tuple(state["operator"])
+        self.solver._reduced = None if state["operator"] is None else ReducedOperator.from_tuple(state["operator"])
         self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
 
 

@@ -422,11 +422,11 @@ def test_result_serialises(axial):
 def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
     # internals of the ball equilibrium: the analytic gradient and Hessian of the regularised power
     # match central differences, and M = H + (M - H) majorises the power (Weiszfeld step is safe)
-    from slewing_model.friction import _Contacts, _ContactSet
+    from slewing_model.ball_kinematics import ContactPoints, ContactSet
 
     bearing, dist = combined
-    geo = _ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
-    contacts = _Contacts(geo, ellipse_quadrature(12, 2), workspace="test")
+    geo = ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
+    contacts = ContactPoints(geo, ellipse_quadrature(12, 2), workspace="test")
     rng = np.random.default_rng(5)
     u = geo.initial_guesses()[0] * (1 + 0.01 * rng.standard_normal((geo.active.size, 3)))
     eps2 = geo.eps2 * 100
@@ -452,11 +452,11 @@ def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
 
 def test_subset_of_balls_evaluates_as_the_whole(combined):
     # the last iterations of a few balls run on their own contacts: same power, gradient, Hessians
-    from slewing_model.friction import _Contacts, _ContactSet
+    from slewing_model.ball_kinematics import ContactPoints, ContactSet
 
     bearing, dist = combined
-    geo = _ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
-    contacts = _Contacts(geo, ellipse_quadrature(12, 2), workspace="test")
+    geo = ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
+    contacts = ContactPoints(geo, ellipse_quadrature(12, 2), workspace="test")
     u = geo.initial_guesses()[1]
     balls = np.array([0, 5, geo.active.size - 1])
     whole = contacts.evaluate(u, geo.eps2, majorant=True)

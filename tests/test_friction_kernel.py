@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from slewing_model import Loads, friction_torque, load_bearing, solve
-from slewing_model.friction import _Contacts, _ContactSet, ellipse_quadrature
+from slewing_model.ball_kinematics import ContactPoints, ContactSet
+from slewing_model.ellipse_quadrature import ellipse_quadrature
 from slewing_model.friction_kernel import AVAILABLE
 
 from conftest import BEARINGS, ROOT
@@ -46,10 +47,10 @@ def _distributions():
 @pytest.mark.parametrize("quadrature", [(12, 2), (20, 4)])
 def test_compiled_sums_equal_the_numpy_sums(case, quadrature):
     bearing, distribution = _distributions()[case]
-    geometry = _ContactSet(bearing, distribution, 0.1, 1.0, 1e-3)
+    geometry = ContactSet(bearing, distribution, 0.1, 1.0, 1e-3)
     quad = ellipse_quadrature(*quadrature)
-    numpy_path = _Contacts(geometry, quad, workspace="kernel-test")
-    compiled = _Contacts(geometry, quad, workspace="kernel-test-compiled", compiled=True)
+    numpy_path = ContactPoints(geometry, quad, workspace="kernel-test")
+    compiled = ContactPoints(geometry, quad, workspace="kernel-test-compiled", compiled=True)
     rng = np.random.default_rng(case)
     start = geometry.initial_guesses()[0]
     for u in (start, start * (1.0 + 0.3 * rng.standard_normal(start.shape))):

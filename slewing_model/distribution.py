@@ -1,0 +1,185 @@
+"""What a load distribution solve takes and gives: the loads on the moving ring and the
+load on every ball (paper section 2: contact loads, contact angles, interference).
+
+Run-time module: numpy and the standard library.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .contact import ISO76_PRESSURE_LIMIT
+
+LOAD_FIELDS = ("Fx", "Fy", "Fz", "Mx", "My")
+DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
+
+
+class NoEquilibriumError(RuntimeError):
+    """No equilibrium exists for the load (or the solver could not find one)."""
+
+
+class LoadCapacityError(NoEquilibriumError):
+    """The load is beyond what the raceways can carry (truncated contact ellipse)."""
+
+
+@dataclass(frozen=True)
+class Loads:
+    """External load on the moving ring, fixed frame, SI units.
+
+    Attributes
+    ----------
+    Fx, Fy, Fz : float, N
+        Force; ``Fz > 0`` pushes the moving (inner) ring towards +z and loads
+        diagonal 1 (contacts 1 and 3).
+    Mx, My : float, N m
+        Tilting moment about the x and y axes (right hand).
+    """
+
+    Fx: float = 0.0
+    Fy: float = 0.0
+    Fz: float = 0.0
+    Mx: float = 0.0
+    My: float = 0.0
+
+    def __post_init__(self):
+        for name in LOAD_FIELDS:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ValueError(f"load {name} = {value!r}: must be a number")
+            if not math.isfinite(value):
+                raise ValueError(f"load {name} = {value!r}: must be finite (not NaN or infinite)")
+
+    @classmethod
+    def from_paper(cls, axial: float = 0.0, radial: float = 0.0, tilting_moment: float = 0.0,
+                   direction: float = 0.0) -> "Loads":
+        """The paper's load set (eqs 19, 22): axial ``Fa`` (N, along +z), radial
+        ``Fr`` (N) in the direction ``phi_r`` (rad) and tilting moment ``Mt``
+        (N m) about the axis perpendicular to it, ``(-sin phi_r, cos phi_r)``."""
+        c, s = math.cos(direction), math.sin(direction)
+        return cls(radial * c, radial * s, axial, -tilting_moment * s, tilting_moment * c)
+
+    @classmethod
+    def from_array(cls, values) -> "Loads":
+        return cls(*[float(v) for v in values])
+
+    def as_array(self) -> np.ndarray:
+        return np.array([self.Fx, self.Fy, self.Fz, self.Mx, self.My])
+
+    def rotated(self, angle: float) -> "Loads":
+        """The same load turned by ``angle`` (rad) about z (e.g. from the
+        moving ring's own frame to the fixed frame)."""
+        c, s = math.cos(angle), math.sin(angle)
+        return Loads(c * self.Fx - s * self.Fy, s * self.Fx + c * self.Fy, self.Fz,
+                     c * self.Mx - s * self.My, s * self.Mx + c * self.My)
+
+
+@dataclass(frozen=True)
+class LoadDistribution:
+    """Result of a BIME solve. Arrays are per ball (axis 0) and per contact 1..4
+    or per diagonal 1, 2 (axis 1). SI units.
+
+    Attributes
+    ----------
+    model : str
+        ``"rigid"`` or ``"flexible"``.
+    loads : Loads
+    displacement : ndarray (5,)
+        Moving ring (X, Y, Z in m; rx, ry in rad).
+    ball_angle : ndarray (B,), rad
+    contact_load : ndarray (B, 4), N
+        ``Q`` of contacts 1..4 (``Q1 = Q3``, ``Q2 = Q4``).
+    contact_angle : ndarray (B, 4), rad
+        Loaded contact angle of each contact (that of its diagonal).
+    interference : ndarray (B, 2), m
+        ``delta_tot`` of diagonals 1 and 2 (negative: a gap).
+    contact_deflection : ndarray (B, 4), m
+        Share ``delta_i = (Q/K_i)^(2/3)`` of each contact.
+    ring_displacement : ndarray (B, 4, 2) or None, m
+        (R, z) displacement of the groove centre of contacts 1..4 by ring
+        deformation (flexible model).
+    semi_axis_a, semi_axis_b : ndarray (B, 4), m
+        Hertz ellipse across the groove and along the rolling direction.
+    contact_pressure : ndarray (B, 4), Pa
+        Maximum Hertz pressure of each contact.
+    truncated : ndarray (B, 4) of bool
+        Edge loading: the contact ellipse runs over the groove edge (its
+        pressure is then higher than Hertz's, which assumes an untruncated ellipse).
+    energy : float, J
+        Total potential energy (eq 20).
+    iterations : int
+    residual : float
+        Largest force residual at the end, relative to the load scale.
+    state : ndarray
+        Solver unknowns, for a warm start (:meth:`BimeSolver.solve` ``initial``).
+    """
+
+    model: str
+    loads: Loads
+    displacement: np.ndarray
+    ball_angle: np.ndarray
+    contact_load: np.ndarray
+    contact_angle: np.ndarray
+    interference: np.ndarray
+    contact_deflection: np.ndarray
+    ring_displacement: np.ndarray | None
+    semi_axis_a: np.ndarray
+    semi_axis_b: np.ndarray
+    contact_pressure: np.ndarray
+    truncated: np.ndarray
+    energy: float
+    iterations: int
+    residual: float
+    state: np.ndarray = field(repr=False)
+
+    @property
+    def max_ball_load(self) -> float:
+        """Largest contact load, N."""
+        return float(self.contact_load.max())
+
+    @property
+    def max_contact_pressure(self) -> float:
+        """Largest Hertz pressure, Pa."""
+        return float(self.contact_pressure.max())
+
+    @property
+    def static_safety_factor(self) -> float:
+        """ISO 76 static safety factor ``(4200 MPa / p_max)^3`` (load ratio, as
+        ``C0 / P0``: Hertz pressure grows with the cube root of the load);
+        infinite for an unloaded bearing."""
+        p = self.max_contact_pressure
+        return math.inf if p <= 0.0 else (ISO76_PRESSURE_LIMIT / p) ** 3
+
+    @property
+    def truncated_contacts(self) -> int:
+        """Number of contacts whose ellipse runs over the groove edge (edge loading)."""
+        return int(np.count_nonzero(self.truncated))
+
+    @property
+    def balls_in_four_point_contact(self) -> int:
+        """Number of balls whose both diagonals carry load."""
+        return int(np.count_nonzero(np.all(self.interference > 0.0, axis=1)))
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready data (the ``slewing solve --json`` object)."""
+        d = {
+            "model": self.model,
+            "loads": {k: getattr(self.loads, k) for k in LOAD_FIELDS},
+            "displacement": dict(zip(DISPLACEMENT_FIELDS, map(float, self.displacement))),
+            "Q": self.contact_load.tolist(),
+            "contact_angle": self.contact_angle.tolist(),
+            "interference": self.interference.tolist(),
+            "ball_angle": self.ball_angle.tolist(),
+            "contact_pressure": self.contact_pressure.tolist(),
+            "max_ball_load": self.max_ball_load,
+            "max_contact_pressure": self.max_contact_pressure,
+            "static_safety_factor": self.static_safety_factor,
+            "balls_in_four_point_contact": self.balls_in_four_point_contact,
+            "truncated_contacts": self.truncated_contacts,
+            "energy": self.energy,
+            "iterations": self.iterations,
+        }
+        if self.ring_displacement is not None:
+            d["ring_displacement"] = self.ring_displacement.tolist()
+        return d

@@ -1,0 +1,180 @@
+"""The reduced Newton operator of the flexible model: the Newton system on the loaded contacts.
+
+For flexible rings the rings are linear, so each Newton step of the energy (paper eq 20)
+eliminates their displacements exactly through their compliance ``M`` at the contacts
+(:mod:`slewing_model.ring_compliance`) and is solved on the *active* (loaded) diagonals
+only (:mod:`slewing_model.bime` derives it):
+
+    ``[(A^-1 + M)_aa  -S J_a] [y_a]   [A_a^-1 f_a + (M y)_a]``
+    ``[-S J_a^T          0  ] [dq ] = [-F                  ]``
+
+with ``A`` the 2x2 stiffness blocks of the Hertz springs (eqs 8-11) at an iterate, ``J``
+the Jacobian of the contacts' relative vectors on the moving ring's five motions (eq 23)
+and ``y`` the contact forces after the step. :class:`ReducedOperator` keeps
+``W^-1 = (A^-1 + M)_aa^-1`` and what follows from it for the five motions (its Schur
+complement). It is reused between iterations and between warm-started steps (a modified
+Newton step, still a descent direction), updated by low-rank (Schur complement) updates
+when a few contacts open or close (:func:`update_operator`), and rebuilt when convergence
+slows (:func:`assemble_operator`).
+
+Run-time module: numpy.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class ReducedOperator:
+    """``W^-1`` of the active contacts and its coupling to the moving ring's motions.
+
+    Attributes
+    ----------
+    rows : ndarray (n,) of int
+        Rows of the active contacts among the 4B contact rows (ball, diagonal, (r, z)), increasing.
+    active : ndarray (2B,) of bool
+        The active diagonals.
+    contact_compliance : ndarray (n/2, 2, 2)
+        ``A^-1`` of the active diagonals when ``W^-1`` was formed.
+    inverse : ndarray (n, n)
+        ``W^-1 = (A^-1 + M)_aa^-1``.
+    jacobian : ndarray (n, 5)
+        ``J_a`` (scaled rotations) when the coupling was formed.
+    coupling : ndarray (n, 5)
+        ``W^-1 J_a``.
+    schur_inverse : ndarray (5, 5)
+        ``(J_a^T W^-1 J_a + mu I)^-1``.
+    """
+
+    rows: np.ndarray
+    active: np.ndarray
+    contact_compliance: np.ndarray
+    inverse: np.ndarray
+    jacobian: np.ndarray
+    coupling: np.ndarray
+    schur_inverse: np.ndarray
+
+    def as_tuple(self) -> tuple:
+        """The arrays, not copied (a solver state to keep or serialise)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+    @classmethod
+    def from_tuple(cls, values) -> "ReducedOperator":
+        return cls(*(np.asarray(v) for v in values))
+
+
+def contact_compliance_blocks(point, stiffness: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """``A^-1`` (n_active, 2, 2): compliance of the active diagonals' Hertz springs at an iterate.
+
+    ``point`` has per diagonal the unit vector ``n``, the elongation ``delta``, the length
+    ``length`` and the load ``q`` of the spring (eqs 7-8); ``stiffness`` is ``K_tot`` (B, 2):
+    normal compliance ``1 / (1.5 K sqrt(delta))``, and ``length / q`` across."""
+    n = point.n.reshape(-1, 2)[active]
+    nn = n[:, :, None] * n[:, None, :]
+    delta = point.delta.ravel()[active]
+    k_normal = 1.5 * stiffness.ravel()[active] * np.sqrt(delta)
+    return nn / k_normal[:, None, None] + (point.length.ravel()[active] / point.q.ravel()[active])[:, None, None] * (
+        np.eye(2) - nn)
+
+
+def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.ndarray, mu: float) -> ReducedOperator:
+    """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5)."""
+    ja = jacobian.reshape(-1, 5)[rows]
+    coupling = inverse @ ja
+    schur_inverse = np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
+    return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
+
+
+def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
+    """Add the 2x2 ``blocks`` (k, 2, 2) on the diagonal of ``matrix`` (2k, 2k), in place."""
+    first = np.arange(0, 2 * blocks.shape[0], 2)
+    for r in range(2):
+        for c in range(2):
+            matrix[first + r, first + c] += blocks[:, r, c]
+
+
+def assemble_operator(point, compliance, stiffness, jacobian, rows, active, mu) -> ReducedOperator:
+    """Form and invert ``W = (A^-1 + M)_aa`` at an iterate: O(n^3)."""
+    a_inv = contact_compliance_blocks(point, stiffness, active)
+    w_mat = compliance[np.ix_(rows, rows)]
+    _add_blocks(w_mat, a_inv)
+    return reduced_operator(rows, active, a_inv, np.linalg.inv(w_mat), jacobian, mu)
+
+
+def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, rows, active, mu
+                    ) -> ReducedOperator | None:
+    """Follow a change of the active contacts by a low-rank update of ``W^-1``.
+
+    Dropping rows: ``(W_kk)^-1 = P - Q S^-1 Q^T`` from the blocks of the old
+    inverse; adding rows (bordering): with ``X = W_kk^-1 B`` and the Schur
+    complement ``C - B^T X``. O(n^2 r) instead of O(n^3) for r changed rows.
+    The kept rows and columns move as slices (:func:`_move_block`).
+    Returns None (rebuild) when many contacts changed."""
+    old_rows, w_inv = op.rows, op.inverse
+    keep = np.isin(old_rows, rows)
+    added = ~np.isin(rows, old_rows)
+    if int((~keep).sum() + added.sum()) > 0.25 * rows.size:
+        return None
+    kept_rows = old_rows[keep]
+    if not keep.all():  # drop the contacts that opened
+        q_mat = w_inv[:, ~keep]
+        w_inv = _move_block(w_inv - q_mat @ np.linalg.solve(q_mat[~keep], q_mat.T), np.flatnonzero(keep),
+                            np.arange(kept_rows.size), kept_rows.size)
+    a_inv = op.contact_compliance[keep[::2]]
+    if added.any():  # border with the contacts that closed
+        new_rows = rows[added]
+        new_diagonals = np.zeros_like(active)
+        new_diagonals[new_rows[::2] // 2] = True
+        new_a_inv = contact_compliance_blocks(point, stiffness, new_diagonals)
+        b_mat = compliance[np.ix_(kept_rows, new_rows)]
+        c_mat = compliance[np.ix_(new_rows, new_rows)]
+        _add_blocks(c_mat, new_a_inv)
+        x_mat = w_inv @ b_mat
+        schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
+        xs = x_mat @ schur
+        at_kept, at_new = np.flatnonzero(~added), np.flatnonzero(added)   # places in the sorted rows
+        w_inv = _move_block(w_inv + xs @ x_mat.T, np.arange(kept_rows.size), at_kept, rows.size)
+        w_inv[np.ix_(at_kept, at_new)] = -xs
+        w_inv[np.ix_(at_new, at_kept)] = -xs.T
+        w_inv[np.ix_(at_new, at_new)] = schur
+        merged = np.empty((rows.size // 2, 2, 2))
+        merged[at_kept[::2] // 2] = a_inv
+        merged[at_new[::2] // 2] = new_a_inv
+        a_inv = merged
+    return reduced_operator(rows, active, a_inv, w_inv, jacobian, mu)
+
+
+def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
+    """The (modified) Newton step with the kept operator: ``dq`` (5,) and the contact forces
+    after the step ``y`` (4B,), zero on the open contacts.
+
+    ``point`` has the spring forces ``force`` (B, 2, 2), the forces felt by the rings ``y``
+    and their motion ``ring_motion = M y``."""
+    rhs = (op.contact_compliance @ point.force.reshape(-1, 2)[op.active][..., None]).ravel() \
+        + point.ring_motion[op.rows]
+    w_vec = op.inverse @ rhs
+    dq = op.schur_inverse @ (f_scaled - op.jacobian.T @ w_vec)
+    y_new = np.zeros_like(point.y)
+    y_new[op.rows] = w_vec + op.coupling @ dq
+    return dq, y_new
+
+
+def _move_block(source: np.ndarray, rows: np.ndarray, places: np.ndarray, size: int) -> np.ndarray:
+    """A new (size, size) matrix whose rows and columns ``places`` hold ``source[np.ix_(rows, rows)]``
+    (both increasing); the others are left to the caller.
+
+    Copied run by run, a run being rows that follow each other in both: when a few contacts
+    open or close there are a few runs, and slices copy at memory speed where numpy's
+    fancy indexing of a matrix copies element by element (ten times slower here)."""
+    out = np.empty((size, size))
+    cut = np.flatnonzero((np.diff(rows) != 1) | (np.diff(places) != 1)) + 1
+    if cut.size > 16:                         # many runs: one fancy copy is cheaper than many slices
+        out[np.ix_(places, places)] = source[np.ix_(rows, rows)]
+        return out
+    runs = [(rows[a], places[a], b - a) for a, b in zip(np.r_[0, cut], np.r_[cut, rows.size])]
+    for r0, p0, n in runs:
+        for c0, q0, m in runs:
+            out[p0:p0 + n, q0:q0 + m] = source[r0:r0 + n, c0:c0 + m]
+    return out

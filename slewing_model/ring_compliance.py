@@ -1,0 +1,68 @@
+"""Compliance of the rings at the contacts, from their superelements (paper eqs 12-15).
+
+Each ring's superelement (:mod:`slewing_model.ring_stiffness`) is its stiffness condensed to
+the radial and axial displacement of its groove centres at every ball: a block-circulant
+matrix (the ring is axisymmetric and the balls equally spaced). Its pseudo-inverse ``G`` is
+the ring's compliance there (a free ring's rigid-body modes dropped), inverted harmonic by
+harmonic; ``M`` combines both rings as the contacts feel them: the operator through which
+the flexible solver (:mod:`slewing_model.bime`, :mod:`slewing_model.reduced_operator`)
+eliminates the ring displacements.
+
+Run-time module: numpy.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .assembly import INNER_SLOT, OUTER_SLOT
+
+
+def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
+    """Pseudo-inverse of a symmetric block-circulant matrix given by its first
+    block row (B, m, m), returned dense. Inverts block by block in the harmonic
+    (DFT) basis, dropping the null space (a free ring's rigid-body modes)."""
+    n, m, _ = first_row.shape
+    blocks = np.fft.fft(first_row, axis=0)  # block j = sum_k C_k exp(-2 pi i j k / B)
+    top = max(np.abs(np.linalg.eigvalsh(0.5 * (b + b.conj().T))).max() for b in blocks)
+    inv = np.empty_like(blocks)
+    for j, b in enumerate(blocks):
+        w, v = np.linalg.eigh(0.5 * (b + b.conj().T))
+        keep = np.abs(w) > rcond * top
+        inv[j] = (v[:, keep] / w[keep]) @ v[:, keep].conj().T
+    row = np.fft.ifft(inv, axis=0).real  # first block row of the pseudo-inverse
+    k = (np.arange(n)[None, :] - np.arange(n)[:, None]) % n
+    return row[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
+
+
+def ring_compliances(superelement) -> dict[str, np.ndarray]:
+    """``G`` (4B, 4B) of each ring: its compliance at its groove centres, the
+    pseudo-inverse of its superelement (a free ring's rigid modes dropped)."""
+    return {name: _pseudo_inverse_circulant(np.asarray(getattr(superelement, name).first_row, dtype=float))
+            for name in ("outer", "inner")}
+
+
+def contact_compliance(rings: dict[str, np.ndarray]) -> np.ndarray:
+    """``M`` (4B, 4B): the combined compliance of both rings seen by the contacts,
+    ordered like the relative vectors ``e`` (ball, diagonal, (r, z)).
+
+    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` from :func:`ring_compliances`."""
+    n = rings["outer"].shape[0] // 4
+    total = 0.0
+    for name, slots in (("outer", OUTER_SLOT), ("inner", INNER_SLOT)):
+        index = ring_index(n, slots)
+        total = total + rings[name][np.ix_(index, index)]
+    return total
+
+
+def ring_index(n: int, slots: np.ndarray) -> np.ndarray:
+    """Ring DOF (paper eq 14 order) of every entry of the relative vectors
+    ``e`` in (ball, diagonal, (r, z)) order; ``slots`` is the ring's contact
+    slot of diagonals 1 and 2."""
+    return (4 * np.arange(n)[:, None, None] + 2 * slots[None, :, None] + np.arange(2)[None, None, :]).ravel()
+
+
+def ring_selector(n: int, slots: np.ndarray) -> np.ndarray:
+    """(4B, 4B) 0/1 matrix taking a ring's DOFs to the order of ``e``."""
+    p = np.zeros((4 * n, 4 * n))
+    p[np.arange(4 * n), ring_index(n, slots)] = 1.0
+    return p
