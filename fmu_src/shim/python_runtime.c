@@ -45,6 +45,7 @@ struct runtime_file {
     char version[64];   /* X.Y.Z of the building Python */
     char home[PATH_MAX];
     char library[PATH_MAX + 64];
+    char environment[PATH_MAX];  /* the prefix with the packages: a virtual environment, or the home */
     char path[PATH_MAX];
     int found;
 };
@@ -71,6 +72,8 @@ static void read_runtime_file(const char *binary_dir, struct runtime_file *rt)
             snprintf(rt->home, sizeof rt->home, "%s", value);
         else if (!strcmp(line, "library"))
             snprintf(rt->library, sizeof rt->library, "%s", value);
+        else if (!strcmp(line, "environment"))
+            snprintf(rt->environment, sizeof rt->environment, "%s", value);
     }
     fclose(fh);
 }
@@ -248,6 +251,15 @@ static int load_locked(const char *binary_dir, char *err, size_t errsize)
         return -1;
     }
     initialize(0);
+    /* a virtual environment's packages (numpy...): what its own python3 would add at start-up */
+    const char *environment = env_home ? env_home : rt.environment;
+    char cfg[PATH_MAX + 16], code[2 * PATH_MAX + 128];
+    snprintf(cfg, sizeof cfg, "%s/pyvenv.cfg", environment);
+    int (*run)(const char *, void *) = (int (*)(const char *, void *))dlsym(handle, "PyRun_SimpleStringFlags");
+    if (*environment && exists(cfg) && run && !strpbrk(environment, "'\\\n")) {
+        snprintf(code, sizeof code, "import site; site.addsitedir('%s/lib/python%s/site-packages')", environment, minor);
+        run(code, NULL);
+    }
     save_thread();
     python_ready = 1;  /* libpython stays loaded: the handle is never closed */
     return 0;
