@@ -6,7 +6,11 @@
 Builds (or takes from the cache) the ring superelement, then packages with
 pythonfmu: the slave ``fmu_src/SlewingBearing.py``, the run-time modules of
 ``slewing_model`` (numpy only: no scipy, no scikit-fem), ``bearing.json`` (the
-definition in SI units) and ``superelement.npz``.
+definition in SI units) and ``superelement.npz``. For FMI 2.0 it then compiles
+the FMU's Linux binary (``fmu_src/shim/``, needs a C compiler), which loads the
+Python named in ``resources/python_runtime.txt`` in front of pythonfmu's binary:
+C and C++ hosts need no LD_PRELOAD and no Python on their PATH
+(``docs/fmu_hosts.md``).
 """
 from __future__ import annotations
 
