@@ -1,106 +1,238 @@
-"""The bearing FMU through fmpy: instantiation time, doStep time, memory over many steps.
+"""The bearing FMU through fmpy, on the cases users run: time per step, its tail, instantiation, memory.
 
-table3 with synthetic errors, flexible rings (fine superelement, the build default), friction on; a slowly
-varying load and a turning ring (Fz ramp with a moment, psi at 0.5 rad/s). The rigid
-model is measured in the same run as the baseline.
+Cases (`benchmarks/cases.py`): the 150-ball pitch bearing under the shipped blade-root series,
+pitching +-5 deg at 0.5 rad/s (flexible and rigid rings); the 180-ball yaw bearing under the
+shipped tower-top series, yawing 0.5 deg/s in bursts; table3 with errors under a heavy combined
+load, turning; and the earlier light table3 case. Friction on, fine superelement, free rings
+(the build's defaults).
 
-Run: .venv/bin/python benchmarks/bench_fmu.py [--steps 100000]
+A step is what a host does each communication step: set the 7 inputs, ``doStep`` (10 ms),
+get 5 outputs. The FMU of the version before this work (``--baseline``, a git revision,
+default ``cd27082``) is built from a temporary git worktree by that version's own
+``build_fmu.py`` and stepped in the same run, its runs alternating with the current one's,
+so that both see the same machine load; the ratio column is current / baseline.
+
+Each FMU runs in a worker process of its own: an FMU's Python code runs in its host's
+interpreter, and two FMUs in one process would share the first ``slewing_model`` imported.
+
+The current FMU sums its friction with a compiled loop where numba is installed in the
+host's Python (as in this venv); ``--without-numba`` makes numba unimportable in the
+workers, so that the FMU runs its numpy fallback, as on a host without numba.
+
+Run: .venv/bin/python benchmarks/bench_fmu.py [--steps 1000] [--runs 3] [--baseline REV|none]
+     [--memory-steps 100000] [--without-numba] [--cases pitch yaw ...]
 """
 from __future__ import annotations
 
 import argparse
-import math
+import json
 import shutil
-import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import print_table  # noqa: E402
+from cases import CASES, DT  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
+OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
+BEARINGS = ("pitch_bearing", "yaw_bearing", "table3_errors")
+WARM = 20  # the first steps (cold start of the solvers) are timed apart: "first step"
+
+
+# ---- worker: one FMU instance in a process of its own -----------------------------------------
+
+class _NoNumba:
+    """An import hook that refuses numba, as on a host where it is not installed."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name == "numba" or name.startswith("numba."):
+            raise ImportError("numba made unimportable by --without-numba")
 
 
 def rss_mb() -> float:
     """Resident memory of this process now, MB (Linux)."""
-    with open("/proc/self/statm") as fh:
-        pages = int(fh.read().split()[1])
     import resource
 
-    return pages * resource.getpagesize() / 1e6
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * resource.getpagesize() / 1e6
+
+
+def worker(fmu_path: str, case_name: str, steps: int) -> None:
+    """Instantiate the FMU, then answer lines ``first count`` on stdin with the step times (JSON)."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    case = CASES[case_name](steps)
+    md = read_model_description(fmu_path)
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    unzipped = extract(fmu_path)
+    start = time.perf_counter()
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="bench")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    for name, value in case.parameters.items():
+        fmu.setInteger([refs[name]], [value])
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    instantiate = time.perf_counter() - start
+    inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in OUTPUTS]
+    compiled = "numba" in sys.modules
+    print(json.dumps({"instantiate": instantiate, "compiled": compiled}), flush=True)
+    for line in sys.stdin:
+        first, count = map(int, line.split())
+        times = []
+        for k in range(first, first + count):
+            values = [*map(float, case.loads[k]), float(case.psi[k]), float(case.omega[k])]
+            t0 = time.perf_counter()
+            fmu.setReal(inputs, values)
+            fmu.doStep(k * DT, DT)                      # fmpy raises on a status other than OK
+            fmu.getReal(outputs)
+            times.append(time.perf_counter() - t0)
+        print(json.dumps({"times": times, "rss_mb": rss_mb()}), flush=True)
+    fmu.terminate()
+    fmu.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
+
+
+class Worker:
+    """The parent's handle on a worker process."""
+
+    def __init__(self, fmu_path: Path, case_name: str, steps: int, without_numba: bool):
+        command = [sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps)]
+        if without_numba:
+            command.append("--without-numba")
+        self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.started = self._answer()
+
+    def _answer(self) -> dict:
+        line = self.process.stdout.readline()
+        if not line:
+            raise RuntimeError(f"benchmark worker ended (exit {self.process.wait()})")
+        return json.loads(line)
+
+    def run(self, first: int, count: int) -> dict:
+        self.process.stdin.write(f"{first} {count}\n")
+        self.process.stdin.flush()
+        return self._answer()
+
+    def close(self):
+        self.process.stdin.close()
+        self.process.wait()
+
+
+# ---- the parent: builds, alternates, tabulates -------------------------------------------------
+
+def build_current(out: Path) -> dict[str, Path]:
+    sys.path.insert(0, str(ROOT))
+    from build_fmu import build_fmu
+
+    return {name: Path(build_fmu(ROOT / f"examples/bearings/{name}.toml", out / f"current_{name}.fmu"))
+            for name in BEARINGS}
+
+
+def build_baseline(revision: str, out: Path) -> dict[str, Path]:
+    """The FMUs of ``revision``, built by that revision's own build_fmu.py from a git worktree."""
+    tree = out / "baseline_tree"
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), revision], check=True,
+                   capture_output=True)
+    try:
+        fmus = {}
+        for name in BEARINGS:
+            fmus[name] = out / f"baseline_{name}.fmu"
+            subprocess.run([sys.executable, "build_fmu.py", f"examples/bearings/{name}.toml", "-o", str(fmus[name])],
+                           cwd=tree, check=True, capture_output=True)
+        return fmus
+    finally:
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
+
+
+def print_table(title: str, header: list[str], rows: list[list[str]]) -> None:
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
+    print(f"\n{title}")
+    print("| " + " | ".join(h.ljust(w) for h, w in zip(header, widths)) + " |")
+    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+    for r in rows:
+        print("| " + " | ".join(c.ljust(w) for c, w in zip(r, widths)) + " |")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("--steps", type=int, default=100_000, help="steps of the memory run")
+    parser.add_argument("--steps", type=int, default=1000, help="steps of each timed run")
+    parser.add_argument("--runs", type=int, default=3, help="timed runs per case and FMU (interleaved)")
+    parser.add_argument("--baseline", default="cd27082", help="git revision of the baseline FMU, or 'none'")
+    parser.add_argument("--memory-steps", type=int, default=100_000, help="steps of the memory run (0: none)")
+    parser.add_argument("--cases", nargs="*", default=list(CASES))
+    parser.add_argument("--without-numba", action="store_true",
+                        help="make numba unimportable in the workers: the current FMU runs its numpy fallback")
+    parser.add_argument("--worker", nargs=3, metavar=("FMU", "CASE", "STEPS"), help=argparse.SUPPRESS)
     args = parser.parse_args()
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
+    if args.worker:
+        if args.without_numba:
+            sys.meta_path.insert(0, _NoNumba())
+        worker(args.worker[0], args.worker[1], int(args.worker[2]))
+        return
 
-    from build_fmu import build_fmu
+    with tempfile.TemporaryDirectory(prefix="bench_fmu_") as tmp:
+        tmp = Path(tmp)
+        fmus = {"current": build_current(tmp)}
+        if args.baseline != "none":
+            fmus["baseline"] = build_baseline(args.baseline, tmp)
+        versions = list(fmus)
+        rows, medians, means, kernel = [], {}, {}, ""
+        total = WARM + args.steps * args.runs
+        for name in args.cases:
+            case = CASES[name](1)
+            bearing = Path(case.bearing).stem
+            workers = {v: Worker(fmus[v][bearing], name, total, args.without_numba) for v in versions}
+            first = {v: workers[v].run(0, WARM)["times"][0] for v in versions}
+            times = {v: [] for v in versions}
+            for r in range(args.runs):
+                for v in versions:
+                    times[v] += workers[v].run(WARM + r * args.steps, args.steps)["times"]
+            for v in versions:
+                workers[v].close()
+                t = times[v] = np.array(times[v]) * 1e3
+                medians[name, v], means[name, v] = float(np.median(t)), float(np.mean(t))
+            kernel = "compiled friction loop (numba)" if workers["current"].started["compiled"] else \
+                "numpy friction (no numba)"
+            for v in versions:
+                t = times[v]
+                ratio = "" if v == "baseline" or "baseline" not in versions else \
+                    f"{medians[name, v] / medians[name, 'baseline']:.2f}"
+                rows.append([name, v, f"{workers[v].started['instantiate'] * 1e3:.0f} ms", f"{first[v] * 1e3:.1f} ms",
+                             f"{np.median(t):.2f} ms", f"{np.percentile(t, 95):.2f} ms",
+                             f"{np.percentile(t, 99):.2f} ms", f"{t.max():.1f} ms", ratio])
+            print(f"  {name}: {case.description}", flush=True)
+        print_table(f"Bearing FMU through fmpy, one step = setReal + doStep ({DT * 1e3:.0f} ms) + getReal; "
+                    f"{args.runs} runs of {args.steps} steps per case and version, interleaved; current: {kernel}",
+                    ["case", "version", "instantiate", "first step", "median", "95th pct", "99th pct", "max",
+                     "median ratio to baseline"], rows)
+        if {"pitch", "yaw"} <= set(args.cases):
+            lines = []
+            for v in versions:
+                turbine = 3 * means["pitch", v] + means["yaw", v]
+                lines.append([v, f"{turbine:.2f} ms", f"{DT * 1e3 / turbine:.2f}"])
+            print_table("A whole turbine's bearings (3 pitch + 1 yaw, flexible rings) at a 10 ms step: mean cost of "
+                        "one step of all four, and the real-time factor (simulated time / wall time; > 1 is faster "
+                        "than real time)", ["version", "4 bearings per step", "real-time factor"], lines)
 
-    fmu_path = build_fmu(ROOT / "examples/bearings/table3_errors.toml", ROOT / "build/SlewingBearing_table3_errors.fmu")
-    md = read_model_description(str(fmu_path))
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    unzipped = extract(str(fmu_path))
-    inputs = [refs[n] for n in ("Fz", "Mx", "psi", "omega")]
-    outputs = [refs[n] for n in ("z", "friction_torque", "max_ball_load", "ball[1].Q1")]
-
-    def instantiate(ring_model):
-        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
-                        instanceName="bench")
-        fmu.instantiate()
-        fmu.setupExperiment(startTime=0.0)
-        fmu.setInteger([refs["ring_model"]], [ring_model])
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
-        return fmu
-
-    def step(fmu, k, dt=0.01):
-        t = k * dt
-        fmu.setReal(inputs, [2e4 + 1e4 * math.sin(0.2 * t), 2e3 * math.cos(0.3 * t), 0.5 * t, 0.5])
-        fmu.doStep(t, dt)
-        return fmu.getReal(outputs)
-
-    rows = []
-    for ring_model, label in ((1, "rigid rings (baseline)"), (2, "flexible rings")):
-        starts = []
-        for _ in range(5):
-            t0 = time.perf_counter()
-            fmu = instantiate(ring_model)
-            starts.append(time.perf_counter() - t0)
-            fmu.terminate()
-            fmu.freeInstance()
-        fmu = instantiate(ring_model)
-        times = []
-        for k in range(2000):
-            t0 = time.perf_counter()
-            step(fmu, k)
-            times.append(time.perf_counter() - t0)
-        fmu.terminate()
-        fmu.freeInstance()
-        rows.append([label, f"{statistics.median(starts) * 1e3:.0f} ms", f"{statistics.median(times) * 1e3:.2f} ms",
-                     f"{sorted(times)[int(0.95 * len(times))] * 1e3:.2f} ms"])
-    base = float(rows[0][2].split()[0])
-    for r in rows:
-        r.append(f"{float(r[2].split()[0]) / base:.2f}")
-    print_table("Bearing FMU through fmpy: table3 with errors (67 balls), friction on, slowly varying load, turning ring",
-                ["model", "instantiate + initialise (median of 5)", "doStep median (2000 steps)",
-                 "doStep 95th percentile", "ratio to rigid"], rows)
-
-    fmu = instantiate(2)
-    memory = []
-    for k in range(args.steps):
-        step(fmu, k)
-        if k + 1 in (1_000, args.steps) or (k + 1) % 20_000 == 0:
-            memory.append((k + 1, rss_mb()))
-    fmu.terminate()
-    fmu.freeInstance()
-    shutil.rmtree(unzipped, ignore_errors=True)
-    print_table("Resident memory of the host process (flexible rings)", ["steps", "RSS [MB]"],
-                [[f"{k:,}", f"{m:.1f}"] for k, m in memory])
+        if args.memory_steps:
+            memory_worker = Worker(fmus["current"]["table3_errors"], "table3_light", args.memory_steps,
+                                   args.without_numba)
+            memory, done = [], 0
+            for mark in sorted({1_000, *range(20_000, args.memory_steps + 1, 20_000), args.memory_steps}):
+                memory.append([f"{mark:,}", f"{memory_worker.run(done, mark - done)['rss_mb']:.1f}"])
+                done = mark
+            memory_worker.close()
+            print_table("Resident memory of the host process (current FMU, table3_light, flexible rings)",
+                        ["steps", "RSS [MB]"], memory)
 
 
 if __name__ == "__main__":
