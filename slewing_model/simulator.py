@@ -191,13 +191,23 @@ class BearingSimulator:
         ValueError
             A non-finite input, naming it.
         NoEquilibriumError, LoadCapacityError
-            The load cannot be carried (state unchanged).
+            The load cannot be carried. The simulator is then as it was before the
+            step (the solver's rotation and kept operator restored): the next step
+            goes on as if this one had not been asked for.
         """
         for name, value in (("psi", psi), ("omega", omega)):
             if not math.isfinite(value):
                 raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
         if self.settings.load_frame == "rotating":
             loads = loads.rotated(psi)
+        before = self.get_state()
+        try:
+            return self._step(loads, psi, omega)
+        except Exception:
+            self.set_state(before)
+            raise
+
+    def _step(self, loads: Loads, psi: float, omega: float) -> StepResult:
         with blas_threads(self.settings.blas_threads):
             if psi != self._psi or self._warm is None:
                 self.solver.set_rotation(psi)

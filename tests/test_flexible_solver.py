@@ -103,3 +103,25 @@ def test_simulator_extrapolated_start_reaches_the_cold_solution(bearing):
         r = sim.step(loads, psi=psi, omega=0.1).distribution
         cold = BimeSolver(sim.bearing, se, psi=psi, rtol=1e-10).solve(loads)
         assert np.allclose(r.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
+
+
+def test_refused_step_leaves_the_simulator_as_it_was(bearing):
+    # an overload refused inside the solver (it had turned the rings and updated its kept
+    # operator by then) must not change what the following steps answer: bit for bit the
+    # steps of a simulator that never saw it
+    from slewing_model import LoadCapacityError
+    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+
+    se = synthetic_superelement(bearing.ball_count)
+    settings = SimulatorSettings(ring_model="flexible", friction_coefficient=0.0)
+    disturbed, clean = BearingSimulator(bearing, se, settings), BearingSimulator(bearing, se, settings)
+    before = [(Loads(Fz=5e4, Mx=2e3), 0.0), (Loads(Fz=5.2e4, Mx=2.5e3), 0.01)]
+    after = [(Loads(Fz=5.3e4, Mx=2.6e3), 0.01), (Loads(Fz=5.5e4, Mx=3e3), 0.02)]   # the first at the same psi
+    for loads, psi in before:
+        disturbed.step(loads, psi, 0.1)
+        clean.step(loads, psi, 0.1)
+    with pytest.raises(LoadCapacityError):
+        disturbed.step(Loads(Fz=5e7), 0.3, 0.1)
+    for loads, psi in after:
+        a, b = disturbed.step(loads, psi, 0.1).distribution, clean.step(loads, psi, 0.1).distribution
+        assert np.array_equal(a.contact_load, b.contact_load) and np.array_equal(a.displacement, b.displacement)
