@@ -132,12 +132,13 @@ def simulator_for(task: CaseTask):
 
     v, s = task.variant, task.simulation
     bearing = case_bearing(task.bearing, v)
+    tolerances = {k: s[k] for k in ("tolerance", "friction_tolerance") if s.get(k) is not None}
     settings = SimulatorSettings(
         ring_model=v["ring_model"], moving_ring=s.get("moving_ring") or bearing.moving_ring,
         load_frame=task.series.load_frame,
         preload=None if v.get("preload_um") is None else v["preload_um"] * 1e-6,
-        friction_coefficient=v["friction_coefficient"], seal_torque=s["seal_torque_Nm"], tolerance=s["tolerance"],
-        omega_regularisation=s["omega_regularisation_rad_s"], friction_tolerance=s["friction_tolerance"])
+        friction_coefficient=v["friction_coefficient"], seal_torque=s["seal_torque_Nm"],
+        omega_regularisation=s["omega_regularisation_rad_s"], **tolerances)
     return BearingSimulator(bearing, task.superelement if v["ring_model"] == "flexible" else None, settings)
 
 

@@ -26,6 +26,8 @@ def run(args) -> int:
     print(f"{report.cases} cases: {ok} ok, {len(report.failed)} failed; {len(report.ran)} run now "
           f"({report.wall_time:.1f} s{', ' + report.cluster if report.cluster else ''}), "
           f"{len(report.skipped)} already finished. Summary: {report.summary}")
+    for note in report.notes:
+        print(f"note: {note}", file=sys.stderr)
     for key, status in report.failed.items():
         print(f"  {key}: {status}", file=sys.stderr)
     return 0 if not report.failed else 1

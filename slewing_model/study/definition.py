@@ -42,13 +42,14 @@ bearing variants::
     bc = "free"
 
 Each load entry may also give ``name``, ``load_frame`` (``"fixed"`` or
-``"rotating"``: the frame the loads are given in; default: the frame the series
-states -- a ``# load_frame = ...`` comment of a CSV file, the frame
-:func:`slewing_model.aeroelastic.bearing_loads` reports -- else ``"rotating"``
-for pitch bearings, whose blade-frame loads turn with the pitch angle, and
-``"fixed"`` otherwise; a study frame that contradicts the series' is refused)
-and, for OpenFAST files, ``mounting`` (passed to
-:func:`slewing_model.aeroelastic.bearing_loads`).
+``"rotating"``: the frame the loads are given in, turning with ``psi`` or not).
+OpenFAST loads are turned into the frame asked for by
+:func:`slewing_model.aeroelastic.bearing_loads` (default ``"rotating"``: the
+blade's frame for a pitch bearing, the nacelle's for a yaw bearing). A CSV file
+may state its frame in a ``# load_frame = ...`` comment (a study frame that
+contradicts it is refused); default ``"fixed"``. OpenFAST entries may also give
+``mounting`` (which way the bearing's +z points: ``"tip"``/``"hub"`` for pitch,
+``"up"``/``"down"`` for yaw; see :mod:`slewing_model.aeroelastic`).
 
 Every case has a key: the SHA-256 of its canonical description (the load and
 bearing files by content, not by path), so that a rerun recognises the cases
@@ -73,8 +74,8 @@ SIMULATION_DEFAULTS = {
     "moving_ring": None,            # None: the bearing file's
     "seal_torque_Nm": 0.0,
     "omega_regularisation_rad_s": 1e-4,
-    "tolerance": 1e-9,
-    "friction_tolerance": 1e-4,
+    "tolerance": None,              # None: SimulatorSettings' default (resolved when read)
+    "friction_tolerance": None,
     "histogram_bins": 20,
 }
 SYNTHETIC_KEYS = ("waviness_orders", "radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um")
@@ -352,7 +353,7 @@ def _load_entries(entry: Any, w: str, base_dir: str) -> list[dict]:
             load["bearing"] = _string(entry, w + "bearing", choices=("pitch", "yaw"))
             if "mounting" in entry:
                 load["mounting"] = _string(entry, w + "mounting")
-            default_frame = "rotating" if load["bearing"] == "pitch" else "fixed"
+            default_frame = "rotating"
     load["load_frame"] = (_string(entry, w + "load_frame", choices=("fixed", "rotating")) if "load_frame" in entry
                           else None)
     load["default_frame"] = default_frame
@@ -444,9 +445,13 @@ def _simulation(table: Mapping) -> dict:
     s["seal_torque_Nm"] = _number(table, w + "seal_torque_Nm", default=0.0, minimum=0.0)
     s["omega_regularisation_rad_s"] = _number(table, w + "omega_regularisation_rad_s", default=1e-4, minimum=0.0)
     for key in ("tolerance", "friction_tolerance"):
-        value = _number(table, w + key, default=SIMULATION_DEFAULTS[key], minimum=0.0, exclusive=True)
-        if value >= 1e-2:
+        value = _number(table, w + key, minimum=0.0, exclusive=True, allow_none=True)
+        if value is not None and value >= 1e-2:
             _fail(w + key, value, "must lie in (0, 0.01)")
+        if value is None:   # the simulator's own default, written into the case (and its key)
+            from ..simulator import SimulatorSettings
+
+            value = getattr(SimulatorSettings(), key)
         s[key] = value
     s["histogram_bins"] = _integer(table, w + "histogram_bins", default=20, minimum=1)
     return s

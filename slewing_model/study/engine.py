@@ -68,6 +68,10 @@ class StudyReport:
         From the first submission to the last result (0 when nothing was submitted).
     cluster : str
         What ran it.
+    figures : list of str
+        The figures written.
+    notes : list of str
+        What the run could not do (e.g. figures without matplotlib).
     """
 
     cases: int
@@ -78,6 +82,8 @@ class StudyReport:
     rows: list = field(default_factory=list)
     wall_time: float = 0.0
     cluster: str = ""
+    figures: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
 
 
 def case_dir(out_dir: str, key: str) -> str:
@@ -139,7 +145,7 @@ def summary_row(case: Case, record: dict | None, status: str | None = None) -> d
     if status is not None:
         row["status"] = status
     row["status"] = " ".join(str(row["status"]).split())   # one line
-    return row
+    return {k: str(v) for k, v in row.items()}             # as summary.csv reads back
 
 
 def write_summary(path: str, rows: list[dict]) -> None:
@@ -328,7 +334,12 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
     write_summary(report.summary, report.rows)
     if figures:
-        from .figures import study_figures
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            report.notes.append("no figures: matplotlib is not installed (the 'plot' extra)")
+        else:
+            from .figures import study_figures
 
-        study_figures(out_dir, cases, report.rows)
+            report.figures = study_figures(out_dir, cases, report.rows)
     return report

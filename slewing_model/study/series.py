@@ -157,8 +157,9 @@ def from_openfast(path: str, *, bearing: str, blade: int = 1, mounting: str | No
     """Bearing loads and motion from an OpenFAST / FAST output file (``.out``, ``.outb``).
 
     Uses :func:`slewing_model.openfast.read_output` and
-    :func:`slewing_model.aeroelastic.bearing_loads`; ``psi`` and ``omega`` are the
-    recorded pitch (or yaw) angle and rate when the returned series carries them.
+    :func:`slewing_model.aeroelastic.bearing_loads` (which turns the loads into the
+    ``load_frame`` asked for, default ``"rotating"``: the blade's or the nacelle's frame);
+    ``psi`` and ``omega`` are the recorded pitch (or yaw) angle and rate.
     """
     try:
         from .. import aeroelastic, openfast
@@ -167,13 +168,15 @@ def from_openfast(path: str, *, bearing: str, blade: int = 1, mounting: str | No
                          f"slewing_model.aeroelastic ({exc})") from None
     output = openfast.read_output(path)
     options = {} if mounting is None else {"mounting": mounting}
-    series = aeroelastic.bearing_loads(output, bearing=bearing, blade=blade, t_start=t_start, t_end=t_end, **options)
+    frame = load_frame or "rotating"
+    series = aeroelastic.bearing_loads(output, bearing=bearing, blade=blade, t_start=t_start, t_end=t_end,
+                                       frame=frame, **options)
     time = np.asarray(series.time, float)
     psi = getattr(series, "psi", None)
     omega = getattr(series, "omega", None)
     psi, omega = _motion(time, None if psi is None else np.asarray(psi, float),
                          None if omega is None else np.asarray(omega, float), omega_default, path)
-    frame = _frame(path, getattr(series, "load_frame", None), load_frame, "rotating" if bearing == "pitch" else "fixed")
+    frame = _frame(path, getattr(series, "load_frame", None), frame, frame)
     return MotionSeries(time, np.asarray(series.loads, float), psi, omega, frame, path)
 
 
