@@ -36,6 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..bime import Loads
+from ..simulator import BearingSimulator, SimulatorSettings
 from .series import MotionSeries
 
 #: the columns of a case's time series
@@ -128,8 +130,6 @@ def case_bearing(bearing, variant: dict):
 
 def simulator_for(task: CaseTask):
     """The :class:`BearingSimulator` of a case."""
-    from ..simulator import BearingSimulator, SimulatorSettings
-
     v, s = task.variant, task.simulation
     bearing = case_bearing(task.bearing, v)
     tolerances = {k: s[k] for k in ("tolerance", "friction_tolerance") if s.get(k) is not None}
@@ -145,7 +145,6 @@ def simulator_for(task: CaseTask):
 def run_case(task: CaseTask) -> CaseResult:
     """Step one case through its series (see the module docstring). Never raises for a
     case that cannot be computed: its ``status`` says why."""
-    from ..bime import Loads
 
     start = time.perf_counter()
     worker = f"{socket.gethostname()}:{os.getpid()}"
