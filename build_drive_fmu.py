@@ -20,6 +20,8 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
+sys.path.insert(0, str(ROOT))
+from build_fmu import install_python_shim  # noqa: E402  (the FMU's Linux layer: no LD_PRELOAD in C hosts)
 
 
 def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5) -> Path:
@@ -56,6 +58,7 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5) ->
                                      project_files=[package, tmp / "drive.json"],
                                      canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                                      needsExecutionTool=True, canHandleVariableCommunicationStepSize=True)
+    install_python_shim(built, "SlewingDrive")     # runs in C hosts without LD_PRELOAD (see build_fmu.py)
     return Path(built)
 
 
@@ -96,6 +99,7 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
         built = FmuBuilder.build_FMU(ROOT / "fmu_src" / "TimeTable.py", dest=output, project_files=[tmp / "table.json"],
                                      canGetAndSetFMUstate=True, canSerializeFMUstate=True, needsExecutionTool=True,
                                      canHandleVariableCommunicationStepSize=True)
+    install_python_shim(built, "TimeTable")
     return Path(built)
 
 

@@ -11,9 +11,11 @@ run_manoeuvre multiplies), one rounding apart, which move the interpolated loads
 bearing's iterative solution by far less than its relative tolerance of 1e-9.
 """
 import math
+import os
 import subprocess
 import sys
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -139,3 +141,34 @@ def test_parallel_coupling_stays_close_to_the_sequential_one(system):
     assert max_relative_difference(a.angle, b.angle) < 1e-5
     assert max_relative_difference(a.motor_torque, b.motor_torque) < 1e-4
     assert max_relative_difference(a.angle, b.angle) > 0  # but they are not the same sequence
+
+
+def test_ecos_program_runs_the_ssp_in_a_minimal_environment(system, tmp_path):
+    # ecos's own executable (C++), started with only PATH=/usr/bin:/bin and HOME and no LD_PRELOAD:
+    # every FMU of the SSP (bearing, drive, tables) carries the Linux layer that loads its Python
+    # (build_fmu.install_python_shim); its last values equal run_manoeuvre's to ecos's six decimals
+    _host("ecos")
+    import ecospy
+
+    program = Path(ecospy.__file__).parent / "binaries" / "ecos"
+    if not program.is_file():
+        pytest.skip(f"ecospy ships no ecos program at {program}")
+    program.chmod(program.stat().st_mode | 0o111)
+    ssp, references = system
+    env = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", str(tmp_path))}
+    run = subprocess.run([str(program), "simulate", "--path", str(ssp), "--stepSize", str(DT), "--stopTime", str(STOP),
+                          "--parameterSet", "pitch_system"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    table = next(tmp_path.glob("*.csv"))
+    with open(table) as fh:
+        header = [h.strip() for h in fh.readline().split(",")]
+        last = [float(v) for v in fh.read().strip().splitlines()[-1].split(",")]
+    reference = references[COUPLING["ecos"]]
+    # ecos writes the values at t = k dt before its last step; run_manoeuvre's k-th row is at (k + 1) dt
+    at = int(np.argmin(np.abs(reference.time - last[header.index("time")])))
+    assert abs(reference.time[at] - last[header.index("time")]) < 1e-9
+    for host_name, column in (("drive.psi", "drive::psi[REAL]"),
+                              ("bearing.friction_torque_magnitude", "bearing::friction_torque_magnitude[REAL]")):
+        want = reference_values(reference, host_name)[at]
+        assert last[header.index(column)] == pytest.approx(want, abs=1e-6 * max(1.0, abs(want))), host_name
