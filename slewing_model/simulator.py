@@ -20,8 +20,8 @@ from .bime import BimeSolver, LoadDistribution, Loads
 from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
 from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE, compiled_evaluate_points
-from .reduced_operator import ReducedOperator
 from .geometry import Bearing
+from .reduced_operator import ReducedOperator
 
 RING_MODELS = ("rigid", "flexible")
 LOAD_FRAMES = ("fixed", "rotating")
@@ -93,6 +93,9 @@ class SimulatorSettings:
         _choice("moving_ring", self.moving_ring, ("inner", "outer"))
         _choice("load_frame", self.load_frame, LOAD_FRAMES)
         _choice("friction_kernel", self.friction_kernel, ("auto", "numpy", "compiled"))
+        if self.friction_kernel == "compiled" and not COMPILED_AVAILABLE:
+            raise ValueError("friction_kernel = 'compiled' needs numba, which is not installed in this Python "
+                             "(pip install numba, or use 'auto' or 'numpy')")
         for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation", "friction_tolerance"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
