@@ -37,6 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cases import CASES, DT  # noqa: E402
+from timing import print_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
@@ -151,15 +152,6 @@ def build_baseline(revision: str, out: Path) -> dict[str, Path]:
         return fmus
     finally:
         subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
-
-
-def print_table(title: str, header: list[str], rows: list[list[str]]) -> None:
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
-    print(f"\n{title}")
-    print("| " + " | ".join(h.ljust(w) for h, w in zip(header, widths)) + " |")
-    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-    for r in rows:
-        print("| " + " | ".join(c.ljust(w) for c, w in zip(r, widths)) + " |")
 
 
 def main() -> None:

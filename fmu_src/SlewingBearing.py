@@ -95,8 +95,8 @@ from slewing_model import Bearing, Loads, NoEquilibriumError
 from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
 
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
-    BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, LOAD_FRAMES, MOVING_RINGS, OUTPUTS, REAL_PARAMETERS,
-    RING_MODELS, UNITS, choice_description, integer_default)
+    BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
+    UNITS, choice_description, integer_default, settings_of)
 
 
 class SlewingBearing(Fmi2Slave):
@@ -210,17 +210,8 @@ class SlewingBearing(Fmi2Slave):
         """Create the simulator from the parameters; log why not and return False."""
         self.simulator = None
         try:
-            for name, choices in (("ring_model", RING_MODELS), ("moving_ring", MOVING_RINGS),
-                                  ("load_frame", LOAD_FRAMES)):
-                value = getattr(self, name)
-                if value not in choices:
-                    raise ValueError(f"parameter {name} = {value}: must be one of "
-                                     + ", ".join(f"{k} ({v})" for k, v in choices.items()))
-            settings = SimulatorSettings(
-                ring_model=RING_MODELS[self.ring_model], moving_ring=MOVING_RINGS[self.moving_ring],
-                load_frame=LOAD_FRAMES[self.load_frame], preload=float(self.preload),
-                friction_coefficient=float(self.friction_coefficient), seal_torque=float(self.seal_torque),
-                tolerance=float(self.tolerance), omega_regularisation=float(self.omega_regularisation))
+            names = [name for name, *_ in REAL_PARAMETERS] + [name for name, *_ in INTEGER_PARAMETERS]
+            settings = SimulatorSettings(**settings_of({name: getattr(self, name) for name in names}))
             superelement = None
             if settings.ring_model == "flexible":
                 from slewing_model.ring_stiffness import Superelement

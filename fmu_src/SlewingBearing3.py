@@ -38,7 +38,7 @@ from pythonfmu3 import (DefaultExperiment, Dimension, Fmi3Causality, Fmi3Initial
                         Fmi3Variability, Float64, Int32, Unit)
 
 from bearing_variables import (BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-                               UNITS, check_choices, check_inputs, choice_description, integer_default)
+                               UNITS, check_inputs, choice_description, integer_default, settings_of)
 from slewing_model import Bearing, Loads, NoEquilibriumError
 from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
 
@@ -132,12 +132,8 @@ class SlewingBearing3(Fmi3Slave):
         """Create the simulator from the parameters; log why not and return False."""
         self.simulator = None
         try:
-            choices = check_choices({name: getattr(self, name) for name, _, _ in INTEGER_PARAMETERS})
-            settings = SimulatorSettings(
-                ring_model=choices["ring_model"], moving_ring=choices["moving_ring"], load_frame=choices["load_frame"],
-                preload=float(self.preload), friction_coefficient=float(self.friction_coefficient),
-                seal_torque=float(self.seal_torque), tolerance=float(self.tolerance),
-                omega_regularisation=float(self.omega_regularisation))
+            names = [name for name, *_ in REAL_PARAMETERS] + [name for name, *_ in INTEGER_PARAMETERS]
+            settings = SimulatorSettings(**settings_of({name: getattr(self, name) for name in names}))
             superelement = None
             if settings.ring_model == "flexible":
                 from slewing_model.ring_stiffness import Superelement

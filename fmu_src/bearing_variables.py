@@ -108,6 +108,15 @@ def check_choices(values: dict) -> dict:
     return names
 
 
+def settings_of(values: dict) -> dict:
+    """The simulator settings (``SimulatorSettings`` keywords) of the FMU's parameter values
+    (every parameter of :data:`REAL_PARAMETERS` and :data:`INTEGER_PARAMETERS` by name);
+    ValueError naming a bad integer choice (the settings check the rest)."""
+    settings = check_choices(values)
+    settings.update({name: float(values[name]) for name, *_ in REAL_PARAMETERS})
+    return settings
+
+
 def check_inputs(values: dict) -> None:
     """ValueError naming the first input of ``values`` that is not finite."""
     for name, _, _ in INPUTS:
