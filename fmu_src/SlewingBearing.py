@@ -13,7 +13,6 @@ registered variables and the solver's warm start.
 from __future__ import annotations
 
 import json
-import math
 import os
 import sys
 import traceback
@@ -91,12 +90,12 @@ from pythonfmu.enums import Fmi2Initial, Fmi2Status
 from pythonfmu.default_experiment import DefaultExperiment
 
 
-from slewing_model import Bearing, Loads, NoEquilibriumError
+from slewing_model import Bearing
 from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
 
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
     BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-    UNITS, choice_description, integer_default, settings_of)
+    UNITS, choice_description, integer_default, scalar_outputs, settings_of, step_or_refuse)
 
 
 class SlewingBearing(Fmi2Slave):
@@ -236,45 +235,14 @@ class SlewingBearing(Fmi2Slave):
         return self._update(current_time)
 
     def _update(self, current_time: float | None = None) -> bool:
-        """Solve for the current inputs; on bad input log why (Discard), keep the state and
-        return False. The same step refused twice (same time, inputs and tunable parameters,
-        as a master that retries without changing anything does) cannot succeed: Error."""
-        sim = self.simulator
-        before = sim.get_state()
-        try:
-            for name, _, _ in INPUTS:
-                value = getattr(self, name)
-                if not math.isfinite(value):
-                    raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
-            tunable = {"friction_coefficient": float(self.friction_coefficient),
-                       "seal_torque": float(self.seal_torque),
-                       "omega_regularisation": float(self.omega_regularisation)}
-            if any(getattr(sim.settings, k) != v for k, v in tunable.items()):
-                sim.tune(**tunable)
-            result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
-        except (ValueError, NoEquilibriumError) as exc:
-            sim.set_state(before)  # the solver may have moved: back to the state before the step
-            key = repr((current_time, [getattr(self, name) for name, _, _ in INPUTS],  # repr: NaN equals NaN
-                        self.friction_coefficient, self.seal_torque, self.omega_regularisation))
-            if current_time is not None and key == self._refused:
-                self.log(f"{self.instance_name}: step at t = {current_time} refused again with the same inputs, "
-                         f"so it cannot succeed (change an input, or stop): {exc}", Fmi2Status.error)
-            else:
-                self.log(f"{self.instance_name}: step refused, state kept: {exc}", Fmi2Status.discard)
-            self._refused = key
+        """Solve for the current inputs (:func:`bearing_variables.step_or_refuse`: a refused step
+        is logged as Discard and keeps the state; the same step refused twice is an Error)."""
+        result = step_or_refuse(self, current_time, Fmi2Status.discard, Fmi2Status.error)
+        if result is None:
             return False
-        except Exception:  # never let a bug crash the host: report it
-            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
-            return False
-        self._refused = None
+        for name, value in scalar_outputs(result).items():
+            setattr(self, name, value)
         d = result.distribution
-        self.x, self.y, self.z, self.rx, self.ry = map(float, d.displacement)
-        self.friction_torque = result.friction_torque
-        self.friction_torque_magnitude = result.friction_torque_magnitude
-        self.max_ball_load = d.max_ball_load
-        self.max_contact_pressure = d.max_contact_pressure
-        self.static_safety_factor = min(d.static_safety_factor, 1e300)
-        self.balls_in_four_point_contact = d.balls_in_four_point_contact
         self._q = d.contact_load.tolist()
         self._alpha = d.contact_angle[:, :2].tolist()
         self._d = d.interference.tolist()

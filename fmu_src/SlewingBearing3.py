@@ -38,8 +38,9 @@ from pythonfmu3 import (DefaultExperiment, Dimension, Fmi3Causality, Fmi3Initial
                         Fmi3Variability, Float64, Int32, Unit)
 
 from bearing_variables import (BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-                               UNITS, check_inputs, choice_description, integer_default, settings_of)
-from slewing_model import Bearing, Loads, NoEquilibriumError
+                               UNITS, choice_description, integer_default, scalar_outputs, settings_of,
+                               step_or_refuse)
+from slewing_model import Bearing
 from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
 
 
@@ -160,39 +161,14 @@ class SlewingBearing3(Fmi3Slave):
         return True
 
     def _update(self, current_time: float | None = None) -> bool:
-        """Solve for the current inputs; on bad input log why (Discard), keep the state and return False."""
-        sim = self.simulator
-        before = sim.get_state()
-        try:
-            check_inputs({name: getattr(self, name) for name, _, _ in INPUTS})
-            tunable = {"friction_coefficient": float(self.friction_coefficient), "seal_torque": float(self.seal_torque),
-                       "omega_regularisation": float(self.omega_regularisation)}
-            if any(getattr(sim.settings, k) != v for k, v in tunable.items()):
-                sim.tune(**tunable)
-            result = sim.step(Loads(self.Fx, self.Fy, self.Fz, self.Mx, self.My), self.psi, self.omega)
-        except (ValueError, NoEquilibriumError) as exc:
-            sim.set_state(before)  # the solver may have moved: back to the state before the step
-            key = (current_time, tuple(getattr(self, name) for name, _, _ in INPUTS),
-                   self.friction_coefficient, self.seal_torque, self.omega_regularisation)
-            if current_time is not None and key == self._refused:
-                self.log(f"{self.instance_name}: step at t = {current_time} refused again with the same inputs, "
-                         f"so it cannot succeed (change an input, or stop): {exc}", Fmi3Status.error)
-            else:
-                self.log(f"{self.instance_name}: step refused, state kept: {exc}", Fmi3Status.discard)
-            self._refused = key
+        """Solve for the current inputs (:func:`bearing_variables.step_or_refuse`: a refused step
+        is logged as Discard and keeps the state; the same step refused twice is an Error)."""
+        result = step_or_refuse(self, current_time, Fmi3Status.discard, Fmi3Status.error)
+        if result is None:
             return False
-        except Exception:  # never let a bug crash the host: report it
-            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi3Status.error)
-            return False
-        self._refused = None
+        for name, value in scalar_outputs(result).items():
+            setattr(self, name, value)
         d = result.distribution
-        self.x, self.y, self.z, self.rx, self.ry = map(float, d.displacement)
-        self.friction_torque = result.friction_torque
-        self.friction_torque_magnitude = result.friction_torque_magnitude
-        self.max_ball_load = d.max_ball_load
-        self.max_contact_pressure = d.max_contact_pressure
-        self.static_safety_factor = min(d.static_safety_factor, 1e300)
-        self.balls_in_four_point_contact = d.balls_in_four_point_contact
         for name, _, columns, _, attribute in BALL_ARRAYS:
             self._arrays[name] = getattr(d, attribute)[:, :len(columns)]
         return True

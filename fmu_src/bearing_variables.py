@@ -1,13 +1,15 @@
 """Variables of the slewing bearing FMU, shared by its FMI 2.0 and FMI 3.0 slaves.
 
 One table per kind of variable (name, SI unit, description), the parameters'
-defaults and choices, and the two checks both slaves make before they step
-(so that both refuse the same bad input with the same message). Plain data and
-the standard library only: no FMI library and no physics here.
+defaults and choices, the checks both slaves make before they step, and the
+step itself with its refusal rule (:func:`step_or_refuse`), so that both
+answer and refuse alike. No FMI library and no physics here: the slaves hand
+in their own status values, slewing_model does the rest.
 """
 from __future__ import annotations
 
 import math
+import traceback
 
 #: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
 UNITS = {
@@ -123,3 +125,54 @@ def check_inputs(values: dict) -> None:
         value = values[name]
         if not math.isfinite(value):
             raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
+
+
+#: the parameters a host may change between steps
+TUNABLE = ("friction_coefficient", "seal_torque", "omega_regularisation")
+
+
+def step_or_refuse(slave, current_time, discard, error):
+    """Step ``slave.simulator`` with the slave's inputs and tunable parameters (attributes by
+    name); the :class:`~slewing_model.simulator.StepResult`, or None after logging why not.
+
+    A bad input or a load the bearing cannot carry refuses the step: logged with the status
+    ``discard``, the simulator as before the step (it restores itself), so the master may
+    retry or go on with other inputs (FMI 2.0, 4.2.3). The same step refused again (same
+    time, inputs and tunable parameters: a master that retries unchanged) cannot succeed and
+    is logged with ``error``, as is an internal error; no exception leaves (it would reach
+    the host). ``slave._refused`` keeps the last refused step."""
+    from slewing_model import Loads, NoEquilibriumError
+
+    sim = slave.simulator
+    try:
+        check_inputs({name: getattr(slave, name) for name, _, _ in INPUTS})
+        tunable = {name: float(getattr(slave, name)) for name in TUNABLE}
+        if any(getattr(sim.settings, k) != v for k, v in tunable.items()):
+            sim.tune(**tunable)
+        result = sim.step(Loads(slave.Fx, slave.Fy, slave.Fz, slave.Mx, slave.My), slave.psi, slave.omega)
+    except (ValueError, NoEquilibriumError) as exc:
+        key = repr((current_time, [getattr(slave, name) for name, _, _ in INPUTS],  # repr: NaN equals NaN
+                    [getattr(slave, name) for name in TUNABLE]))
+        if current_time is not None and key == slave._refused:
+            slave.log(f"{slave.instance_name}: step at t = {current_time} refused again with the same inputs, "
+                      f"so it cannot succeed (change an input, or stop): {exc}", error)
+        else:
+            slave.log(f"{slave.instance_name}: step refused, state kept: {exc}", discard)
+        slave._refused = key
+        return None
+    except Exception:
+        slave.log(f"{slave.instance_name}: internal error:\n{traceback.format_exc()}", error)
+        return None
+    slave._refused = None
+    return result
+
+
+def scalar_outputs(result) -> dict:
+    """The scalar outputs (:data:`OUTPUTS` and :data:`COUNT_OUTPUT`) of a step result, by name."""
+    d = result.distribution
+    values = dict(zip(("x", "y", "z", "rx", "ry"), map(float, d.displacement)))
+    values.update(friction_torque=result.friction_torque, friction_torque_magnitude=result.friction_torque_magnitude,
+                  max_ball_load=d.max_ball_load, max_contact_pressure=d.max_contact_pressure,
+                  static_safety_factor=min(d.static_safety_factor, 1e300))
+    values[COUNT_OUTPUT[0]] = d.balls_in_four_point_contact
+    return values
