@@ -38,6 +38,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_flexible.py
 	$(PY) benchmarks/bench_friction.py
 	$(PY) benchmarks/bench_fmu.py
+	$(PY) benchmarks/bench_batch.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info results

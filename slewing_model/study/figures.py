@@ -54,12 +54,26 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
     return written
 
 
+def _labels(rows: list[dict]) -> list[str]:
+    """Case labels without what all cases share (the bearing variant, or the load series)."""
+    loads = [r["name"].split(" | ", 1)[0] for r in rows]
+    variants = [r["name"].split(" | ", 1)[-1] for r in rows]
+    if len(set(variants)) == 1:
+        return loads
+    if len(set(loads)) == 1:
+        return variants
+    return [r["name"] for r in rows]
+
+
 def overview(path: str, rows: list[dict]) -> str:
     plt = _pyplot()
     ok = [r for r in rows if r["status"] == "ok"]
     failed = len(rows) - len(ok)
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5 if len(ok) <= 40 else 6.5))
     title = f"{len(rows)} cases, {len(ok)} ok, {failed} failed (see summary.csv)"
+    variants = {r["name"].split(" | ", 1)[-1] for r in ok}
+    if len(ok) <= 40 and len(variants) == 1:
+        title += f"; bearing: {variants.pop()}"
     fig.suptitle(title)
     if not ok:
         for ax in axes.flat:
@@ -74,7 +88,7 @@ def overview(path: str, rows: list[dict]) -> str:
         (("friction_energy",), 1e-3, "friction energy over the motion [kJ]"),
     ]
     if len(ok) <= 40:
-        labels = [r["name"] for r in ok]
+        labels = _labels(ok)
         y = np.arange(len(ok))
         for ax, (keys, scale, label) in zip(axes.flat, panels):
             height = 0.8 / len(keys)
@@ -103,12 +117,13 @@ def overview(path: str, rows: list[dict]) -> str:
 
 
 def band_against(path: str, ok: list[dict], key: str, label: str) -> str:
-    """Mean friction torque against a swept parameter: median and 5-95 % band per group."""
+    """Mean friction torque against a swept parameter: median and 5-95 % band per group (left),
+    and the band relative to the median (right: narrow bands are invisible on the left)."""
     plt = _pyplot()
     groups = defaultdict(list)
     for r in ok:
         groups[(r["load"], r["bearing"], r["ring_model"])].append(r)
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    fig, (ax, rel) = plt.subplots(1, 2, figsize=(12, 4.8))
     for (load, bearing, model), members in sorted(groups.items()):
         by_x = defaultdict(list)
         for r in members:
@@ -120,13 +135,23 @@ def band_against(path: str, ok: list[dict], key: str, label: str) -> str:
         hi = np.array([np.percentile(s, 95) for s in samples])
         n = min(len(s) for s in samples)
         line, = ax.plot(xs, median, "o-", label=f"{bearing}, {model}, {load}: median ({n} cases per point)")
-        ax.fill_between(xs, lo, hi, color=line.get_color(), alpha=0.25, label="5-95 % band")
+        color = line.get_color()
+        ax.fill_between(xs, lo, hi, color=color, alpha=0.25, label="5-95 % band")
         for x, s in zip(xs, samples):
-            ax.plot(np.full(s.shape, x), s, ".", color=line.get_color(), alpha=0.15, ms=3)
+            ax.plot(np.full(s.shape, x), s, ".", color=color, alpha=0.15, ms=3)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel.fill_between(xs, 100 * (lo / median - 1), 100 * (hi / median - 1), color=color, alpha=0.3,
+                             label=f"{bearing}, {model}: 5-95 % band")
+            for x, s, m in zip(xs, samples, median):
+                rel.plot(np.full(s.shape, x), 100 * (s / m - 1), ".", color=color, alpha=0.15, ms=3)
     ax.set_xlabel(label)
     ax.set_ylabel("mean friction torque [N m]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
+    rel.set_xlabel(label)
+    rel.set_ylabel("mean friction torque / median - 1 [%]")
+    rel.grid(alpha=0.3)
+    rel.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
