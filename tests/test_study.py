@@ -268,3 +268,17 @@ def test_openfast_pitch_case_steps_the_recorded_pitch_angle(tmp_path, cluster):
     pitch = -np.degrees(ts[:, 1])                    # psi = -BldPitch1 (mounting "tip", slewing_model.aeroelastic)
     assert np.all((pitch > -0.1) & (pitch < 8.0)) and np.ptp(pitch) > 0.01          # BldPitch1: -0.02..7.85 deg
     assert float(row["min_static_safety_factor"]) > 1.0
+
+
+def test_superelement_built_once_per_bearing_variant(tmp_path):
+    """Flexible rings: the cases of one bearing file (here 2 preloads x 2 seeds x 2 load series) carry
+    one and the same superelement, built before submission; the rigid cases carry none."""
+    path = write_study(tmp_path, idling("idle", 5) + idling("axial", 5, fz=1e4))
+    path.write_text(path.read_text().replace('ring_model = ["rigid"]', 'ring_model = ["rigid", "flexible"]'))
+    study = load_study(path)
+    prepared = _Prepared(study.simulation)
+    tasks = [prepared.task(c) for c in study.cases()]
+    flexible = [t.superelement for t in tasks if t.variant["ring_model"] == "flexible"]
+    assert len(flexible) == 8 and all(se is flexible[0] for se in flexible)
+    assert all(t.superelement is None for t in tasks if t.variant["ring_model"] == "rigid")
+    flexible[0].check(load_bearing(TABLE3))              # built for this bearing
