@@ -15,7 +15,6 @@ from __future__ import annotations
 import json
 import os
 import sys
-import traceback
 
 
 #: names the Python installation or virtual environment the FMU runs in (see README, "The FMU")
@@ -91,11 +90,11 @@ from pythonfmu.default_experiment import DefaultExperiment
 
 
 from slewing_model import Bearing
-from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
+from slewing_model.simulator import BearingSimulator, decode_state, encode_state
 
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
     BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-    UNITS, choice_description, integer_default, scalar_outputs, settings_of, step_or_refuse)
+    UNITS, build_simulator, choice_description, integer_default, scalar_outputs, step_or_refuse)
 
 
 class SlewingBearing(Fmi2Slave):
@@ -207,22 +206,7 @@ class SlewingBearing(Fmi2Slave):
 
     def _build_simulator(self) -> bool:
         """Create the simulator from the parameters; log why not and return False."""
-        self.simulator = None
-        try:
-            names = [name for name, *_ in REAL_PARAMETERS] + [name for name, *_ in INTEGER_PARAMETERS]
-            settings = SimulatorSettings(**settings_of({name: getattr(self, name) for name in names}))
-            superelement = None
-            if settings.ring_model == "flexible":
-                from slewing_model.ring_stiffness import Superelement
-
-                superelement = Superelement.load(self.superelement_path, self.bearing)
-            self.simulator = BearingSimulator(self.bearing, superelement, settings)
-            return True
-        except ValueError as exc:
-            self.log(f"{self.instance_name}: {exc}", Fmi2Status.error)
-        except Exception:
-            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
-        return False
+        return build_simulator(self, Fmi2Status.error)
 
     # A step is refused (do_step returns False) with the reason logged as Discard: pythonfmu
     # then returns fmi2Discard, and the FMU's Linux binary (fmu_src/shim) reports

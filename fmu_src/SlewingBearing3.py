@@ -31,17 +31,16 @@ from __future__ import annotations
 
 import json
 import os
-import traceback
 
 import numpy as np
 from pythonfmu3 import (DefaultExperiment, Dimension, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Status,
                         Fmi3Variability, Float64, Int32, Unit)
 
 from bearing_variables import (BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-                               UNITS, choice_description, integer_default, scalar_outputs, settings_of,
+                               UNITS, build_simulator, choice_description, integer_default, scalar_outputs,
                                step_or_refuse)
 from slewing_model import Bearing
-from slewing_model.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
+from slewing_model.simulator import BearingSimulator, decode_state, encode_state
 
 
 class SlewingBearing3(Fmi3Slave):
@@ -131,22 +130,7 @@ class SlewingBearing3(Fmi3Slave):
 
     def _build_simulator(self) -> bool:
         """Create the simulator from the parameters; log why not and return False."""
-        self.simulator = None
-        try:
-            names = [name for name, *_ in REAL_PARAMETERS] + [name for name, *_ in INTEGER_PARAMETERS]
-            settings = SimulatorSettings(**settings_of({name: getattr(self, name) for name in names}))
-            superelement = None
-            if settings.ring_model == "flexible":
-                from slewing_model.ring_stiffness import Superelement
-
-                superelement = Superelement.load(self.superelement_path, self.bearing)
-            self.simulator = BearingSimulator(self.bearing, superelement, settings)
-            return True
-        except ValueError as exc:
-            self.log(f"{self.instance_name}: {exc}", Fmi3Status.error)
-        except Exception:
-            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi3Status.error)
-        return False
+        return build_simulator(self, Fmi3Status.error)
 
     # A step is refused as by the FMI 2.0 slave: do_step returns False (fmi3Discard) with the
     # reason logged as Discard, and the state stays the one before the step, so the host may

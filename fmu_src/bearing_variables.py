@@ -131,6 +131,28 @@ def check_inputs(values: dict) -> None:
 TUNABLE = ("friction_coefficient", "seal_torque", "omega_regularisation")
 
 
+def build_simulator(slave, error) -> bool:
+    """Create ``slave.simulator`` from the slave's parameters (attributes by name), its ``bearing``
+    and ``superelement_path``; log why not (status ``error``) and return False."""
+    from slewing_model.ring_stiffness import Superelement
+    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+
+    slave.simulator = None
+    try:
+        names = [name for name, *_ in REAL_PARAMETERS] + [name for name, *_ in INTEGER_PARAMETERS]
+        settings = SimulatorSettings(**settings_of({name: getattr(slave, name) for name in names}))
+        superelement = None
+        if settings.ring_model == "flexible":
+            superelement = Superelement.load(slave.superelement_path, slave.bearing)
+        slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
+        return True
+    except ValueError as exc:
+        slave.log(f"{slave.instance_name}: {exc}", error)
+    except Exception:
+        slave.log(f"{slave.instance_name}: internal error:\n{traceback.format_exc()}", error)
+    return False
+
+
 def step_or_refuse(slave, current_time, discard, error):
     """Step ``slave.simulator`` with the slave's inputs and tunable parameters (attributes by
     name); the :class:`~slewing_model.simulator.StepResult`, or None after logging why not.
