@@ -61,8 +61,10 @@ class Case:
 
 def _series(path, time: np.ndarray) -> np.ndarray:
     """Fx..My of a shipped load series CSV at ``time``, interpolated linearly."""
-    data = np.genfromtxt(path, delimiter=",", names=True)
-    return np.stack([np.interp(time, data["time"], data[name]) for name in ("Fx", "Fy", "Fz", "Mx", "My")], axis=1)
+    from slewing_drives.load_series import LoadSeries   # numpy only: the FMU workers import no slewing_model
+
+    series = LoadSeries.read_csv(path)
+    return np.stack([np.interp(time, series.time, series.loads[:, k]) for k in range(5)], axis=1)
 
 
 def _triangle(time: np.ndarray, amplitude: float, rate: float):
