@@ -330,7 +330,8 @@ class BimeSolver:
                 my = self.compliance @ y
             e = e - my.reshape(e.shape)       # e_D = -M y: groove centres moved by ring deformation
             ring = 0.5 * float(y @ my)        # eq 15
-        delta, q, force, energy, hess, n, length = self._contacts(e)
+        # the flexible step takes the springs' compliance from n, delta, q (reduced_operator)
+        delta, q, force, energy, hess, n, length = self._contacts(e, hessian=self.compliance is None)
         work = float(f_scaled @ qs)
         # the total is a difference of larger terms: its roundoff scales with them
         return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work), my)

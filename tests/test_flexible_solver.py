@@ -125,3 +125,24 @@ def test_refused_step_leaves_the_simulator_as_it_was(bearing):
     for loads, psi in after:
         a, b = disturbed.step(loads, psi, 0.1).distribution, clean.step(loads, psi, 0.1).distribution
         assert np.array_equal(a.contact_load, b.contact_load) and np.array_equal(a.displacement, b.displacement)
+
+
+@pytest.mark.parametrize("balls", [67, 150])
+def test_block_circulant_product_by_harmonics_equals_the_dense_product(balls):
+    """The ring compliance's product by FFT (from FFT_FROM_BALLS balls on) against the
+    dense matrix-vector product, on a random symmetric block-circulant matrix: block
+    (b, c) = C_(c-b mod B), C_(-k) = C_k^T."""
+    from slewing_model.ring_compliance import FFT_FROM_BALLS, BlockCirculant
+
+    rng = np.random.default_rng(balls)
+    blocks = rng.standard_normal((balls, 4, 4))
+    blocks = 0.5 * (blocks + blocks[(-np.arange(balls)) % balls].transpose(0, 2, 1))
+    k = (np.arange(balls)[None, :] - np.arange(balls)[:, None]) % balls
+    dense = blocks[k].transpose(0, 2, 1, 3).reshape(4 * balls, 4 * balls)
+    assert np.array_equal(dense, dense.T)
+    matrix = BlockCirculant(dense, 4)
+    assert matrix.by_harmonics == (balls >= FFT_FROM_BALLS)
+    y = rng.standard_normal(4 * balls)
+    expected = np.array([sum(dense[r, c] * y[c] for c in range(4 * balls)) for r in range(4 * balls)])
+    assert np.abs(matrix @ y - expected).max() <= 1e-13 * np.abs(expected).max()
+    assert np.array_equal(matrix[np.ix_([0, 5], [3, 7])], dense[np.ix_([0, 5], [3, 7])])
