@@ -128,6 +128,8 @@ class BimeSolver:
         jr = np.stack([c * one, s * one, zero, -z * s / L, z * c / L], axis=-1)
         jz = np.stack([zero, zero, one, r * s / L, -r * c / L], axis=-1)
         self.jacobian = a.moving_sign * np.stack([jr, jz], axis=2)
+        self._jacobian_rows = self.jacobian.reshape(-1, 5)     # (4B, 5): one matrix-vector product
+        self._separation = a.separation                        # e before loading, (B, 2, 2)
         k_mean = float(a.stiffness.mean())
         self.reference_stiffness = a.stiffness.size * k_mean * math.sqrt(1e-4 * self.bearing.ball_diameter)
 
@@ -145,8 +147,8 @@ class BimeSolver:
         n = e / length[..., None]
         delta = length - a.natural_length                                   # eq 7
         dpos = np.maximum(delta, 0.0)
-        q = a.stiffness * dpos**1.5                                         # eq 8
-        energy = 0.4 * float(np.sum(a.stiffness * dpos**2.5))               # eq 1
+        q = a.stiffness * (dpos * np.sqrt(dpos))                            # eq 8
+        energy = 0.4 * float(np.vdot(q, dpos))                              # eq 1: 2/5 K delta^(5/2)
         force = q[..., None] * n
         if not hessian:
             return delta, q, force, energy, None, n, length
@@ -323,7 +325,7 @@ class BimeSolver:
                   my: np.ndarray | None = None) -> "_Point":
         """Contact terms and total energy at the unknowns ``(qs, y)``; ``my``: ``M y`` if known
         (along a search line it is linear in the step)."""
-        e = self.assembly.separation + self.jacobian @ qs
+        e = self._separation + (self._jacobian_rows @ qs).reshape(self.jacobian.shape[:-1])
         ring = 0.0
         if self.compliance is not None:
             if my is None:
