@@ -23,7 +23,7 @@ import numpy as np
 
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
-from .friction_kernel import compiled_evaluate_points
+from .friction_kernel import compiled_evaluate_points, compiled_point_coefficients
 from .geometry import RING_CONTACTS, Bearing
 
 #: sign of the (r, z) components of the contact normals of contacts 1..4
@@ -218,9 +218,26 @@ class ContactPoints:
                  compiled: bool = False):
         geo = self.geometry = geometry
         self.compiled = compiled           # evaluate with the compiled loop (friction_kernel)
+        u_nodes, t2, weight = quad.across_nodes, quad.along_squared, quad.folded_weight
+        if compiled:                       # the same formulas, one compiled loop (friction_kernel)
+            column = [np.ascontiguousarray(x[:, 0]) for x in (geo.a, geo.b, geo.rb, geo.rd, geo.n_r, geo.n_z,
+                                                              geo.ring_speed, geo.moving)]
+            (self.g10, self.g12, self.h1, self.s0, self.s1, self.hs, self.arm1,
+             self.arm2) = compiled_point_coefficients()(*column, np.array(u_nodes), geo.length_scale, geo.pitch_radius)
+        else:
+            self._coefficients(geo, u_nodes)
+        self.t2 = np.array(t2, dtype=float)          # writable (the compiled loop takes no read-only arrays)
+        space = self._space = _workspace(workspace)
+        shape = (self.t2.size, geo.ball_index.size, quad.n_across)
+        self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))
+        self._s, self._k, self._k3 = (space.get(name, shape) for name in ("s", "k", "k3"))
+        self._ones = np.ones(quad.n_across)
+        self._products = None
+
+    def _coefficients(self, geo: ContactSet, u_nodes: np.ndarray) -> None:
+        """The velocity coefficients ``g10 .. hs`` and lever arms ``arm1, arm2`` (C, I), numpy."""
         ls, big_r = geo.length_scale, geo.pitch_radius
         rb, rd, n_r, n_z, ring_speed = geo.rb, geo.rd, geo.n_r, geo.n_z, geo.ring_speed
-        u_nodes, t2, weight = quad.across_nodes, quad.along_squared, quad.folded_weight
         # sin of the angle a u / Rd (C, I), |angle| < pi/2; the nodes u are symmetric and sin is odd
         n_i, n_neg = u_nodes.size, u_nodes.size // 2
         sin_pos = np.sin(geo.a * (u_nodes[n_neg:] / rd))
@@ -242,13 +259,6 @@ class ContactPoints:
         # lever arm of the moving ring's torque: e_z x (c + r) . v = arm1 v1 + arm2 t^2 S
         self.arm1 = np.where(geo.moving, big_r + r_r, 0.0)
         self.arm2 = np.where(geo.moving, -t2_r * half, 0.0)
-        self.t2 = np.array(t2, dtype=float)          # writable (the compiled loop takes no read-only arrays)
-        space = self._space = _workspace(workspace)
-        shape = (self.t2.size, geo.ball_index.size, quad.n_across)
-        self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))
-        self._s, self._k, self._k3 = (space.get(name, shape) for name in ("s", "k", "k3"))
-        self._ones = np.ones(quad.n_across)
-        self._products = None
 
     def _prepare_derivatives(self) -> None:
         """Coefficient products of the Hessian (derivatives only)."""

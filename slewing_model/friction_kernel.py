@@ -6,13 +6,16 @@ Weiszfeld majorant ``M - H``) over the quadrature points of every loaded contact
 With numpy that is some sixty array operations per evaluation, each a few microseconds of
 call overhead for a few thousand points: for a 150-ball bearing the overhead, not the
 arithmetic, sets the time. :func:`_evaluate_points`, compiled, is the same sum as one loop
-over contacts, across-groove nodes and folded along-groove nodes.
+over contacts, across-groove nodes and folded along-groove nodes. :func:`_point_coefficients`
+is, likewise, the set-up of the points' velocity coefficients (``ContactPoints``), some twenty
+array operations done twice a step (the rule the balls are solved on and the torque's).
 
 numba is optional (it is not part of the FMU's run-time requirements): without it
 :data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
-results to round-off (``tests/test_friction_kernel.py``). The loop is compiled when first
-asked for (:func:`compiled_evaluate_points`), which the simulator does when it is built, so
-that the compile time lands in the FMU's instantiation, never in a step.
+results to round-off (``tests/test_friction_kernel.py``). The loops are compiled when first
+asked for (:func:`compiled_evaluate_points`, :func:`compiled_point_coefficients`), which the
+simulator does when it is built, so that the compile time lands in the FMU's instantiation,
+never in a step.
 """
 from __future__ import annotations
 
@@ -118,3 +121,50 @@ def compiled_evaluate_points():
     import numba
 
     return numba.njit(_SIGNATURE, cache=True, nogil=True)(_evaluate_points)
+
+
+_COEFFICIENT_SIGNATURE = ("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], b1[:], f8[:], "
+                          "f8, f8)")
+
+
+def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, length_scale, pitch_radius):
+    """Velocity and lever-arm coefficients (C, I) of every contact (C,) at the across nodes
+    ``u_nodes`` (I,, symmetric about 0): ``g10, g12, h1, s0, s1, hs, arm1, arm2``, the
+    formulas of ``ContactPoints.__init__`` (:mod:`slewing_model.ball_kinematics`), which
+    derives them, in the same order of operations."""
+    n_contacts, n_across = a.size, u_nodes.size
+    n_neg = n_across // 2
+    out = [np.empty((n_contacts, n_across)) for _ in range(8)]
+    g10, g12, h1, s0, s1, hs, arm1, arm2 = out
+    root = np.sqrt(1.0 - u_nodes ** 2)
+    for c in range(n_contacts):
+        for i in range(n_neg, n_across):
+            sin_pos = math.sin(a[c] * (u_nodes[i] / rd[c]))
+            # sin is odd and the nodes symmetric: the node n_across - 1 - i has -sin_pos
+            mirror = n_across - 1 - i
+            for side in range(1 if mirror == i else 2):     # the middle node of an odd rule once
+                k, sin_t = (i, sin_pos) if side == 0 else (mirror, -sin_pos)
+                cos_t = math.sqrt(1.0 - sin_t * sin_t)
+                rho = rb[c] - rd[c] + rd[c] * cos_t
+                r_r = rho * n_r[c] - rd[c] * sin_t * n_z[c]
+                r_z = rho * n_z[c] + rd[c] * sin_t * n_r[c]
+                t2_r = -cos_t * n_z[c] - sin_t * n_r[c]
+                t2_z = cos_t * n_r[c] - sin_t * n_z[c]
+                half = b[c] * root[k]
+                g10[c, k] = r_z / length_scale
+                g12[c, k] = -r_r / length_scale
+                h1[c, k] = ring_speed[c] * (pitch_radius + r_r)
+                s0[c, k] = -half * t2_z / length_scale
+                s1[c, k] = half * t2_r / length_scale
+                hs[c, k] = -half * ring_speed[c] * t2_r
+                arm1[c, k] = pitch_radius + r_r if moving[c] else 0.0
+                arm2[c, k] = -t2_r * half if moving[c] else 0.0
+    return g10, g12, h1, s0, s1, hs, arm1, arm2
+
+
+@functools.lru_cache(maxsize=1)
+def compiled_point_coefficients():
+    """The compiled :func:`_point_coefficients` (as :func:`compiled_evaluate_points`)."""
+    import numba
+
+    return numba.njit(_COEFFICIENT_SIGNATURE, cache=True, nogil=True)(_point_coefficients)
