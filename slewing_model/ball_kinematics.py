@@ -23,7 +23,7 @@ import numpy as np
 
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
-from .friction_kernel import compiled_evaluate_points, compiled_point_coefficients
+from .friction_kernel import compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients
 from .geometry import RING_CONTACTS, Bearing
 
 #: sign of the (r, z) components of the contact normals of contacts 1..4
@@ -466,43 +466,57 @@ def minimise_power(contacts: ContactPoints, u: np.ndarray, tol: float, max_itera
 
     Stopping rule: the Newton decrement ``g . H^-1 g`` of every ball is at
     most ``tol (D_b + floor)``, ``D_b`` its power and ``floor`` the mean
-    power per ball (of this call, unless given): each ball's power is within
+    power per ball at the start (unless given): each ball's power is within
     ``tol`` of the mean of its own power and the average one, so the total is
-    within ``tol`` of its minimum, and a ball that carries almost nothing is
-    not iterated to a relative accuracy that cannot show in the torque. That
-    last Newton step is taken where it lowers the power. When at most a
-    quarter of the balls are left after :data:`_STRAGGLERS_AFTER` iterations, they go on alone
+    within ``tol`` of its minimum (the start is above it: the test is a
+    little looser than at the minimum, by the warm start's excess power), and
+    a ball that carries almost nothing is not iterated to a relative accuracy
+    that cannot show in the torque. That last Newton step is taken where it
+    lowers the power (also by the converged balls when others run out of
+    iterations). When at most a quarter of the balls are left after
+    :data:`_STRAGGLERS_AFTER` iterations, they go on alone
     (:meth:`ContactPoints.subset`), the others take that last step.
 
-    Returns ``(u, iterations, residual, converged)``; ``residual``: the largest
-    force residual of a ball, relative to ``mu Q_max``, at the last evaluation."""
+    The floor fixed, every ball's iterates depend on its own contacts only: the
+    compiled loop (``contacts.compiled``) solves ball after ball
+    (:func:`slewing_model.friction_kernel.compiled_minimise_balls`), taking the
+    same steps as this batched numpy loop.
+
+    Returns ``(u, iterations, residual, converged)``; ``iterations``: the most
+    a ball took; ``residual``: the largest force residual of a ball, relative
+    to ``mu Q_max``, at its last evaluation."""
     eps2 = contacts.geometry.eps2
     n, m = u.shape
+    scale = contacts.geometry.force_scale
+    if contacts.compiled and theta is None:
+        if floor is None:
+            floor = float(contacts.evaluate(u, eps2, derivatives=False)[0].mean())
+        return _minimise_compiled(contacts, u, tol, max_iterations, floor)
     theta = np.zeros(n) if theta is None else np.array(theta, dtype=float)
     f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta)))
-    scale = contacts.geometry.force_scale
+    share = f.mean() if floor is None else floor            # fixed: each ball's iterates are its own
     iterations = 0
 
     def residual():
         return float(np.max(np.abs(g).max(axis=1) / scale))
 
+    def last_newton_step(done):                             # where it lowers the power
+        trial = np.where(done[:, None], u + newton, u)
+        keep = done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
+        return np.where(keep[:, None], trial, u)
+
     while True:
         newton = solve_per_ball(h, -g)
         decrement = -np.einsum("bk,bk->b", g, newton)
-        share = f.mean() if floor is None else floor
         done = decrement <= tol * (f + share)
         if np.all(done):
-            trial = u + newton
-            keep = contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12)
-            return np.where(keep[:, None], trial, u), iterations + 1, residual(), True
+            return last_newton_step(done), iterations + 1, residual(), True
         if iterations >= max_iterations:
-            return u, iterations, residual(), False
+            return last_newton_step(done), iterations, residual(), False
         left = np.flatnonzero(~done)
         if iterations >= _STRAGGLERS_AFTER and n >= 8 and 4 * left.size <= n:   # a long tail: the stragglers alone
             res_done = float(np.max(np.abs(g[done]).max(axis=1) / scale[done]))
-            trial = np.where(done[:, None], u + newton, u)          # the last Newton step of the others
-            keep = done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
-            u = np.where(keep[:, None], trial, u)
+            u = last_newton_step(done)
             u[left], more, res_left, converged = minimise_power(contacts.subset(left), u[left], tol,
                                                            max_iterations - iterations, theta[left], share)
             return u, iterations + more, max(res_done, res_left), converged
@@ -544,6 +558,18 @@ def minimise_power(contacts: ContactPoints, u: np.ndarray, tol: float, max_itera
             else:
                 x_t = None                                          # recomputed if a ball needs it
         u, f, g, h, extra = trial, f_t, g_t, h_t, x_t
+
+
+def _minimise_compiled(contacts: ContactPoints, u: np.ndarray, tol: float, max_iterations: int, floor: float):
+    """:func:`minimise_power` ball by ball in one compiled loop
+    (:func:`slewing_model.friction_kernel.compiled_minimise_balls`): the same steps."""
+    geo = contacts.geometry
+    first = np.searchsorted(geo.owner, np.arange(u.shape[0] + 1))      # contacts are ordered by ball
+    u, iterations, residual, converged = compiled_minimise_balls()(
+        np.ascontiguousarray(u, dtype=float), first, contacts.g10, contacts.g12, contacts.h1, contacts.s0,
+        contacts.s1, contacts.hs, contacts.weight, contacts.t2, np.ravel(geo.eps2), geo.force_scale, tol, floor,
+        max_iterations, _THETA_DOWN, _THETA_UP, _THETA_MIN_UP)
+    return u, int(iterations.max(initial=0)), float(residual.max(initial=0.0)), bool(converged.all())
 
 
 def spin_roll_ratio(geometry: ContactSet, u: np.ndarray, n_balls: int) -> np.ndarray:

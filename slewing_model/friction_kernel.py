@@ -42,6 +42,66 @@ _SIGNATURE = ("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
               "f8[:], f8[:], b1, b1)")
 
 
+def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, derivatives, majorant,
+                  gradient, hessian, extra):
+    """Power of contact ``c`` at the ball unknowns ``(u0, u1, u2)``, returned; with
+    ``derivatives`` its gradient (3,) and the upper triangle of its Hessian (3, 3) added to
+    ``gradient`` and ``hessian``, with ``majorant`` that of ``M - H`` to ``extra``.
+    The formulas are those of ``ContactPoints.evaluate`` (:mod:`slewing_model.ball_kinematics`)."""
+    n_across, n_along = g10.shape[1], t2.shape[0]
+    power = 0.0
+    for i in range(n_across):
+        a = g10[c, i] * u0 + g12[c, i] * u1 + (h1[c, i] - u2)
+        s_ = s0[c, i] * u0 + s1[c, i] * u1 + hs[c, i]
+        a2, s2 = a * a, s_ * s_
+        total = 0.0
+        alpha = beta = m0 = m1 = m2 = 0.0
+        for k in range(n_along):
+            speed = math.sqrt(a2 + t2[k] * s2 + e2)
+            w = weight[k, c, i]
+            total += w * speed
+            if derivatives:
+                ws = w / speed                      # w / s
+                alpha += ws
+                beta += ws * t2[k]
+                ws3 = ws / speed / speed            # w / s^3
+                m0 += ws3
+                m1 += ws3 * t2[k]
+                m2 += ws3 * t2[k] * t2[k]
+        power += total
+        if not derivatives:
+            continue
+        ga_0, ga_1 = g10[c, i], g12[c, i]           # GA = (g10, g12, -1), GS = (s0, s1, 0)
+        gs_0, gs_1 = s0[c, i], s1[c, i]
+        grad_a, grad_s = alpha * a, beta * s_       # dD/dA, dD/dS
+        gradient[0] += grad_a * ga_0 + grad_s * gs_0
+        gradient[1] += grad_a * ga_1 + grad_s * gs_1
+        gradient[2] -= grad_a
+        e_aa, e_as, e_ss = m0 * a2, m1 * a * s_, m2 * s2
+        h_aa, h_ss = alpha - e_aa, beta - e_ss
+        # H = h_aa GA GA^T - e_as (GA GS^T + GS GA^T) + h_ss GS GS^T
+        hessian[0, 0] += h_aa * ga_0 * ga_0 - e_as * 2.0 * ga_0 * gs_0 + h_ss * gs_0 * gs_0
+        hessian[0, 1] += h_aa * ga_0 * ga_1 - e_as * (ga_0 * gs_1 + gs_0 * ga_1) + h_ss * gs_0 * gs_1
+        hessian[1, 1] += h_aa * ga_1 * ga_1 - e_as * 2.0 * ga_1 * gs_1 + h_ss * gs_1 * gs_1
+        hessian[0, 2] += e_as * gs_0 - h_aa * ga_0
+        hessian[1, 2] += e_as * gs_1 - h_aa * ga_1
+        hessian[2, 2] += h_aa
+        if majorant:  # M - H = e_aa GA GA^T + e_as (GA GS^T + GS GA^T) + e_ss GS GS^T
+            extra[0, 0] += e_aa * ga_0 * ga_0 + e_as * 2.0 * ga_0 * gs_0 + e_ss * gs_0 * gs_0
+            extra[0, 1] += e_aa * ga_0 * ga_1 + e_as * (ga_0 * gs_1 + gs_0 * ga_1) + e_ss * gs_0 * gs_1
+            extra[1, 1] += e_aa * ga_1 * ga_1 + e_as * 2.0 * ga_1 * gs_1 + e_ss * gs_1 * gs_1
+            extra[0, 2] -= e_aa * ga_0 + e_as * gs_0
+            extra[1, 2] -= e_aa * ga_1 + e_as * gs_1
+            extra[2, 2] += e_aa
+    return power
+
+
+def _symmetrise(matrix):
+    """Copy the upper triangle of a (3, 3) matrix into its lower one."""
+    for r, c in ((1, 0), (2, 0), (2, 1)):
+        matrix[r, c] = matrix[c, r]
+
+
 def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, eps2, derivatives, majorant):
     """Power (B,), gradient (B, 3), Hessian (B, 3, 3) and ``M - H`` (B, 3, 3) of the balls.
 
@@ -50,65 +110,197 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
     ``S = s0 u0 + s1 u1 + hs``; ``weight`` (K, C, I) the quadrature weights times ``mu Q``;
     ``t2`` (K,) the folded ``t^2``; ``eps2`` (C,) the squared regularisation. Without
     ``derivatives`` only the power is summed (the others come back zero), without
-    ``majorant`` ``M - H`` comes back zero. The formulas are those of ``ContactPoints.evaluate``."""
-    n_contacts, n_across = g10.shape
-    n_along = t2.shape[0]
+    ``majorant`` ``M - H`` comes back zero."""
     power = np.zeros(n_balls)
     gradient = np.zeros((n_balls, 3))
     hessian = np.zeros((n_balls, 3, 3))
     extra = np.zeros((n_balls, 3, 3))
-    for c in range(n_contacts):
+    for c in range(g10.shape[0]):
         b = owner[c]
-        u0, u1, u2 = u[b, 0], u[b, 1], u[b, 2]
-        e2 = eps2[c]
-        for i in range(n_across):
-            a = g10[c, i] * u0 + g12[c, i] * u1 + (h1[c, i] - u2)
-            s_ = s0[c, i] * u0 + s1[c, i] * u1 + hs[c, i]
-            a2, s2 = a * a, s_ * s_
-            total = 0.0
-            alpha = beta = m0 = m1 = m2 = 0.0
-            for k in range(n_along):
-                speed = math.sqrt(a2 + t2[k] * s2 + e2)
-                w = weight[k, c, i]
-                total += w * speed
-                if derivatives:
-                    ws = w / speed                      # w / s
-                    alpha += ws
-                    beta += ws * t2[k]
-                    ws3 = ws / speed / speed            # w / s^3
-                    m0 += ws3
-                    m1 += ws3 * t2[k]
-                    m2 += ws3 * t2[k] * t2[k]
-            power[b] += total
-            if not derivatives:
-                continue
-            ga_0, ga_1 = g10[c, i], g12[c, i]           # GA = (g10, g12, -1), GS = (s0, s1, 0)
-            gs_0, gs_1 = s0[c, i], s1[c, i]
-            grad_a, grad_s = alpha * a, beta * s_       # dD/dA, dD/dS
-            gradient[b, 0] += grad_a * ga_0 + grad_s * gs_0
-            gradient[b, 1] += grad_a * ga_1 + grad_s * gs_1
-            gradient[b, 2] -= grad_a
-            e_aa, e_as, e_ss = m0 * a2, m1 * a * s_, m2 * s2
-            h_aa, h_ss = alpha - e_aa, beta - e_ss
-            # H = h_aa GA GA^T - e_as (GA GS^T + GS GA^T) + h_ss GS GS^T
-            hessian[b, 0, 0] += h_aa * ga_0 * ga_0 - e_as * 2.0 * ga_0 * gs_0 + h_ss * gs_0 * gs_0
-            hessian[b, 0, 1] += h_aa * ga_0 * ga_1 - e_as * (ga_0 * gs_1 + gs_0 * ga_1) + h_ss * gs_0 * gs_1
-            hessian[b, 1, 1] += h_aa * ga_1 * ga_1 - e_as * 2.0 * ga_1 * gs_1 + h_ss * gs_1 * gs_1
-            hessian[b, 0, 2] += e_as * gs_0 - h_aa * ga_0
-            hessian[b, 1, 2] += e_as * gs_1 - h_aa * ga_1
-            hessian[b, 2, 2] += h_aa
-            if majorant:  # M - H = e_aa GA GA^T + e_as (GA GS^T + GS GA^T) + e_ss GS GS^T
-                extra[b, 0, 0] += e_aa * ga_0 * ga_0 + e_as * 2.0 * ga_0 * gs_0 + e_ss * gs_0 * gs_0
-                extra[b, 0, 1] += e_aa * ga_0 * ga_1 + e_as * (ga_0 * gs_1 + gs_0 * ga_1) + e_ss * gs_0 * gs_1
-                extra[b, 1, 1] += e_aa * ga_1 * ga_1 + e_as * 2.0 * ga_1 * gs_1 + e_ss * gs_1 * gs_1
-                extra[b, 0, 2] -= e_aa * ga_0 + e_as * gs_0
-                extra[b, 1, 2] -= e_aa * ga_1 + e_as * gs_1
-                extra[b, 2, 2] += e_aa
+        power[b] += _contact_sums(c, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs, weight, t2, eps2[c],
+                                  derivatives, majorant, gradient[b], hessian[b], extra[b])
     for b in range(n_balls):                            # the lower triangles
-        for r, c in ((1, 0), (2, 0), (2, 1)):
-            hessian[b, r, c] = hessian[b, c, r]
-            extra[b, r, c] = extra[b, c, r]
+        _symmetrise(hessian[b])
+        _symmetrise(extra[b])
     return power, gradient, hessian, extra
+
+
+def _solve3(a, rhs, out):
+    """``out = a^-1 rhs`` for a symmetric (3, 3) ``a``: Gaussian elimination with partial
+    pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same). A
+    singular ``a`` (not met) is regularised as ``solve_per_ball`` does: ``a + 1e-13 mean(diag) I``."""
+    m = np.empty((3, 4))
+    shift = 0.0
+    for attempt in range(2):
+        for r in range(3):
+            for c in range(3):
+                m[r, c] = a[r, c]
+            m[r, r] += shift
+            m[r, 3] = rhs[r]
+        singular = False
+        for col in range(3):
+            pivot = col
+            for r in range(col + 1, 3):
+                if abs(m[r, col]) > abs(m[pivot, col]):
+                    pivot = r
+            if m[pivot, col] == 0.0:
+                singular = True
+                break
+            if pivot != col:
+                for c in range(col, 4):
+                    m[col, c], m[pivot, c] = m[pivot, c], m[col, c]
+            for r in range(col + 1, 3):
+                factor = m[r, col] / m[col, col]
+                for c in range(col, 4):
+                    m[r, c] -= factor * m[col, c]
+        if not singular:
+            break
+        shift = 1e-13 * max((a[0, 0] + a[1, 1] + a[2, 2]) / 3.0, 1e-300)
+    for r in range(2, -1, -1):
+        value = m[r, 3]
+        for c in range(r + 1, 3):
+            value -= m[r, c] * out[c]
+        out[r] = value / m[r, r]
+
+
+def _ball_evaluate(u, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, derivatives, majorant,
+                   gradient, hessian, extra):
+    """Power of one ball (its contacts ``c_first .. c_last - 1``), its gradient, Hessian and
+    ``M - H`` written into the given arrays (as :func:`_evaluate_points` for one ball)."""
+    gradient[:] = 0.0
+    hessian[:] = 0.0
+    extra[:] = 0.0
+    power = 0.0
+    for c in range(c_first, c_last):
+        power += _contact_sums(c, u[0], u[1], u[2], g10, g12, h1, s0, s1, hs, weight, t2, eps2[c],
+                               derivatives, majorant, gradient, hessian, extra)
+    _symmetrise(hessian)
+    _symmetrise(extra)
+    return power
+
+
+def _quadratic(g, h, du):
+    """``g . du`` and ``du . h . du``."""
+    slope = curvature = 0.0
+    for r in range(3):
+        slope += g[r] * du[r]
+        for c in range(3):
+            curvature += du[r] * h[r, c] * du[c]
+    return slope, curvature
+
+
+def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_scale, tol, floor,
+                    max_iterations, theta_down, theta_up, theta_min_up):
+    """The minimisation of :func:`slewing_model.ball_kinematics.minimise_power`, ball by ball.
+
+    Ball ``b`` owns the contacts ``first[b] .. first[b + 1] - 1``; the other arguments are
+    those of :func:`_evaluate_points` and of ``minimise_power`` (its damping schedule
+    ``theta_down, theta_up, theta_min_up``). Every ball follows the steps the batched
+    numpy loop takes for it: its iterates depend on its own contacts, ``tol`` and
+    ``floor`` only. Returns the unknowns (B, 3), and per ball the iterations, the force
+    residual (relative to ``force_scale``) at its last evaluation and whether it converged."""
+    n_balls = u.shape[0]
+    out = u.copy()
+    iterations = np.zeros(n_balls, dtype=np.int64)
+    residual = np.zeros(n_balls)
+    converged = np.zeros(n_balls, dtype=np.bool_)
+    x = np.empty(3)
+    g, h, e = np.empty(3), np.empty((3, 3)), np.empty((3, 3))          # at the iterate x
+    g_t, h_t, e_t = np.empty(3), np.empty((3, 3)), np.empty((3, 3))    # at the trial point
+    newton, du, trial, minus_g = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    damped = np.empty((3, 3))
+    for b in range(n_balls):
+        c0, c1 = first[b], first[b + 1]
+        x[:] = out[b]
+        theta = 0.0
+        f = _ball_evaluate(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, False, g, h, e)
+        has_extra = False
+        count = 0
+        while True:
+            minus_g[:] = -g
+            _solve3(h, minus_g, newton)
+            slope, _ = _quadratic(g, h, newton)
+            decrement = -slope
+            if decrement <= tol * (f + floor):           # converged: the last Newton step where it lowers D
+                trial[:] = x + newton
+                if _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False,
+                                  g_t, h_t, e_t) <= f * (1.0 + 1e-12):
+                    x[:] = trial
+                count += 1
+                converged[b] = True
+                break
+            if count >= max_iterations:
+                break
+            count += 1
+            if theta > 0.0:
+                if not has_extra:
+                    f = _ball_evaluate(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, e)
+                    has_extra = True
+                damped[:, :] = h + theta * e
+                _solve3(damped, minus_g, du)
+                slope, curvature = _quadratic(g, h, du)
+                predicted = -(slope + 0.5 * curvature)
+            else:
+                du[:] = newton
+                slope, predicted = -decrement, 0.5 * decrement
+            trial[:] = x + du
+            good = False
+            for _ in range(12):
+                with_extra = theta > 0.0
+                f_t = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, with_extra,
+                                     g_t, h_t, e_t)
+                actual = f - f_t
+                good = actual >= -1e-4 * slope or abs(actual) <= 1e-13 * abs(f)
+                if good:
+                    if actual >= 0.5 * predicted:
+                        theta = theta_down * theta if theta > 1e-3 else 0.0
+                    break
+                if theta >= 1.0:                          # Weiszfeld failed: round-off
+                    break
+                theta = min(1.0, max(theta_up * theta, theta_min_up))
+                if not has_extra:
+                    f = _ball_evaluate(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, e)
+                    has_extra = True
+                damped[:, :] = h + theta * e
+                _solve3(damped, minus_g, du)
+                slope, curvature = _quadratic(g, h, du)
+                predicted = -(slope + 0.5 * curvature)
+                trial[:] = x + du
+            if good:                                      # else no step lowered its power: the ball stays
+                x[:] = trial
+                f = f_t
+                g[:], h[:, :], e[:, :] = g_t, h_t, e_t
+                has_extra = with_extra
+        out[b] = x
+        iterations[b] = count
+        residual[b] = max(abs(g[0]), abs(g[1]), abs(g[2])) / force_scale[b]
+    return out, iterations, residual, converged
+
+
+_MINIMISE_SIGNATURE = ("Tuple((f8[:, :], i8[:], f8[:], b1[:]))("
+                       "f8[:, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :, :], "
+                       "f8[:], f8[:], f8[:], f8, f8, i8, f8, f8, f8)")
+
+
+@functools.lru_cache(maxsize=1)
+def _compiled_helpers() -> None:
+    """Compile the helpers the loops call, in place of their Python definitions.
+
+    numba takes the functions a compiled function calls from the module's globals when it
+    compiles it: they must be compiled functions by then. The Python definitions are used
+    by nothing else (the numpy path is :mod:`slewing_model.ball_kinematics`' own code)."""
+    import numba
+
+    module = globals()
+    for name in ("_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic"):
+        module[name] = numba.njit(cache=True, nogil=True)(module[name])
+
+
+def _compile(function, signature):
+    import numba
+
+    _compiled_helpers()
+    return numba.njit(signature, cache=True, nogil=True)(function)
 
 
 @functools.lru_cache(maxsize=1)
@@ -118,9 +310,13 @@ def compiled_evaluate_points():
     The first call compiles (about a second) or loads it from the cache;
     :class:`slewing_model.simulator.BearingSimulator` makes that call when it is built, so
     that it lands in the FMU's instantiation and never in a step."""
-    import numba
+    return _compile(_evaluate_points, _SIGNATURE)
 
-    return numba.njit(_SIGNATURE, cache=True, nogil=True)(_evaluate_points)
+
+@functools.lru_cache(maxsize=1)
+def compiled_minimise_balls():
+    """The compiled :func:`_minimise_balls` (as :func:`compiled_evaluate_points`)."""
+    return _compile(_minimise_balls, _MINIMISE_SIGNATURE)
 
 
 _COEFFICIENT_SIGNATURE = ("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], b1[:], f8[:], "
@@ -165,6 +361,4 @@ def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, len
 @functools.lru_cache(maxsize=1)
 def compiled_point_coefficients():
     """The compiled :func:`_point_coefficients` (as :func:`compiled_evaluate_points`)."""
-    import numba
-
-    return numba.njit(_COEFFICIENT_SIGNATURE, cache=True, nogil=True)(_point_coefficients)
+    return _compile(_point_coefficients, _COEFFICIENT_SIGNATURE)

@@ -19,7 +19,9 @@ import numpy as np
 from .bime import BimeSolver, LoadDistribution, Loads
 from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
-from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE, compiled_evaluate_points, compiled_point_coefficients
+from .friction_kernel import (
+    AVAILABLE as COMPILED_AVAILABLE, compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients,
+)
 from .geometry import Bearing
 from .reduced_operator import ReducedOperator
 
@@ -172,6 +174,7 @@ class BearingSimulator:
         if s.friction_kernel != "numpy" and COMPILED_AVAILABLE:
             compiled_evaluate_points()     # compiled (or loaded from numba's cache) now, not in a step
             compiled_point_coefficients()
+            compiled_minimise_balls()
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step

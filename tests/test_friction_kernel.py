@@ -88,6 +88,29 @@ def test_compiled_torque_equals_the_numpy_torque(case):
     assert warm["compiled"].magnitude == pytest.approx(warm["numpy"].magnitude, rel=1e-12)
 
 
+@needs_numba
+@pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
+def test_compiled_steps_equal_the_numpy_steps(name):
+    # the co-simulation's steps, warm-started from each other: the compiled minimisation (ball by
+    # ball) takes the steps the numpy loop (batched) takes, so the torques agree to round-off
+    import sys
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from cases import CASES
+    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.superelement import build_superelement
+
+    case = CASES[name](25)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    sims = {k: BearingSimulator(bearing, superelement, SimulatorSettings(
+        ring_model="flexible", load_frame="rotating" if case.parameters["load_frame"] == 2 else "fixed",
+        friction_kernel=k)) for k in ("numpy", "compiled")}
+    for k in range(case.steps):
+        out = {kernel: sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for kernel, sim in sims.items()}
+        assert out["compiled"].friction_torque == pytest.approx(out["numpy"].friction_torque, rel=1e-10), k
+        assert np.allclose(sims["compiled"]._friction_warm, sims["numpy"]._friction_warm, rtol=1e-8, atol=1e-12), k
+
+
 def test_unknown_kernel_is_refused():
     bearing, distribution = _distributions()[0]
     with pytest.raises(ValueError, match="kernel = 'fortran'"):
