@@ -64,6 +64,10 @@ from .ring_compliance import contact_compliance, ring_compliances, ring_selector
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
 #: residual by less than this factor (benchmarks/bench_flexible.py measured the choice)
 REFRESH = 0.25
+#: ... unless, at the rate of that iteration, the residual reaches the tolerance within this many
+#: more iterations, which cost less than a new operator (measured on the pitch bearing: 3 of
+#: 0.1 ms against one operator of 4 ms; docs/speed.md)
+FINISH_ITERATIONS = 3
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
 
@@ -287,6 +291,9 @@ class BimeSolver:
                 # a fresh reduced operator on the first iteration of a cold solve and whenever
                 # the residual fell by less than a factor 4 in the last iteration
                 fresh = last_residual is None or residual > REFRESH * last_residual
+                if fresh and last_residual is not None and residual < last_residual:
+                    # slow, but the iterations this rate still needs are few: they cost less than a new operator
+                    fresh = math.log(self.rtol / residual) < FINISH_ITERATIONS * math.log(residual / last_residual)
                 last_residual = residual
                 dq, dy = self._flexible_direction(point, f_scaled, mu, fresh)
                 m_dy = self.compliance @ dy       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
