@@ -70,8 +70,10 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         (tmp / "bearing.json").write_text(json.dumps(bearing.to_dict()))
         superelement.save(tmp / "superelement.npz")
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
-            return _build_fmi3(output, [package, tmp / "bearing.json", tmp / "superelement.npz",
-                                        ROOT / "fmu_src" / "bearing_variables.py"])
+            built = _build_fmi3(output, [package, tmp / "bearing.json", tmp / "superelement.npz",
+                                         ROOT / "fmu_src" / "bearing_variables.py"])
+            ship_compiled_kernels(built)
+            return built
         built = FmuBuilder.build_FMU(
             ROOT / "fmu_src" / "SlewingBearing.py", dest=output,
             project_files=[package, tmp / "bearing.json", tmp / "superelement.npz",
@@ -80,7 +82,34 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
             needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
         )
     install_python_shim(built, "SlewingBearing", fmi_version=2)
+    ship_compiled_kernels(built)
     return Path(built)
+
+
+def ship_compiled_kernels(fmu) -> list[Path]:
+    """Add numba's cache of the friction loops to the FMU's copy of ``slewing_model``.
+
+    An instance compiles the loops when it starts (:func:`slewing_model.friction_kernel.compile_all`),
+    about ten seconds, unless numba's cache beside the source holds them: numba keys that cache
+    by the source's content (not its path or time), so the entries made here are valid in any
+    folder the FMU is unpacked to, on this machine (another CPU compiles them anew, once per
+    unpacked folder). Compiles (or loads) the loops here, in ``slewing_model/__pycache__``, and
+    adds the entry points' files to ``resources/slewing_model/__pycache__`` (pythonfmu leaves
+    ``__pycache__`` folders out); nothing when numba is not installed (the FMU then runs its
+    numpy code). Returns the files added."""
+    from slewing_model import friction_kernel
+
+    if not friction_kernel.AVAILABLE:
+        return []
+    friction_kernel.compile_all()
+    cache = Path(friction_kernel.__file__).parent / "__pycache__"
+    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
+    files = [f for _, function in friction_kernel.KERNELS
+             for f in cache.glob(f"friction_kernel.{function.__name__}-{function.__code__.co_firstlineno}.{tag}.*")]
+    with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive:
+        for f in files:
+            archive.write(f, f"resources/slewing_model/__pycache__/{f.name}")
+    return files
 
 
 def _build_fmi3(output: Path, project_files) -> Path:

@@ -13,9 +13,10 @@ array operations done twice a step (the rule the balls are solved on and the tor
 numba is optional (it is not part of the FMU's run-time requirements): without it
 :data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
 results to round-off (``tests/test_friction_kernel.py``). The loops are compiled when first
-asked for (:func:`compiled_evaluate_points`, :func:`compiled_point_coefficients`), which the
-simulator does when it is built, so that the compile time lands in the FMU's instantiation,
-never in a step.
+asked for (:func:`compile_all`), which the simulator does when it is built, so that the compile
+time lands in the FMU's instantiation, never in a step. Compiling takes about ten seconds;
+numba's on-disk cache (``__pycache__`` beside this file, keyed by the source's content) makes it
+a fraction of a second after the first time, and ``build_fmu.py`` ships that cache in the FMU.
 """
 from __future__ import annotations
 
@@ -362,3 +363,14 @@ def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, len
 def compiled_point_coefficients():
     """The compiled :func:`_point_coefficients` (as :func:`compiled_evaluate_points`)."""
     return _compile(_point_coefficients, _COEFFICIENT_SIGNATURE)
+
+
+#: the compiled loops' factories and the Python functions they compile
+KERNELS = ((compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
+           (compiled_minimise_balls, _minimise_balls))
+
+
+def compile_all() -> None:
+    """Compile the loops, or load them from numba's cache (what an FMU instance does when it starts)."""
+    for factory, _ in KERNELS:
+        factory()

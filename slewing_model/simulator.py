@@ -19,9 +19,7 @@ import numpy as np
 from .bime import BimeSolver, LoadDistribution, Loads
 from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
-from .friction_kernel import (
-    AVAILABLE as COMPILED_AVAILABLE, compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients,
-)
+from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE, compile_all
 from .geometry import Bearing
 from .reduced_operator import ReducedOperator
 
@@ -172,9 +170,7 @@ class BearingSimulator:
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
                                  rtol=s.tolerance)
         if s.friction_kernel != "numpy" and COMPILED_AVAILABLE:
-            compiled_evaluate_points()     # compiled (or loaded from numba's cache) now, not in a step
-            compiled_point_coefficients()
-            compiled_minimise_balls()
+            compile_all()     # compiled (or loaded from numba's cache) now, not in a step
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step

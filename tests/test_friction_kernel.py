@@ -145,6 +145,32 @@ print(json.dumps({"available": AVAILABLE, "torque": friction_torque(b, d).magnit
     assert there["torque"] == pytest.approx(here, rel=1e-12)
 
 
+@needs_numba
+def test_fmu_ships_its_compiled_loops(table3_fmu):
+    # unpacked to a new folder, an instance loads the loops from the cache the FMU carries
+    # (numba keys it by the source's content): no compilation at instantiation
+    out = subprocess.run([sys.executable, "-c", f"""
+import json, sys
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+md = read_model_description({str(table3_fmu)!r})
+folder = extract({str(table3_fmu)!r})
+fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
+                instanceName="cache")
+fmu.instantiate()
+kernel = sys.modules["slewing_model.friction_kernel"]
+stats = [f().stats for f, _ in kernel.KERNELS]
+print(json.dumps({{"inside": kernel.__file__.startswith(str(folder)), "hits": [sum(s.cache_hits.values()) for s in stats],
+                   "misses": [sum(s.cache_misses.values()) for s in stats]}}))
+fmu.terminate()
+fmu.freeInstance()
+"""], capture_output=True, text=True, cwd="/", timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    assert result["inside"]                             # the FMU's own copy of the library
+    assert result["misses"] == [0, 0, 0] and all(h >= 1 for h in result["hits"]), result
+
+
 def test_fmu_without_numba_gives_the_same_outputs(table3_fmu):
     from fmpy import simulate_fmu
 
