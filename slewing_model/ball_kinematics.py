@@ -23,7 +23,9 @@ import numpy as np
 
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
-from .friction_kernel import compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients
+from .friction_kernel import (
+    compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
+)
 from .geometry import RING_CONTACTS, Bearing
 
 #: sign of the (r, z) components of the contact normals of contacts 1..4
@@ -403,7 +405,13 @@ class ContactPoints:
 
     def tractions(self, u: np.ndarray):
         """Dissipated power (W) and torque on the moving ring about +z (N m) of
-        every contact, at the final regularisation."""
+        every contact, at the final regularisation (with ``compiled``: one compiled loop,
+        :func:`slewing_model.friction_kernel.compiled_tractions`)."""
+        geo = self.geometry
+        if self.compiled:
+            return compiled_tractions()(np.ascontiguousarray(u, dtype=float), geo.owner, self.g10, self.g12, self.h1,
+                                        self.s0, self.s1, self.hs, self.weight, self.t2, np.ravel(geo.eps2),
+                                        self.arm1, self.arm2)
         a, s_ = self.velocity(u)
         a2, s2 = a * a, s_ * s_
         s = self._speed(a2, s2, self.geometry.eps2)

@@ -278,6 +278,32 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     return out, iterations, residual, converged
 
 
+def _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, t2, eps2, arm1, arm2):
+    """Dissipated power (C,) and torque on the moving ring (C,) of every contact: the sums of
+    ``ContactPoints.tractions`` (:mod:`slewing_model.ball_kinematics`), whose formulas they are."""
+    n_contacts, n_across = g10.shape
+    power = np.zeros(n_contacts)
+    torque = np.zeros(n_contacts)
+    for c in range(n_contacts):
+        b = owner[c]
+        for i in range(n_across):
+            a = g10[c, i] * u[b, 0] + g12[c, i] * u[b, 1] + (h1[c, i] - u[b, 2])
+            s_ = s0[c, i] * u[b, 0] + s1[c, i] * u[b, 1] + hs[c, i]
+            alpha = beta = 0.0
+            for k in range(t2.shape[0]):
+                ws = weight[k, c, i] / math.sqrt(a * a + t2[k] * s_ * s_ + eps2[c])
+                alpha += ws
+                beta += ws * t2[k]
+            ga, gs = alpha * a, beta * s_
+            power[c] += ga * a + gs * s_
+            torque[c] -= ga * arm1[c, i] + gs * arm2[c, i]   # the traction on the ring is minus that on the ball
+    return power, torque
+
+
+_TRACTIONS_SIGNATURE = ("UniTuple(f8[:], 2)(f8[:, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], "
+                        "f8[:, :], f8[:, :, :], f8[:], f8[:], f8[:, :], f8[:, :])")
+
+
 _MINIMISE_SIGNATURE = ("Tuple((f8[:, :], i8[:], f8[:], b1[:]))("
                        "f8[:, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :, :], "
                        "f8[:], f8[:], f8[:], f8, f8, i8, f8, f8, f8)")
@@ -312,6 +338,12 @@ def compiled_evaluate_points():
     :class:`slewing_model.simulator.BearingSimulator` makes that call when it is built, so
     that it lands in the FMU's instantiation and never in a step."""
     return _compile(_evaluate_points, _SIGNATURE)
+
+
+@functools.lru_cache(maxsize=1)
+def compiled_tractions():
+    """The compiled :func:`_tractions` (as :func:`compiled_evaluate_points`)."""
+    return _compile(_tractions, _TRACTIONS_SIGNATURE)
 
 
 @functools.lru_cache(maxsize=1)
@@ -367,7 +399,7 @@ def compiled_point_coefficients():
 
 #: the compiled loops' factories and the Python functions they compile
 KERNELS = ((compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
-           (compiled_minimise_balls, _minimise_balls))
+           (compiled_minimise_balls, _minimise_balls), (compiled_tractions, _tractions))
 
 
 def compile_all() -> None:

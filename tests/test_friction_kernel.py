@@ -66,6 +66,9 @@ def test_compiled_sums_equal_the_numpy_sums(case, quadrature):
             assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * scale), name
         power_only = compiled.evaluate(u, geometry.eps2, derivatives=False)
         assert power_only[1] is None and np.allclose(power_only[0], want[0], rtol=1e-12)
+        # each contact's power and torque on the moving ring (the torque's sign changes across the contacts)
+        for name, a, b in zip(("power", "torque"), compiled.tractions(u), numpy_path.tractions(u)):
+            assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * np.abs(b).max()), name
     # a subset of the balls (the stragglers' path) keeps the compiled loop
     balls = np.arange(0, geometry.active.size, 3)
     sub_np, sub_c = numpy_path.subset(balls), compiled.subset(balls)
@@ -168,7 +171,7 @@ fmu.freeInstance()
     assert out.returncode == 0, out.stderr[-2000:]
     result = json.loads(out.stdout.strip().splitlines()[-1])
     assert result["inside"]                             # the FMU's own copy of the library
-    assert result["misses"] == [0, 0, 0] and all(h >= 1 for h in result["hits"]), result
+    assert not any(result["misses"]) and all(h >= 1 for h in result["hits"]), result
 
 
 def test_fmu_without_numba_gives_the_same_outputs(table3_fmu):
