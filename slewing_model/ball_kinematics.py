@@ -497,9 +497,7 @@ def minimise_power(contacts: ContactPoints, u: np.ndarray, tol: float, max_itera
     n, m = u.shape
     scale = contacts.geometry.force_scale
     if contacts.compiled and theta is None:
-        if floor is None:
-            floor = float(contacts.evaluate(u, eps2, derivatives=False)[0].mean())
-        return _minimise_compiled(contacts, u, tol, max_iterations, floor)
+        return _minimise_compiled(contacts, u, tol, max_iterations, -1.0 if floor is None else floor)
     theta = np.zeros(n) if theta is None else np.array(theta, dtype=float)
     f, g, h, extra = contacts.evaluate(u, eps2, majorant=bool(np.any(theta)))
     share = f.mean() if floor is None else floor            # fixed: each ball's iterates are its own
@@ -570,7 +568,8 @@ def minimise_power(contacts: ContactPoints, u: np.ndarray, tol: float, max_itera
 
 def _minimise_compiled(contacts: ContactPoints, u: np.ndarray, tol: float, max_iterations: int, floor: float):
     """:func:`minimise_power` ball by ball in one compiled loop
-    (:func:`slewing_model.friction_kernel.compiled_minimise_balls`): the same steps."""
+    (:func:`slewing_model.friction_kernel.compiled_minimise_balls`): the same steps
+    (``floor < 0``: the mean power at ``u``, as the numpy loop takes it)."""
     geo = contacts.geometry
     first = np.searchsorted(geo.owner, np.arange(u.shape[0] + 1))      # contacts are ordered by ball
     u, iterations, residual, converged = compiled_minimise_balls()(

@@ -198,7 +198,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     those of :func:`_evaluate_points` and of ``minimise_power`` (its damping schedule
     ``theta_down, theta_up, theta_min_up``). Every ball follows the steps the batched
     numpy loop takes for it: its iterates depend on its own contacts, ``tol`` and
-    ``floor`` only. Returns the unknowns (B, 3), and per ball the iterations, the force
+    ``floor`` only (``floor < 0``: the mean power per ball at ``u``). Returns the unknowns (B, 3), and per ball the iterations, the force
     residual (relative to ``force_scale``) at its last evaluation and whether it converged."""
     n_balls = u.shape[0]
     out = u.copy()
@@ -210,6 +210,12 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     g_t, h_t, e_t = np.empty(3), np.empty((3, 3)), np.empty((3, 3))    # at the trial point
     newton, du, trial, minus_g = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     damped = np.empty((3, 3))
+    if floor < 0.0:
+        total = 0.0
+        for b in range(n_balls):
+            total += _ball_evaluate(out[b], first[b], first[b + 1], g10, g12, h1, s0, s1, hs, weight, t2, eps2,
+                                    False, False, g, h, e)
+        floor = total / max(n_balls, 1)
     for b in range(n_balls):
         c0, c1 = first[b], first[b + 1]
         x[:] = out[b]
