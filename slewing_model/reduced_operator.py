@@ -156,10 +156,12 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     if int((~keep).sum() + added.sum()) > 0.25 * rows.size:
         return None
     kept_rows = old_rows[keep]
-    if not keep.all():  # drop the contacts that opened
-        q_mat = w_inv[:, ~keep]
-        w_inv = _move_block(w_inv - q_mat @ np.linalg.solve(q_mat[~keep], q_mat.T), np.flatnonzero(keep),
-                            np.arange(kept_rows.size), kept_rows.size)
+    if not keep.all():  # drop the contacts that opened: the kept block, less a rank-r correction
+        kept, dropped = np.flatnonzero(keep), np.flatnonzero(~keep)
+        q_mat = w_inv.take(dropped, axis=1)
+        q_kept = q_mat[kept]
+        w_inv = w_inv.take(kept, axis=0).take(kept, axis=1)
+        w_inv -= q_kept @ np.linalg.solve(q_mat[dropped], q_kept.T)
     a_inv = op.contact_compliance[keep[::2]]
     if added.any():  # border with the contacts that closed
         new_rows = rows[added]

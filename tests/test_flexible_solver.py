@@ -170,3 +170,35 @@ def test_inverse_by_halves_is_as_exact_as_lapack():
         assert np.array_equal(halves, halves.T)
         assert np.abs(halves @ w - eye).max() <= 10.0 * max(np.abs(lapack @ w - eye).max(), 1e-12)
         assert np.abs(halves - lapack).max() <= 1e-8 * np.abs(lapack).max()
+
+
+def test_operator_updated_for_other_contacts_equals_a_fresh_one(bearing):
+    """Contacts opening and closing (the active-set updates of the kept inverse: rows dropped
+    by a rank-r correction of the kept block, rows added by bordering) give the inverse that
+    forming and inverting the operator on the new contacts gives, at the same iterate."""
+    from slewing_model.reduced_operator import assemble_operator, update_operator
+
+    loads = LOADS[1]
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    result = solver.solve(loads)
+    point = solver._evaluate(result.state[:5], result.state[5:], solver._scaled_load(loads))
+    loaded = np.flatnonzero((point.delta > 0.0).ravel())
+    assert loaded.size > 12
+    mu = 1e-12 * solver.reference_stiffness
+
+    def operator(diagonals, op=None):
+        active = np.zeros(point.delta.size, dtype=bool)
+        active[diagonals] = True
+        rows = np.flatnonzero(np.repeat(active, 2))
+        args = (point, solver.compliance, solver.assembly.stiffness, solver.jacobian, rows, active, mu)
+        return assemble_operator(*args) if op is None else update_operator(op, *args)
+
+    for before, after in ((loaded, loaded[3:]),                                   # three open
+                          (loaded[[0, 2] + list(range(5, loaded.size))], loaded),  # three close
+                          (np.delete(loaded, [1, 7]), np.delete(loaded, [4, 9, 10]))):  # both
+        updated = operator(after, operator(before))
+        fresh = operator(after)
+        assert np.array_equal(updated.rows, fresh.rows)
+        scale = np.abs(fresh.inverse).max()
+        assert np.abs(updated.inverse - fresh.inverse).max() <= 1e-9 * scale
+        assert np.allclose(updated.schur_inverse, fresh.schur_inverse, rtol=1e-8)
