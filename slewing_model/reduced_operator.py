@@ -148,7 +148,8 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     Dropping rows: ``(W_kk)^-1 = P - Q S^-1 Q^T`` from the blocks of the old
     inverse; adding rows (bordering): with ``X = W_kk^-1 B`` and the Schur
     complement ``C - B^T X``. O(n^2 r) instead of O(n^3) for r changed rows.
-    The kept rows and columns move as slices (:func:`_move_block`).
+    Dropping takes the kept block first (``take``) and corrects it in place; adding
+    moves the kept rows and columns to their new places as slices (:func:`_move_block`).
     Returns None (rebuild) when many contacts changed."""
     old_rows, w_inv = op.rows, op.inverse
     keep = np.isin(old_rows, rows)
