@@ -22,6 +22,7 @@ ball file
 from __future__ import annotations
 
 import csv
+import functools
 import math
 import os
 from dataclasses import dataclass
@@ -59,14 +60,30 @@ class RingErrorMap:
         """Periodic linear interpolation at ring angles ``theta`` (rad, shape (B,)).
 
         Returns radial (B, 2), axial (B, 2) and groove radius (B, 2) or None."""
-        theta = np.asarray(theta, dtype=float)
+        x = np.asarray(theta, dtype=float) % (2.0 * np.pi)
+        angle, columns = self._periodic_table
+        values = [np.interp(x, angle, column) for column in columns]
+        rc = None if self.groove_radius is None else np.stack(values[4:], axis=1)
+        return np.stack(values[:2], axis=1), np.stack(values[2:4], axis=1), rc
 
-        def interp(values):
-            return np.stack([np.interp(theta, self.angle, values[:, k], period=2.0 * np.pi)
-                             for k in range(2)], axis=1)
-
-        rc = None if self.groove_radius is None else interp(self.groove_radius)
-        return interp(self.radial), interp(self.axial), rc
+    @functools.cached_property
+    def _periodic_table(self):
+        """The table sorted and closed over one period, as ``np.interp(..., period=2 pi)``
+        builds it on every call (the same arithmetic, so the same values): the angles, and
+        the columns radial 1, 2, axial 1, 2 (and groove radius 1, 2). Built once: the run
+        time calls :meth:`at` every step."""
+        period = 2.0 * np.pi
+        xp = self.angle % period
+        order = np.argsort(xp)
+        xp = xp[order]
+        angle = np.concatenate((xp[-1:] - period, xp, xp[0:1] + period))
+        tables = [self.radial, self.axial] + ([] if self.groove_radius is None else [self.groove_radius])
+        columns = []
+        for table in tables:
+            for k in range(2):
+                fp = np.asarray(table[:, k], dtype=float)[order]
+                columns.append(np.concatenate((fp[-1:], fp, fp[0:1])))
+        return angle, columns
 
     def to_dict(self) -> dict:
         return {

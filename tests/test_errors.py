@@ -22,6 +22,19 @@ def test_interpolation_is_linear_and_periodic():
     assert np.allclose(radial[:, 0], [1.5e-6, 2.5e-6, 1.5e-6, 2.5e-6])
 
 
+def test_interpolation_of_an_unsorted_table_across_zero():
+    # the table in any order and past 360 deg; between 350 and 370 (= 10) deg the values blend linearly
+    theta = np.radians([370.0, 100.0, 350.0, 200.0])
+    radial = np.column_stack([[1e-6, 5e-6, 3e-6, 7e-6], [0.0, 1e-6, 0.0, 1e-6]])
+    axial = -radial
+    groove = 1e-3 + radial
+    m = RingErrorMap(theta, radial, axial, groove)
+    r, a, g = m.at(np.radians([0.0, 355.0, -5.0, 720.0 + 150.0]))
+    assert np.allclose(r[:, 0], [2e-6, 2.5e-6, 2.5e-6, 6e-6], rtol=1e-12)
+    assert np.allclose(a[:, 0], -r[:, 0]) and np.allclose(g[:, 0], 1e-3 + r[:, 0])
+    assert np.allclose(r[:, 1], [0.0, 0.0, 0.0, 1e-6], atol=1e-18)
+
+
 def test_ring_csv_round_trip(tmp_path):
     errors = synthetic_errors(10, seed=3, groove_radius_amplitude=2e-6, nominal_groove_radius=[0.01325] * 4)
     path = tmp_path / "outer.csv"
