@@ -7,7 +7,8 @@ force along the rolling direction vanish where the dissipated power
 (the Jones / Leblanc-Nelias line of models, paper refs [17-20]). :class:`ContactSet` holds
 the loaded contacts of a load distribution, :class:`ContactPoints` the sliding velocities
 at the points of one quadrature rule, and :func:`minimise_power` solves all balls at once
-(batched Newton / Weiszfeld iterations); two and four loaded contacts are the same
+(batched Newton / Weiszfeld iterations; with numba, ball by ball in a compiled loop that
+takes the same steps); two and four loaded contacts are the same
 equations. :mod:`slewing_model.friction` turns the result into the bearing's torque.
 
 Run-time module: numpy and the standard library (numba where installed, through

@@ -27,9 +27,10 @@ The model, one module per idea:
    normal loads these are the stationarity conditions of the dissipated power
    ``D = sum integral mu p |v_s| dA``, a convex function of the unknowns: the
    ball moves so as to dissipate the least power. All balls are solved at once;
-   two and four loaded contacts are the same equations. The sums over the
-   quadrature points run as one compiled loop where numba is installed
-   (:mod:`slewing_model.friction_kernel`).
+   two and four loaded contacts are the same equations. Where numba is
+   installed the points' set-up, the minimisation (ball by ball) and the
+   torque's sums run as compiled loops (:mod:`slewing_model.friction_kernel`),
+   with the same results.
 4. **Bearing torque** (this module, :func:`friction_torque`): the dissipated
    power over the ring speed, plus a load-independent seal part. It equals the
    moment about z of the friction tractions on the moving ring's contacts at the
@@ -279,11 +280,11 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
         error (~1e-3).
     max_iterations : int
     kernel : {"auto", "numpy", "compiled"}
-        How the power and its derivatives are summed over the quadrature points:
-        numpy array operations, or one compiled loop
+        How the points are set up, the balls' equilibrium solved and the torque
+        summed: numpy array operations, or compiled loops
         (:mod:`slewing_model.friction_kernel`, needs numba); "auto" takes the
-        compiled loop where numba is installed. Both give the same results to
-        round-off.
+        compiled loops where numba is installed. Both take the same steps and
+        give the same results to round-off (torques to 1e-10 in the tests).
 
     Returns
     -------

@@ -71,8 +71,8 @@ class SimulatorSettings:
         step's matrices have a few hundred rows, and a second thread that spins while
         other processes share the cores makes steps several times slower.
     friction_kernel : {"auto", "numpy", "compiled"}
-        How the friction model sums over its quadrature points (``kernel`` of
-        :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loop
+        How the friction model runs its loops over points and balls (``kernel`` of
+        :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loops
         where numba is installed, numpy otherwise; the results are the same to round-off.
     """
 
