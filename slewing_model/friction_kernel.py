@@ -190,6 +190,20 @@ def _quadratic(g, h, du):
     return slope, curvature
 
 
+def _damped_step(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta, has_extra, f, g, h, extra,
+                 minus_g, damped, du):
+    """The damped step ``du = -(H + theta (M - H))^-1 g`` of one ball at ``x`` into ``du``,
+    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra``;
+    returns the power at ``x``, the slope ``g . du`` and the decrease the quadratic model
+    predicts, ``-(g . du + du . H du / 2)``."""
+    if not has_extra:
+        f = _ball_evaluate(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, extra)
+    damped[:, :] = h + theta * extra
+    _solve3(damped, minus_g, du)
+    slope, curvature = _quadratic(g, h, du)
+    return f, slope, -(slope + 0.5 * curvature)
+
+
 def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_scale, tol, floor,
                     max_iterations, theta_down, theta_up, theta_min_up):
     """The minimisation of :func:`slewing_model.ball_kinematics.minimise_power`, ball by ball.
@@ -240,13 +254,9 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
                 break
             count += 1
             if theta > 0.0:
-                if not has_extra:
-                    f = _ball_evaluate(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, e)
-                    has_extra = True
-                damped[:, :] = h + theta * e
-                _solve3(damped, minus_g, du)
-                slope, curvature = _quadratic(g, h, du)
-                predicted = -(slope + 0.5 * curvature)
+                f, slope, predicted = _damped_step(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta,
+                                                   has_extra, f, g, h, e, minus_g, damped, du)
+                has_extra = True
             else:
                 du[:] = newton
                 slope, predicted = -decrement, 0.5 * decrement
@@ -265,13 +275,9 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
                 if theta >= 1.0:                          # Weiszfeld failed: round-off
                     break
                 theta = min(1.0, max(theta_up * theta, theta_min_up))
-                if not has_extra:
-                    f = _ball_evaluate(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, e)
-                    has_extra = True
-                damped[:, :] = h + theta * e
-                _solve3(damped, minus_g, du)
-                slope, curvature = _quadratic(g, h, du)
-                predicted = -(slope + 0.5 * curvature)
+                f, slope, predicted = _damped_step(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta,
+                                                   has_extra, f, g, h, e, minus_g, damped, du)
+                has_extra = True
                 trial[:] = x + du
             if good:                                      # else no step lowered its power: the ball stays
                 x[:] = trial
@@ -325,7 +331,7 @@ def _compiled_helpers() -> None:
     import numba
 
     module = globals()
-    for name in ("_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic"):
+    for name in ("_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step"):
         module[name] = numba.njit(cache=True, nogil=True)(module[name])
 
 
