@@ -152,8 +152,9 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     moves the kept rows and columns to their new places as slices (:func:`_move_block`).
     Returns None (rebuild) when many contacts changed."""
     old_rows, w_inv = op.rows, op.inverse
-    keep = np.isin(old_rows, rows)
-    added = ~np.isin(rows, old_rows)
+    size = max(int(old_rows[-1]), int(rows[-1])) + 1 if old_rows.size and rows.size else 0
+    keep = _member(old_rows, rows, size)
+    added = ~_member(rows, old_rows, size)
     if int((~keep).sum() + added.sum()) > 0.25 * rows.size:
         return None
     kept_rows = old_rows[keep]
@@ -200,6 +201,14 @@ def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
     y_new = np.zeros_like(point.y)
     y_new[op.rows] = w_vec + op.coupling @ dq
     return dq, y_new
+
+
+def _member(values: np.ndarray, of: np.ndarray, size: int) -> np.ndarray:
+    """``np.isin(values, of)`` for row numbers below ``size``, by a mask (np.isin sorts:
+    ten times slower on a few hundred rows)."""
+    mask = np.zeros(size, dtype=bool)
+    mask[of] = True
+    return mask[values]
 
 
 def _move_block(source: np.ndarray, rows: np.ndarray, places: np.ndarray, size: int) -> np.ndarray:
