@@ -65,8 +65,8 @@ from .ring_compliance import contact_compliance, ring_compliances, ring_selector
 #: residual by less than this factor (benchmarks/bench_flexible.py measured the choice)
 REFRESH = 0.25
 #: ... unless, at the rate of that iteration, the residual reaches the tolerance within this many
-#: more iterations, which cost less than a new operator (measured on the pitch bearing: 3 of
-#: 0.1 ms against one operator of 4 ms; docs/speed.md)
+#: more iterations, which cost less than a new operator (pitch bearing: 3 of 0.1 ms against
+#: one operator of 2.5 ms, 4 ms when this was measured; docs/speed.md)
 FINISH_ITERATIONS = 3
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
