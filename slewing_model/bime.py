@@ -58,7 +58,7 @@ from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the erro
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
 from .geometry import RING_CONTACTS, Bearing
-from .reduced_operator import assemble_operator, newton_step, reduced_operator, update_operator
+from .reduced_operator import assemble_operator, newton_step, turned_operator, update_operator
 from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
 
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
@@ -371,9 +371,8 @@ class BimeSolver:
         if not fresh and op is not None and not np.array_equal(op.rows, rows):
             op = update_operator(op, p, self.compliance, stiffness, self.jacobian, rows, active, mu)
         if not fresh and op is not None and not np.array_equal(op.jacobian, self.jacobian.reshape(-1, 5)[rows]):
-            # the ring turned since (set_rotation): W^-1 holds (the rings are axisymmetric and
-            # the balls keep their spacing), the coupling to (X, Y, Z, rx, ry) is rebuilt
-            op = reduced_operator(rows, active, op.contact_compliance, op.inverse, self.jacobian, mu)
+            # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
+            op = turned_operator(op, self.jacobian, rows, active, mu)
         if fresh or op is None:
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)
         self._reduced = op

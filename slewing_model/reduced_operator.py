@@ -87,6 +87,27 @@ def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.nda
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
 
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu) -> ReducedOperator:
+    """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
+
+    ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
+    ``W^-1 J_a`` follows the Jacobian. Where every ball keeps its groove centres (no
+    manufacturing errors) turning the balls by an angle only mixes the Jacobian's columns,
+    ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
+    ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``. ``T`` is
+    fitted by least squares and used where it reproduces ``J_new`` to 1e-12; otherwise (errors
+    move the groove centres with the ring) the coupling is formed anew."""
+    ja = jacobian.reshape(-1, 5)[rows]
+    if op.jacobian.shape == ja.shape:
+        old = op.jacobian
+        turn = np.linalg.solve(old.T @ old, old.T @ ja)
+        if np.abs(old @ turn - ja).max() <= 1e-12 * np.abs(ja).max():
+            coupling = op.coupling @ turn
+            return ReducedOperator(rows, active, op.contact_compliance, op.inverse, ja, coupling,
+                                   np.linalg.inv(ja.T @ coupling + mu * np.eye(5)))
+    return reduced_operator(rows, active, op.contact_compliance, op.inverse, jacobian, mu)
+
+
 def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
     """Add the 2x2 ``blocks`` (k, 2, 2) on the diagonal of ``matrix`` (2k, 2k), in place."""
     first = np.arange(0, 2 * blocks.shape[0], 2)

@@ -202,3 +202,29 @@ def test_operator_updated_for_other_contacts_equals_a_fresh_one(bearing):
         scale = np.abs(fresh.inverse).max()
         assert np.abs(updated.inverse - fresh.inverse).max() <= 1e-9 * scale
         assert np.allclose(updated.schur_inverse, fresh.schur_inverse, rtol=1e-8)
+
+
+@pytest.mark.parametrize("with_errors", [False, True])
+def test_operator_after_a_turn_equals_one_formed_anew(bearing, with_errors):
+    """After the ring turns, the kept operator's coupling to the ring's motions follows the
+    Jacobian: for balls that keep their groove centres by a 5 x 5 column turn (eq 23), else
+    (manufacturing errors move the groove centres with the ring) formed anew; either way as
+    forming it from the new Jacobian."""
+    from slewing_model.errors import synthetic_errors
+    from slewing_model.reduced_operator import reduced_operator, turned_operator
+
+    if with_errors:
+        bearing = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=2))
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    solver.solve(LOADS[1])
+    op, mu = solver._reduced, 1e-12 * solver.reference_stiffness
+    solver.set_rotation(0.3)
+    # which way: without errors the new Jacobian is the old one with its columns turned
+    old, new = op.jacobian, solver.jacobian.reshape(-1, 5)[op.rows]
+    fit = old @ np.linalg.lstsq(old, new, rcond=None)[0] - new
+    assert (np.abs(fit).max() > 1e-9 * np.abs(new).max()) == with_errors
+    turned = turned_operator(op, solver.jacobian, op.rows, op.active, mu)
+    formed = reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, solver.jacobian, mu)
+    assert np.array_equal(turned.jacobian, formed.jacobian)
+    assert np.abs(turned.coupling - formed.coupling).max() <= 1e-12 * np.abs(formed.coupling).max()
+    assert np.allclose(turned.schur_inverse, formed.schur_inverse, rtol=1e-9, atol=1e-12 * np.abs(formed.schur_inverse).max())
