@@ -16,6 +16,7 @@ Run-time module: numpy and the standard library (numba where installed, through
 """
 from __future__ import annotations
 
+import functools
 import math
 import threading
 from dataclasses import dataclass
@@ -112,8 +113,6 @@ class ContactSet:
         position[active] = np.arange(active.size)
         self.owner = position[self.ball_index]                # active-ball row of every contact
         n_c = self.ball_index.size
-        self.sum_matrix = np.zeros((active.size, n_c))        # per-contact -> per-ball sums
-        self.sum_matrix[self.owner, np.arange(n_c)] = 1.0
         dw = np.full(n_balls, bearing.ball_diameter + bearing.preload)
         if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
             dw = dw + bearing.errors.ball_diameter_deviation
@@ -138,6 +137,14 @@ class ContactSet:
         self.force_scale = mu * q[active].max(axis=1) if active.size else np.zeros(0)
         self.contact_angle = arrays["contact_angle"]
         self.moving_ring = bearing.moving_ring
+
+    @functools.cached_property
+    def sum_matrix(self) -> np.ndarray:
+        """(B_active, C): per-contact -> per-ball sums of the numpy path (the compiled loops
+        sum by ``owner``), made when first asked for."""
+        out = np.zeros((self.active.size, self.ball_index.size))
+        out[self.owner, np.arange(self.ball_index.size)] = 1.0
+        return out
 
     def initial_guesses(self) -> np.ndarray:
         """Candidate scaled unknowns (2, B_active, 3) for a cold start, each a
@@ -339,7 +346,7 @@ class ContactPoints:
         geo = self.geometry
         if self.compiled:
             kernel = compiled_evaluate_points()
-            f, g, h, x = kernel(np.ascontiguousarray(u, dtype=float), geo.owner, geo.sum_matrix.shape[0],
+            f, g, h, x = kernel(np.ascontiguousarray(u, dtype=float), geo.owner, geo.active.size,
                                 self.g10, self.g12, self.h1, self.s0, self.s1, self.hs, self.weight, self.t2,
                                 np.ravel(eps2), derivatives, majorant)
             return (f, g, h, x if majorant else None) if derivatives else (f, None, None, None)
