@@ -15,7 +15,7 @@ so that both see the same machine load; the ratio column is current / baseline.
 Each FMU runs in a worker process of its own: an FMU's Python code runs in its host's
 interpreter, and two FMUs in one process would share the first ``slewing_model`` imported.
 
-The current FMU sums its friction with a compiled loop where numba is installed in the
+The current FMU runs its friction loops compiled where numba is installed in the
 host's Python (as in this venv); ``--without-numba`` makes numba unimportable in the
 workers, so that the FMU runs its numpy fallback, as on a host without numba.
 

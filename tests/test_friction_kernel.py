@@ -2,8 +2,11 @@
 
 The compiled loop (:mod:`slewing_model.friction_kernel`) is optional: the FMU runs where
 numba is not installed, with the numpy code. These tests compare both paths term by term
-(power, gradient, Hessian, Weiszfeld majorant) and on whole friction torques, cold and
-warm-started, and run the library and the FMU in a Python where numba cannot be imported.
+(the points' coefficients; power, gradient, Hessian, Weiszfeld majorant; each contact's power
+and torque), on whole friction torques, cold and warm-started, and over co-simulation steps
+(the compiled minimisation goes ball by ball, the numpy one batched: the same steps); they
+run the library and the FMU in a Python where numba cannot be imported, and check that the
+FMU loads its compiled loops from the cache it carries instead of compiling them.
 """
 import json
 import subprocess
