@@ -1,0 +1,100 @@
+"""The flexible solver's fresh reduced operator: its inverse by halves against LAPACK's.
+
+A fresh operator ``W^-1 = (A^-1 + M)_aa^-1`` is what sets the tail of a co-simulation step
+(`docs/speed.md`). This takes the operators ``W`` the simulator forms while stepping the
+benchmark cases (`benchmarks/cases.py`: the pitch and yaw bearings, fine superelement) and
+inverts each by :func:`slewing_model.reduced_operator.spd_inverse` (Schur complements,
+matrix products) and by ``np.linalg.inv`` (LU, then triangular solves), alternately, on one
+BLAS thread as in a step; it prints the median and tail of each, their ratio, and the
+residual ``|X W - I|`` of both.
+
+Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from cases import CASES  # noqa: E402
+from timing import print_table  # noqa: E402
+
+import slewing_model.reduced_operator as reduced_operator  # noqa: E402
+from slewing_model import Loads, load_bearing  # noqa: E402
+from slewing_model.blas import blas_threads  # noqa: E402
+from slewing_model.simulator import BearingSimulator, SimulatorSettings  # noqa: E402
+from slewing_model.superelement import build_superelement  # noqa: E402
+
+
+def formed_operators(case_name: str, steps: int) -> list[np.ndarray]:
+    """The matrices ``W`` the simulator inverted while stepping a case, after its first
+    (cold) step."""
+    case = CASES[case_name](steps)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="fine", bc="free")
+    simulator = BearingSimulator(bearing, superelement, SimulatorSettings(
+        load_frame="rotating" if case.parameters["load_frame"] == 2 else "fixed"))
+    formed, depth, step = [], [0], [0]
+    inverse = reduced_operator.spd_inverse
+
+    def keep(w):                                 # the operators, not the halves it recurses on
+        if depth[0] == 0 and step[0] > 0:
+            formed.append(w.copy())
+        depth[0] += 1
+        try:
+            return inverse(w)
+        finally:
+            depth[0] -= 1
+
+    reduced_operator.spd_inverse = keep
+    try:
+        for k in range(steps):
+            step[0] = k
+            simulator.step(Loads.from_array(case.loads[k]), case.psi[k], case.omega[k])
+    finally:
+        reduced_operator.spd_inverse = inverse
+    return formed
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--runs", type=int, default=30, help="inversions of each operator by each method")
+    parser.add_argument("--steps", type=int, default=200, help="steps of each case that form the operators")
+    args = parser.parse_args()
+    rows = []
+    for name in ("pitch", "yaw"):
+        operators = formed_operators(name, args.steps)
+        warm = operators
+        times = {"halves": [], "lapack": []}
+        residual = {"halves": 0.0, "lapack": 0.0}
+        methods = {"halves": reduced_operator.spd_inverse, "lapack": np.linalg.inv}
+        with blas_threads(1):
+            for _ in range(args.runs):
+                for w in warm:
+                    for method, invert in methods.items():
+                        start = time.perf_counter()
+                        x = invert(w)
+                        times[method].append(time.perf_counter() - start)
+            for w in warm:
+                eye = np.eye(w.shape[0])
+                for method, invert in methods.items():
+                    residual[method] = max(residual[method], float(np.abs(invert(w) @ w - eye).max()))
+        sizes = sorted({w.shape[0] for w in warm})
+        for method in methods:
+            t = np.array(times[method]) * 1e3
+            ratio = np.median(times[method]) / np.median(times["lapack"])
+            rows.append([name, f"{len(warm)} ({sizes[0]}-{sizes[-1]} rows)", method, f"{np.median(t):.2f} ms",
+                         f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms", f"{ratio:.2f}",
+                         f"{residual[method]:.1e}"])
+    print_table(f"Fresh reduced operator, one BLAS thread, {args.runs} runs of each operator, methods alternating: "
+                "spd_inverse (halves) against np.linalg.inv (lapack)",
+                ["case", "operators", "method", "median", "95th pct", "99th pct", "ratio to lapack",
+                 "max |X W - I|"], rows)
+
+
+if __name__ == "__main__":
+    main()
