@@ -36,6 +36,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_rigid.py
 	$(PY) benchmarks/bench_superelement.py
 	$(PY) benchmarks/bench_flexible.py
+	$(PY) benchmarks/bench_operator.py
 	$(PY) benchmarks/bench_friction.py
 	$(PY) benchmarks/bench_fmu.py
 	$(PY) benchmarks/bench_batch.py
