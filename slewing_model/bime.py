@@ -126,12 +126,14 @@ class BimeSolver:
         phi = a.ball_angle[:, None]
         r, z = a.moving_centre[..., 0], a.moving_centre[..., 1]
         c, s = np.cos(phi), np.sin(phi)
-        zero, one = np.zeros_like(r), np.ones_like(r)
         L = self.length
         # d(R, z of the moving groove centre)/d(X, Y, Z, L rx, L ry), eq 23: (B, 2 diag, 2 comp, 5)
-        jr = np.stack([c * one, s * one, zero, -z * s / L, z * c / L], axis=-1)
-        jz = np.stack([zero, zero, one, r * s / L, -r * c / L], axis=-1)
-        self.jacobian = a.moving_sign * np.stack([jr, jz], axis=2)
+        jac = np.zeros(r.shape + (2, 5))
+        jac[:, :, 0, 0], jac[:, :, 0, 1] = c, s                              # R
+        jac[:, :, 0, 3], jac[:, :, 0, 4] = -z * s / L, z * c / L
+        jac[:, :, 1, 2] = 1.0                                                # z
+        jac[:, :, 1, 3], jac[:, :, 1, 4] = r * s / L, -r * c / L
+        self.jacobian = a.moving_sign * jac
         self._jacobian_rows = self.jacobian.reshape(-1, 5)     # (4B, 5): one matrix-vector product
         self._separation = a.separation                        # e before loading, (B, 2, 2)
         k_mean = float(a.stiffness.mean())
