@@ -100,8 +100,11 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu)
     ja = jacobian.reshape(-1, 5)[rows]
     if op.jacobian.shape == ja.shape:
         old = op.jacobian
-        turn = np.linalg.solve(old.T @ old, old.T @ ja)
-        if np.abs(old @ turn - ja).max() <= 1e-12 * np.abs(ja).max():
+        try:            # J_a has rank < 5 on fewer than three loaded diagonals: then formed anew
+            turn = np.linalg.solve(old.T @ old, old.T @ ja)
+        except np.linalg.LinAlgError:
+            turn = None
+        if turn is not None and np.abs(old @ turn - ja).max() <= 1e-12 * np.abs(ja).max():
             coupling = op.coupling @ turn
             return ReducedOperator(rows, active, op.contact_compliance, op.inverse, ja, coupling,
                                    np.linalg.inv(ja.T @ coupling + mu * np.eye(5)))

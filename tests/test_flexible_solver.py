@@ -228,3 +228,26 @@ def test_operator_after_a_turn_equals_one_formed_anew(bearing, with_errors):
     assert np.array_equal(turned.jacobian, formed.jacobian)
     assert np.abs(turned.coupling - formed.coupling).max() <= 1e-12 * np.abs(formed.coupling).max()
     assert np.allclose(turned.schur_inverse, formed.schur_inverse, rtol=1e-9, atol=1e-12 * np.abs(formed.schur_inverse).max())
+
+
+def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
+    """On one or two loaded diagonals the Jacobian has rank below 5 and no column turn can be
+    fitted: the coupling is then formed anew, without error (found by a review: a singular solve)."""
+    from slewing_model.reduced_operator import assemble_operator, reduced_operator, turned_operator
+
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    loads = LOADS[1]
+    result = solver.solve(loads)
+    point = solver._evaluate(result.state[:5], result.state[5:], solver._scaled_load(loads))
+    loaded = np.flatnonzero((point.delta > 0.0).ravel())
+    mu = 1e-12 * solver.reference_stiffness
+    for count in (1, 2, 3):
+        active = np.zeros(point.delta.size, dtype=bool)
+        active[loaded[:count]] = True
+        rows = np.flatnonzero(np.repeat(active, 2))
+        op = assemble_operator(point, solver.compliance, solver.assembly.stiffness, solver.jacobian, rows, active, mu)
+        solver.set_rotation(0.3 * count)
+        turned = turned_operator(op, solver.jacobian, rows, active, mu)
+        formed = reduced_operator(rows, active, op.contact_compliance, op.inverse, solver.jacobian, mu)
+        assert np.abs(turned.coupling - formed.coupling).max() <= 1e-12 * np.abs(formed.coupling).max()
+        solver.set_rotation(0.0)
