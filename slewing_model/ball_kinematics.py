@@ -584,7 +584,9 @@ def _minimise_compiled(contacts: ContactPoints, u: np.ndarray, tol: float, max_i
         np.ascontiguousarray(u, dtype=float), first, contacts.g10, contacts.g12, contacts.h1, contacts.s0,
         contacts.s1, contacts.hs, contacts.weight, contacts.t2, np.ravel(geo.eps2), geo.force_scale, tol, floor,
         max_iterations, _THETA_DOWN, _THETA_UP, _THETA_MIN_UP)
-    return u, int(iterations.max(initial=0)), float(residual.max(initial=0.0)), bool(converged.all())
+    # as the numpy loop counts: the most a ball took, or max_iterations when some ball ran out
+    done = bool(converged.all())
+    return u, int(iterations.max(initial=0)) if done else max_iterations, float(residual.max(initial=0.0)), done
 
 
 def spin_roll_ratio(geometry: ContactSet, u: np.ndarray, n_balls: int) -> np.ndarray:

@@ -129,7 +129,8 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
 def _solve3(a, rhs, out):
     """``out = a^-1 rhs`` for a symmetric (3, 3) ``a``: Gaussian elimination with partial
     pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same). A
-    singular ``a`` (not met) is regularised as ``solve_per_ball`` does: ``a + 1e-13 mean(diag) I``."""
+    singular ``a`` (not met) is regularised as ``solve_per_ball`` does: ``a + 1e-13 mean(diag) I``;
+    still singular, it raises ValueError (numpy's LinAlgError is one)."""
     m = np.empty((3, 4))
     shift = 0.0
     for attempt in range(2):
@@ -156,6 +157,8 @@ def _solve3(a, rhs, out):
                     m[r, c] -= factor * m[col, c]
         if not singular:
             break
+        if attempt == 1:
+            raise ValueError("singular ball Hessian in the friction's ball equilibrium")
         shift = 1e-13 * max((a[0, 0] + a[1, 1] + a[2, 2]) / 3.0, 1e-300)
     for r in range(2, -1, -1):
         value = m[r, 3]

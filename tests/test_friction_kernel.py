@@ -117,6 +117,23 @@ def test_compiled_steps_equal_the_numpy_steps(name):
         assert np.allclose(sims["compiled"]._friction_warm, sims["numpy"]._friction_warm, rtol=1e-8, atol=1e-12), k
 
 
+@needs_numba
+@pytest.mark.parametrize("case", range(3))
+def test_both_paths_count_iterations_alike_when_they_run_out(case):
+    # a few iterations allowed from a perturbed start: some balls converge, others run out;
+    # both report max_iterations then (found by a review: the compiled loop reported one more)
+    bearing, distribution = _distributions()[case]
+    start = friction_torque(bearing, distribution).state * 1.3
+    for most in (1, 2, 3):
+        out = {k: friction_torque(bearing, distribution, kernel=k, initial=start, max_iterations=most)
+               for k in ("numpy", "compiled")}
+        assert out["compiled"].iterations == out["numpy"].iterations <= most + 1
+        assert out["compiled"].converged == out["numpy"].converged
+        if not out["numpy"].converged:
+            assert out["numpy"].iterations == most
+        assert out["compiled"].magnitude == pytest.approx(out["numpy"].magnitude, rel=1e-12)
+
+
 def test_unknown_kernel_is_refused():
     bearing, distribution = _distributions()[0]
     with pytest.raises(ValueError, match="kernel = 'fortran'"):
