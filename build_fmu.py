@@ -103,9 +103,12 @@ def ship_compiled_kernels(fmu) -> list[Path]:
         return []
     friction_kernel.compile_all()
     cache = Path(friction_kernel.__file__).parent / "__pycache__"
-    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
+    tag = f"py{sys.version_info.major}{sys.version_info.minor}"      # numba adds the ABI flags (py311t)
     files = [f for _, function in friction_kernel.KERNELS
-             for f in cache.glob(f"friction_kernel.{function.__name__}-{function.__code__.co_firstlineno}.{tag}.*")]
+             for f in cache.glob(f"friction_kernel.{function.__name__}-{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
+    if not files:
+        warnings.warn(f"numba's cache of the friction loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
+                      "writable): the FMU will compile them when instantiated (about 10 s)")
     with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive:
         for f in files:
             archive.write(f, f"resources/slewing_model/__pycache__/{f.name}")
