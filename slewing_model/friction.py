@@ -61,7 +61,7 @@ from .contact_friction import (  # noqa: F401
 from .ellipse_quadrature import (  # noqa: F401
     DEFAULT_QUADRATURE, DEFAULT_SOLVE_QUADRATURE, EllipseQuadrature, as_quadrature, ellipse_quadrature,
 )
-from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE
+from .friction_kernel import use_compiled
 from .friction_studies import preload_sweep, torque_ripple  # noqa: F401
 from .geometry import Bearing
 
@@ -304,11 +304,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     omega = check_number("omega", omega)
     sliding_regularisation = check_number("sliding_regularisation", sliding_regularisation, 0.0, strict=True)
     tol = check_number("tol", tol, 0.0, strict=True)
-    if kernel not in ("auto", "numpy", "compiled"):
-        raise ValueError(f"kernel = {kernel!r}: must be 'auto', 'numpy' or 'compiled'")
-    if kernel == "compiled" and not COMPILED_AVAILABLE:
-        raise ValueError("kernel = 'compiled' needs numba, which is not installed in this Python")
-    compiled = kernel == "compiled" or (kernel == "auto" and COMPILED_AVAILABLE)
+    compiled = use_compiled(kernel)
     quad = as_quadrature(quadrature)
     solve_quad = quad if solve_quadrature is None else as_quadrature(solve_quadrature)
     seal = seal_torque_of(bearing, seal_torque, seal_torque_per_length, seal_length)

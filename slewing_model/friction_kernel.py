@@ -38,6 +38,21 @@ def _numba_installed() -> bool:
 #: importing numba also imports scipy, which the run-time part does not otherwise need)
 AVAILABLE = _numba_installed()
 
+#: how the friction model may run its loops (``kernel`` of ``friction_torque``)
+KERNEL_CHOICES = ("auto", "numpy", "compiled")
+
+
+def use_compiled(kernel: str, name: str = "kernel") -> bool:
+    """Whether ``kernel`` (one of :data:`KERNEL_CHOICES`) runs the compiled loops here:
+    "compiled", or "auto" where numba is installed. ValueError naming ``name`` for another
+    value, or for "compiled" where numba is not installed."""
+    if kernel not in KERNEL_CHOICES:
+        raise ValueError(f"{name} = {kernel!r}: must be 'auto', 'numpy' or 'compiled'")
+    if kernel == "compiled" and not AVAILABLE:
+        raise ValueError(f"{name} = 'compiled' needs numba, which is not installed in this Python "
+                         "(pip install numba, or use 'auto' or 'numpy')")
+    return AVAILABLE and kernel != "numpy"
+
 _SIGNATURE = ("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
               "f8[:, :], i8[:], i8, f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :, :], "
               "f8[:], f8[:], b1, b1)")

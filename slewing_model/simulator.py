@@ -19,7 +19,7 @@ import numpy as np
 from .bime import BimeSolver, LoadDistribution, Loads
 from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
-from .friction_kernel import AVAILABLE as COMPILED_AVAILABLE, compile_all
+from .friction_kernel import compile_all, use_compiled
 from .geometry import Bearing
 from .reduced_operator import ReducedOperator
 
@@ -92,10 +92,7 @@ class SimulatorSettings:
         _choice("ring_model", self.ring_model, RING_MODELS)
         _choice("moving_ring", self.moving_ring, ("inner", "outer"))
         _choice("load_frame", self.load_frame, LOAD_FRAMES)
-        _choice("friction_kernel", self.friction_kernel, ("auto", "numpy", "compiled"))
-        if self.friction_kernel == "compiled" and not COMPILED_AVAILABLE:
-            raise ValueError("friction_kernel = 'compiled' needs numba, which is not installed in this Python "
-                             "(pip install numba, or use 'auto' or 'numpy')")
+        use_compiled(self.friction_kernel, "friction_kernel")
         for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation", "friction_tolerance"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
@@ -169,7 +166,7 @@ class BearingSimulator:
         self.bearing = bearing
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
                                  rtol=s.tolerance)
-        if s.friction_kernel != "numpy" and COMPILED_AVAILABLE:
+        if use_compiled(s.friction_kernel, "friction_kernel"):
             compile_all()     # compiled (or loaded from numba's cache) now, not in a step
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm
