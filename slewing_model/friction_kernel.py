@@ -58,6 +58,12 @@ _SIGNATURE = ("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
               "f8[:], f8[:], b1, b1)")
 
 
+def _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs):
+    """``A`` and ``S`` of point ``(c, i)`` for the ball unknowns ``(u0, u1, u2)``
+    (``ContactPoints.velocity``)."""
+    return g10[c, i] * u0 + g12[c, i] * u1 + (h1[c, i] - u2), s0[c, i] * u0 + s1[c, i] * u1 + hs[c, i]
+
+
 def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, derivatives, majorant,
                   gradient, hessian, extra):
     """Power of contact ``c`` at the ball unknowns ``(u0, u1, u2)``, returned; with
@@ -67,8 +73,7 @@ def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, deriv
     n_across, n_along = g10.shape[1], t2.shape[0]
     power = 0.0
     for i in range(n_across):
-        a = g10[c, i] * u0 + g12[c, i] * u1 + (h1[c, i] - u2)
-        s_ = s0[c, i] * u0 + s1[c, i] * u1 + hs[c, i]
+        a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
         a2, s2 = a * a, s_ * s_
         total = 0.0
         alpha = beta = m0 = m1 = m2 = 0.0
@@ -317,11 +322,11 @@ def _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, t2, eps2, arm1, arm2)
     for c in range(n_contacts):
         b = owner[c]
         for i in range(n_across):
-            a = g10[c, i] * u[b, 0] + g12[c, i] * u[b, 1] + (h1[c, i] - u[b, 2])
-            s_ = s0[c, i] * u[b, 0] + s1[c, i] * u[b, 1] + hs[c, i]
+            a, s_ = _sliding(c, i, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs)
+            a2, s2 = a * a, s_ * s_
             alpha = beta = 0.0
             for k in range(t2.shape[0]):
-                ws = weight[k, c, i] / math.sqrt(a * a + t2[k] * s_ * s_ + eps2[c])
+                ws = weight[k, c, i] / math.sqrt(a2 + t2[k] * s2 + eps2[c])
                 alpha += ws
                 beta += ws * t2[k]
             ga, gs = alpha * a, beta * s_
@@ -349,7 +354,8 @@ def _compiled_helpers() -> None:
     import numba
 
     module = globals()
-    for name in ("_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step"):
+    for name in ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic",
+                 "_damped_step"):
         module[name] = numba.njit(cache=True, nogil=True)(module[name])
 
 
