@@ -372,8 +372,8 @@ class BimeSolver:
         stiffness, op = self.assembly.stiffness, self._reduced
         if not fresh and op is not None and not np.array_equal(op.rows, rows):
             op = update_operator(op, p, self.compliance, stiffness, self.jacobian, rows, active, mu)
-        if not fresh and op is not None and not np.array_equal(op.jacobian, self.jacobian.reshape(-1, 5)[rows]):
-            # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
+        if not fresh and op is not None:
+            # the ring may have turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
             op = turned_operator(op, self.jacobian, rows, active, mu)
         if fresh or op is None:
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)

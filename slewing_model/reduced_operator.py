@@ -79,10 +79,12 @@ def contact_compliance_blocks(point, stiffness: np.ndarray, active: np.ndarray) 
         np.eye(2) - nn)
 
 
-def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.ndarray, mu: float) -> ReducedOperator:
-    """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5)."""
+def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.ndarray, mu: float,
+                     coupling: np.ndarray | None = None) -> ReducedOperator:
+    """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5),
+    ``W^-1 J_a`` unless given, and the Schur complement's inverse."""
     ja = jacobian.reshape(-1, 5)[rows]
-    coupling = inverse @ ja
+    coupling = inverse @ ja if coupling is None else coupling
     schur_inverse = np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
@@ -96,19 +98,21 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu)
     ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
     ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``. ``T`` is
     fitted by least squares and used where it reproduces ``J_new`` to 1e-12; otherwise (errors
-    move the groove centres with the ring) the coupling is formed anew."""
+    move the groove centres with the ring) the coupling is formed anew. The operator itself
+    when the Jacobian did not change."""
     ja = jacobian.reshape(-1, 5)[rows]
+    if np.array_equal(op.jacobian, ja):
+        return op
+    coupling = None
     if op.jacobian.shape == ja.shape:
         old = op.jacobian
         try:            # J_a has rank < 5 on fewer than three loaded diagonals: then formed anew
             turn = np.linalg.solve(old.T @ old, old.T @ ja)
+            if np.abs(old @ turn - ja).max() <= 1e-12 * np.abs(ja).max():
+                coupling = op.coupling @ turn
         except np.linalg.LinAlgError:
-            turn = None
-        if turn is not None and np.abs(old @ turn - ja).max() <= 1e-12 * np.abs(ja).max():
-            coupling = op.coupling @ turn
-            return ReducedOperator(rows, active, op.contact_compliance, op.inverse, ja, coupling,
-                                   np.linalg.inv(ja.T @ coupling + mu * np.eye(5)))
-    return reduced_operator(rows, active, op.contact_compliance, op.inverse, jacobian, mu)
+            pass
+    return reduced_operator(rows, active, op.contact_compliance, op.inverse, jacobian, mu, coupling)
 
 
 def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
