@@ -127,8 +127,8 @@ def check_inputs(values: dict) -> None:
             raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
 
 
-#: the parameters a host may change between steps
-TUNABLE = ("friction_coefficient", "seal_torque", "omega_regularisation")
+#: the parameters a host may change between steps (those of :data:`REAL_PARAMETERS` marked tunable)
+TUNABLE = tuple(name for name, _, _, tunable, _ in REAL_PARAMETERS if tunable)
 
 
 def build_simulator(slave, error) -> bool:
