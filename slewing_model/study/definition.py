@@ -65,6 +65,18 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
+
+#: a case's name: its load series' name, this, its bearing variant's name
+CASE_NAME_SEPARATOR = " | "
+
+
+def case_name_parts(name: str) -> tuple[str, str]:
+    """The load series' and the bearing variant's names in a case's name (both the whole name
+    when it has no separator)."""
+    load, _, variant = name.partition(CASE_NAME_SEPARATOR)
+    return load, variant or load
+
+
 #: bump when a case's numbers change for the same inputs (reruns then recompute)
 CASE_FORMAT = 1
 
@@ -159,7 +171,7 @@ class Study:
                 "variant": _with_digests(variant, ("file",), digests),
                 "simulation": self.simulation,
             }
-            name = f"{load['name']} | {variant['name']}"
+            name = f"{load['name']}{CASE_NAME_SEPARATOR}{variant['name']}"
             out.append(Case(i, case_key(spec), name, load, variant, self.simulation, spec))
         return out
 

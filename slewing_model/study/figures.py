@@ -19,6 +19,7 @@ from collections import defaultdict
 import numpy as np
 
 from .case import TIMESERIES_COLUMNS
+from .definition import case_name_parts
 
 SWEPT = {"preload_um": ("ball preload [um]", 1.0), "friction_coefficient": ("friction coefficient mu [-]", 1.0)}
 
@@ -56,12 +57,11 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
 
 def _labels(rows: list[dict]) -> list[str]:
     """Case labels without what all cases share (the bearing variant, or the load series)."""
-    loads = [r["name"].split(" | ", 1)[0] for r in rows]
-    variants = [r["name"].split(" | ", 1)[-1] for r in rows]
+    loads, variants = zip(*(case_name_parts(r["name"]) for r in rows))
     if len(set(variants)) == 1:
-        return loads
+        return list(loads)
     if len(set(loads)) == 1:
-        return variants
+        return list(variants)
     return [r["name"] for r in rows]
 
 
@@ -71,7 +71,7 @@ def overview(path: str, rows: list[dict]) -> str:
     failed = len(rows) - len(ok)
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5 if len(ok) <= 40 else 6.5))
     title = f"{len(rows)} cases, {len(ok)} ok, {failed} failed (see summary.csv)"
-    variants = {r["name"].split(" | ", 1)[-1] for r in ok}
+    variants = {case_name_parts(r["name"])[1] for r in ok}
     if len(ok) <= 40 and len(variants) == 1:
         title += f"; bearing: {variants.pop()}"
     fig.suptitle(title)
