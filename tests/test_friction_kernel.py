@@ -99,7 +99,6 @@ def test_compiled_torque_equals_the_numpy_torque(case):
 def test_compiled_steps_equal_the_numpy_steps(name):
     # the co-simulation's steps, warm-started from each other: the compiled minimisation (ball by
     # ball) takes the steps the numpy loop (batched) takes, so the torques agree to round-off
-    import sys
     sys.path.insert(0, str(ROOT / "benchmarks"))
     from cases import CASES
     from slewing_model.simulator import BearingSimulator, SimulatorSettings
