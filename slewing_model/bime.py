@@ -359,10 +359,11 @@ class BimeSolver:
 
         The reduced operator ``(A^-1 + M)_aa^-1`` is kept and reused (a modified
         Newton step with the contact stiffness ``A`` of an earlier iterate, which
-        is still a descent direction) while the active contacts stay the same and
-        ``fresh`` is False; the solve loop asks for a fresh one when convergence
-        slows. Between warm-started solves of slowly changing loads (the FMU's
-        steps) an iteration then costs matrix-vector products only.
+        is still a descent direction) while ``fresh`` is False, bordered by contacts
+        that close (contacts that open keep their rows, :func:`update_operator`); the
+        solve loop asks for a fresh one when convergence slows. Between warm-started
+        solves of slowly changing loads (the FMU's steps) an iteration then costs
+        matrix-vector products only.
         """
         active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
         rows = np.flatnonzero(np.repeat(active, 2))
@@ -370,11 +371,11 @@ class BimeSolver:
             self._reduced = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
         stiffness, op = self.assembly.stiffness, self._reduced
-        if not fresh and op is not None and not np.array_equal(op.rows, rows):
-            op = update_operator(op, p, self.compliance, stiffness, self.jacobian, rows, active, mu)
         if not fresh and op is not None:
             # the ring may have turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-            op = turned_operator(op, self.jacobian, rows, active, mu)
+            op = turned_operator(op, self.jacobian, op.rows, op.active, mu)
+            if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
+                op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
         if fresh or op is None:
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)
         self._reduced = op

@@ -13,9 +13,9 @@ the Jacobian of the contacts' relative vectors on the moving ring's five motions
 and ``y`` the contact forces after the step. :class:`ReducedOperator` keeps
 ``W^-1 = (A^-1 + M)_aa^-1`` and what follows from it for the five motions (its Schur
 complement). It is reused between iterations and between warm-started steps (a modified
-Newton step, still a descent direction), updated by low-rank (Schur complement) updates
-when a few contacts open or close (:func:`update_operator`), and rebuilt when convergence
-slows (:func:`assemble_operator`).
+Newton step, still a descent direction), bordered by the contacts that close
+(:func:`update_operator`; contacts that open keep their rows until a fresh operator), and
+rebuilt when convergence slows (:func:`assemble_operator`).
 
 Run-time module: numpy.
 """
@@ -33,11 +33,13 @@ class ReducedOperator:
     Attributes
     ----------
     rows : ndarray (n,) of int
-        Rows of the active contacts among the 4B contact rows (ball, diagonal, (r, z)), increasing.
+        Rows of the operator's contacts among the 4B contact rows (ball, diagonal, (r, z)), two a
+        diagonal, in the order they entered (:func:`update_operator`): the diagonals loaded when it
+        was formed, then those that closed since.
     active : ndarray (2B,) of bool
-        The active diagonals.
+        The operator's diagonals (``rows[::2] // 2``) as a mask.
     contact_compliance : ndarray (n/2, 2, 2)
-        ``A^-1`` of the active diagonals when ``W^-1`` was formed.
+        ``A^-1`` of the operator's diagonals, in its order, when each entered.
     inverse : ndarray (n, n)
         ``W^-1 = (A^-1 + M)_aa^-1``.
     jacobian : ndarray (n, 5)
@@ -169,51 +171,49 @@ def assemble_operator(point, compliance, stiffness, jacobian, rows, active, mu) 
     return reduced_operator(rows, active, a_inv, spd_inverse(w_mat), jacobian, mu)
 
 
-def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, rows, active, mu
+def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu
                     ) -> ReducedOperator | None:
-    """Follow a change of the active contacts by a low-rank update of ``W^-1``.
+    """Follow contacts that closed by bordering the kept ``W^-1``; contacts that opened stay.
 
-    Dropping rows: ``(W_kk)^-1 = P - Q S^-1 Q^T`` from the blocks of the old
-    inverse; adding rows (bordering): with ``X = W_kk^-1 B`` and the Schur
-    complement ``C - B^T X``. O(n^2 r) instead of O(n^3) for r changed rows.
-    Dropping takes the kept block first (``take``) and corrects it in place; adding
-    moves the kept rows and columns to their new places as slices (:func:`_move_block`).
-    Returns None (rebuild) when many contacts changed."""
-    old_rows, w_inv = op.rows, op.inverse
-    size = max(int(old_rows[-1]), int(rows[-1])) + 1 if old_rows.size and rows.size else 0
-    keep = _member(old_rows, rows, size)
-    added = ~_member(rows, old_rows, size)
-    if int((~keep).sum() + added.sum()) > 0.25 * rows.size:
+    A diagonal that opened keeps its row in the operator with the stiffness it had when the
+    operator was formed, until the next fresh one: a modified Newton step whose fixed point is
+    the same, since the step's row of that contact, ``A^-1 (y_new - f) + (M dy) - J dq = 0``,
+    holds at the equilibrium with ``y = f = 0``. Its stiffness was small (it was about to
+    open), so the rate of the iteration barely changes, and dropping it would cost a pass over
+    ``W^-1`` that, as the ring turns, a contact closing again soon after would undo (measured
+    on the pitch bearing's steps: updates 0.93 -> 0.28 a step, docs/speed.md).
+
+    A diagonal that closed must enter: its force is zero outside the operator's rows. With
+    ``B = M`` (kept rows, new rows), ``C = (A^-1 + M)`` on the new rows, ``X = W^-1 B`` and
+    ``S = (C - B^T X)^-1``, ``W_new^-1 = [[W^-1 + X S X^T, -X S], [-S X^T, S]]``: O(n^2 r) for
+    ``r`` new rows instead of O(n^3). The new rows come after the kept ones (the operator's
+    rows are in the order they entered), and the coupling follows by the same blocks:
+    ``W_new^-1 J_new = [W^-1 J - X S d, S d]``, ``d = J_r - X^T J``, with ``op`` turned to
+    ``jacobian`` first (:func:`turned_operator`). Returns None (form anew) when more than a
+    quarter of the rows would be new."""
+    closed = active & ~op.active
+    new_rows = np.flatnonzero(np.repeat(closed, 2))
+    if new_rows.size > 0.25 * op.rows.size:
         return None
-    kept_rows = old_rows[keep]
-    if not keep.all():  # drop the contacts that opened: the kept block, less a rank-r correction
-        kept, dropped = np.flatnonzero(keep), np.flatnonzero(~keep)
-        q_mat = w_inv.take(dropped, axis=1)
-        q_kept = q_mat[kept]
-        w_inv = w_inv.take(kept, axis=0).take(kept, axis=1)
-        w_inv -= q_kept @ np.linalg.solve(q_mat[dropped], q_kept.T)
-    a_inv = op.contact_compliance[keep[::2]]
-    if added.any():  # border with the contacts that closed
-        new_rows = rows[added]
-        new_diagonals = np.zeros_like(active)
-        new_diagonals[new_rows[::2] // 2] = True
-        new_a_inv = contact_compliance_blocks(point, stiffness, new_diagonals)
-        b_mat = compliance[np.ix_(kept_rows, new_rows)]
-        c_mat = compliance[np.ix_(new_rows, new_rows)]
-        _add_blocks(c_mat, new_a_inv)
-        x_mat = w_inv @ b_mat
-        schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
-        xs = x_mat @ schur
-        at_kept, at_new = np.flatnonzero(~added), np.flatnonzero(added)   # places in the sorted rows
-        w_inv = _move_block(w_inv + xs @ x_mat.T, np.arange(kept_rows.size), at_kept, rows.size)
-        w_inv[np.ix_(at_kept, at_new)] = -xs
-        w_inv[np.ix_(at_new, at_kept)] = -xs.T
-        w_inv[np.ix_(at_new, at_new)] = schur
-        merged = np.empty((rows.size // 2, 2, 2))
-        merged[at_kept[::2] // 2] = a_inv
-        merged[at_new[::2] // 2] = new_a_inv
-        a_inv = merged
-    return reduced_operator(rows, active, a_inv, w_inv, jacobian, mu)
+    rows = np.concatenate([op.rows, new_rows])
+    new_a_inv = contact_compliance_blocks(point, stiffness, closed)
+    b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
+    c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
+    _add_blocks(c_mat, new_a_inv)
+    x_mat = op.inverse @ b_mat
+    schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
+    schur = 0.5 * (schur + schur.T)
+    xs = x_mat @ schur
+    n = op.rows.size
+    inverse = np.empty((rows.size, rows.size))
+    np.add(op.inverse, xs @ x_mat.T, out=inverse[:n, :n])
+    inverse[:n, n:] = -xs
+    inverse[n:, :n] = -xs.T
+    inverse[n:, n:] = schur
+    d = jacobian.reshape(-1, 5)[new_rows] - x_mat.T @ op.jacobian
+    coupling = np.concatenate([op.coupling - xs @ d, schur @ d])
+    return reduced_operator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
+                            jacobian, mu, coupling)
 
 
 def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
@@ -222,37 +222,10 @@ def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
 
     ``point`` has the spring forces ``force`` (B, 2, 2), the forces felt by the rings ``y``
     and their motion ``ring_motion = M y``."""
-    rhs = (op.contact_compliance @ point.force.reshape(-1, 2)[op.active][..., None]).ravel() \
+    rhs = (op.contact_compliance @ point.force.reshape(-1, 2)[op.rows[::2] // 2][..., None]).ravel() \
         + point.ring_motion[op.rows]
     w_vec = op.inverse @ rhs
     dq = op.schur_inverse @ (f_scaled - op.jacobian.T @ w_vec)
     y_new = np.zeros_like(point.y)
     y_new[op.rows] = w_vec + op.coupling @ dq
     return dq, y_new
-
-
-def _member(values: np.ndarray, of: np.ndarray, size: int) -> np.ndarray:
-    """``np.isin(values, of)`` for row numbers below ``size``, by a mask (np.isin sorts:
-    ten times slower on a few hundred rows)."""
-    mask = np.zeros(size, dtype=bool)
-    mask[of] = True
-    return mask[values]
-
-
-def _move_block(source: np.ndarray, rows: np.ndarray, places: np.ndarray, size: int) -> np.ndarray:
-    """A new (size, size) matrix whose rows and columns ``places`` hold ``source[np.ix_(rows, rows)]``
-    (both increasing); the others are left to the caller.
-
-    Copied run by run, a run being rows that follow each other in both: when a few contacts
-    open or close there are a few runs, and slices copy at memory speed where numpy's
-    fancy indexing of a matrix copies element by element (ten times slower here)."""
-    out = np.empty((size, size))
-    cut = np.flatnonzero((np.diff(rows) != 1) | (np.diff(places) != 1)) + 1
-    if cut.size > 16:                         # many runs: one fancy copy is cheaper than many slices
-        out[np.ix_(places, places)] = source[np.ix_(rows, rows)]
-        return out
-    runs = [(rows[a], places[a], b - a) for a, b in zip(np.r_[0, cut], np.r_[cut, rows.size])]
-    for r0, p0, n in runs:
-        for c0, q0, m in runs:
-            out[p0:p0 + n, q0:q0 + m] = source[r0:r0 + n, c0:c0 + m]
-    return out

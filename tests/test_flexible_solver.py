@@ -172,10 +172,10 @@ def test_inverse_by_halves_is_as_exact_as_lapack():
         assert np.abs(halves - lapack).max() <= 1e-8 * np.abs(lapack).max()
 
 
-def test_operator_updated_for_other_contacts_equals_a_fresh_one(bearing):
-    """Contacts opening and closing (the active-set updates of the kept inverse: rows dropped
-    by a rank-r correction of the kept block, rows added by bordering) give the inverse that
-    forming and inverting the operator on the new contacts gives, at the same iterate."""
+def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing):
+    """Contacts closing (the kept inverse bordered by their rows; those that opened keep theirs)
+    give the inverse, coupling and Schur complement that forming and inverting the operator on
+    the same contacts gives, at the same iterate, with the rows in another order."""
     from slewing_model.reduced_operator import assemble_operator, update_operator
 
     loads = LOADS[1]
@@ -185,23 +185,48 @@ def test_operator_updated_for_other_contacts_equals_a_fresh_one(bearing):
     loaded = np.flatnonzero((point.delta > 0.0).ravel())
     assert loaded.size > 12
     mu = 1e-12 * solver.reference_stiffness
+    jacobian, stiffness = solver.jacobian, solver.assembly.stiffness
 
-    def operator(diagonals, op=None):
+    def mask(diagonals):
         active = np.zeros(point.delta.size, dtype=bool)
         active[diagonals] = True
-        rows = np.flatnonzero(np.repeat(active, 2))
-        args = (point, solver.compliance, solver.assembly.stiffness, solver.jacobian, rows, active, mu)
-        return assemble_operator(*args) if op is None else update_operator(op, *args)
+        return active
 
-    for before, after in ((loaded, loaded[3:]),                                   # three open
-                          (loaded[[0, 2] + list(range(5, loaded.size))], loaded),  # three close
-                          (np.delete(loaded, [1, 7]), np.delete(loaded, [4, 9, 10]))):  # both
-        updated = operator(after, operator(before))
-        fresh = operator(after)
-        assert np.array_equal(updated.rows, fresh.rows)
+    def formed(active):
+        rows = np.flatnonzero(np.repeat(active, 2))
+        return assemble_operator(point, solver.compliance, stiffness, jacobian, rows, active, mu)
+
+    for before, after in ((loaded[[0, 2] + list(range(5, loaded.size))], loaded),      # three close
+                          (np.delete(loaded, [1, 7]), np.delete(loaded, [4, 9, 10]))):  # two close, three open
+        kept = formed(mask(before))
+        updated = update_operator(kept, point, solver.compliance, stiffness, jacobian, mask(after), mu)
+        assert np.array_equal(updated.rows[:kept.rows.size], kept.rows)     # the kept rows stay, opened or not
+        fresh = formed(mask(before) | mask(after))
+        order = np.argsort(updated.rows)
+        assert np.array_equal(updated.rows[order], fresh.rows)
+        assert np.array_equal(updated.active, fresh.active)
         scale = np.abs(fresh.inverse).max()
-        assert np.abs(updated.inverse - fresh.inverse).max() <= 1e-9 * scale
+        assert np.abs(updated.inverse[np.ix_(order, order)] - fresh.inverse).max() <= 1e-9 * scale
+        assert np.abs(updated.coupling[order] - fresh.coupling).max() <= 1e-9 * np.abs(fresh.coupling).max()
         assert np.allclose(updated.schur_inverse, fresh.schur_inverse, rtol=1e-8)
+        assert np.array_equal(updated.contact_compliance[order[::2] // 2], fresh.contact_compliance)
+
+
+def test_contacts_opening_under_the_kept_operator_reach_the_cold_solution(bearing):
+    """Contacts that open keep their rows (and their earlier stiffness) in the operator until a
+    fresh one: the iteration still ends at the equilibrium of the new load, where they carry
+    nothing."""
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count), rtol=1e-10)
+    before = solver.solve(Loads(Fz=5e4, My=4.4e4))
+    tilted = Loads(Fz=5e4, My=4.6e4)         # a larger moment lifts the balls on one side
+    warm = solver.solve(tilted, initial=before)
+    opened = (before.interference > 0) & ~(warm.interference > 0)
+    assert opened.any()                                          # the case does open contacts ...
+    assert solver._reduced.active[opened.ravel()].any()          # ... that stayed in the operator
+    cold = BimeSolver(bearing, synthetic_superelement(bearing.ball_count), rtol=1e-10).solve(tilted)
+    assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
+    assert np.allclose(warm.displacement, cold.displacement, rtol=1e-8, atol=1e-14)
+    assert np.all(warm.contact_load[~(warm.interference > 0)[:, [0, 1, 0, 1]]] == 0.0)
 
 
 @pytest.mark.parametrize("with_errors", [False, True])
