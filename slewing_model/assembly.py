@@ -15,7 +15,7 @@ Everything returned is per ball and per diagonal, ready for the energy of
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -90,7 +90,8 @@ class Assembly:
         return self.groove_centre[:, cols]
 
 
-def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None) -> Assembly:
+def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None,
+             previous: Assembly | None = None) -> Assembly:
     """Groove centres, groove radii, ball diameters and spring constants at ``psi``.
 
     Parameters
@@ -101,6 +102,10 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     cage_angle : float, rad, optional
         Rotation of the ball set (cage); default ``cage_ratio(bearing) * psi``
         (rolling without slip).
+    previous : Assembly, optional
+        This bearing assembled at another rotation. Where neither ring has
+        errors, every ball sees the same grooves at any ``psi`` (each ball keeps
+        its own diameter), so only the angles change: the rest is taken from it.
 
     Returns
     -------
@@ -109,6 +114,8 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     n = bearing.ball_count
     cage = cage_ratio(bearing) * psi if cage_angle is None else cage_angle
     phi = bearing.ball_angles + cage
+    if previous is not None and not rings_have_errors(bearing):
+        return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi)
     centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()
     radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
     dw = np.full(n, bearing.ball_diameter + bearing.preload)
@@ -137,3 +144,9 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
         contact_stiffness=k, stiffness=k_tot, natural_length=natural,
         moving_sign=1.0 if bearing.moving_ring == "inner" else -1.0,
     )
+
+
+def rings_have_errors(bearing: Bearing) -> bool:
+    """Whether a ring's errors put other grooves under the balls as the moving ring turns."""
+    errors = bearing.errors
+    return errors is not None and (errors.outer is not None or errors.inner is not None)

@@ -115,16 +115,22 @@ class BimeSolver:
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
+        self.assembly: Assembly | None = None
         self.set_rotation(psi, cage_angle)
 
     # ---- set-up -------------------------------------------------------------------
     def set_rotation(self, psi: float, cage_angle: float | None = None) -> None:
         """Re-assemble at another rotation of the moving ring (errors move with
         the rings; the ring matrices do not change: the rings are axisymmetric)."""
-        self.assembly: Assembly = assemble(self.bearing, psi, cage_angle)
-        a = self.assembly
+        previous = self.assembly
+        self.assembly = a = assemble(self.bearing, psi, cage_angle, previous=previous)
+        if previous is None or a.groove_centre is not previous.groove_centre:   # other grooves under the balls
+            self._moving_centre = a.moving_centre
+            self._separation = a.separation                    # e before loading, (B, 2, 2)
+            k_mean = float(a.stiffness.mean())
+            self.reference_stiffness = a.stiffness.size * k_mean * math.sqrt(1e-4 * self.bearing.ball_diameter)
         phi = a.ball_angle[:, None]
-        r, z = a.moving_centre[..., 0], a.moving_centre[..., 1]
+        r, z = self._moving_centre[..., 0], self._moving_centre[..., 1]
         c, s = np.cos(phi), np.sin(phi)
         L = self.length
         # d(R, z of the moving groove centre)/d(X, Y, Z, L rx, L ry), eq 23: (B, 2 diag, 2 comp, 5)
@@ -135,9 +141,6 @@ class BimeSolver:
         jac[:, :, 1, 3], jac[:, :, 1, 4] = r * s / L, -r * c / L
         self.jacobian = a.moving_sign * jac
         self._jacobian_rows = self.jacobian.reshape(-1, 5)     # (4B, 5): one matrix-vector product
-        self._separation = a.separation                        # e before loading, (B, 2, 2)
-        k_mean = float(a.stiffness.mean())
-        self.reference_stiffness = a.stiffness.size * k_mean * math.sqrt(1e-4 * self.bearing.ball_diameter)
 
     def _scaled_load(self, loads: Loads) -> np.ndarray:
         f = loads.as_array()
