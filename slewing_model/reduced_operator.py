@@ -178,10 +178,11 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     A diagonal that opened keeps its row in the operator with the stiffness it had when the
     operator was formed, until the next fresh one: a modified Newton step whose fixed point is
     the same, since the step's row of that contact, ``A^-1 (y_new - f) + (M dy) - J dq = 0``,
-    holds at the equilibrium with ``y = f = 0``. Its stiffness was small (it was about to
-    open), so the rate of the iteration barely changes, and dropping it would cost a pass over
-    ``W^-1`` that, as the ring turns, a contact closing again soon after would undo (measured
-    on the pitch bearing's steps: updates 0.93 -> 0.28 a step, docs/speed.md).
+    holds at the equilibrium with ``y = f = 0``. Its stiffness is that of when the operator
+    was formed, maybe some steps earlier: where it slows the iteration, the solve's refresh
+    rule forms a new operator. Dropping it would cost a pass over ``W^-1`` that, as the ring
+    turns, a contact closing again soon after would undo (measured on the pitch bearing's
+    steps: updates 0.93 -> 0.28 a step, docs/speed.md).
 
     A diagonal that closed must enter: its force is zero outside the operator's rows. With
     ``B = M`` (kept rows, new rows), ``C = (A^-1 + M)`` on the new rows, ``X = W^-1 B`` and
