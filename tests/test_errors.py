@@ -107,6 +107,14 @@ def test_assembly_at_another_rotation_equals_one_made_anew(table3, errors):
     assert (turned.groove_centre is previous.groove_centre) == (errors != "rings")
 
 
+def test_assembly_of_another_bearing_is_refused_as_previous(table3):
+    from conftest import BEARINGS
+
+    other = assemble(load_bearing(BEARINGS / "pitch_bearing.toml"))
+    with pytest.raises(ValueError, match=r"previous: an assembly of 150 balls.*not of this bearing \(67 balls"):
+        assemble(table3, 0.1, previous=other)
+
+
 def test_definition_with_csv_errors(tmp_path):
     errors = synthetic_errors(67, seed=2)
     write_ring_csv(tmp_path / "outer.csv", "outer", errors.outer)
