@@ -115,8 +115,19 @@ class BimeSolver:
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
+        self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
         self.assembly: Assembly | None = None
         self.set_rotation(psi, cage_angle)
+
+    @property
+    def operator(self):
+        """The reduced Newton operator kept between solves (flexible rings; None before the first,
+        :mod:`slewing_model.reduced_operator`): part of a co-simulation's state."""
+        return self._reduced
+
+    @operator.setter
+    def operator(self, op) -> None:
+        self._reduced, self._reduced_jacobian = op, None     # its coupling is checked against the Jacobian
 
     # ---- set-up -------------------------------------------------------------------
     def set_rotation(self, psi: float, cage_angle: float | None = None) -> None:
@@ -275,14 +286,16 @@ class BimeSolver:
         iterations = 0
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         point = self._evaluate(qs, y, f_scaled)
+        load_scale = float(np.abs(f_scaled).max())
         while True:
             f = point.force.ravel()
-            grad_q = self.jacobian.reshape(-1, 5).T @ f - f_scaled
-            scale = max(float(np.abs(f_scaled).max()), float(point.q.max()), 1e-300)
+            grad_q = self._jacobian_rows.T @ f - f_scaled
+            scale = max(load_scale, float(point.q.max()), 1e-300)
             residual = float(np.abs(grad_q).max())
             if flexible:
+                mismatch = f - point.y            # the Hertz forces less those the rings feel
                 scale = max(scale, float(np.abs(point.y).max()))
-                residual = max(residual, float(np.abs(f - point.y).max()))
+                residual = max(residual, float(np.abs(mismatch).max()))
             residual /= scale
             if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
@@ -302,11 +315,11 @@ class BimeSolver:
                 last_residual = residual
                 dq, dy = self._flexible_direction(point, f_scaled, mu, fresh)
                 m_dy = self.compliance @ dy       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
-                slope = float(grad_q @ dq) - float((f - point.y) @ m_dy)
+                slope = float(grad_q @ dq) - float(mismatch @ m_dy)
             else:
                 dq, dy = self._rigid_direction(point, grad_q, mu), point.y
                 slope = float(grad_q @ dq)
-            norm = float(np.linalg.norm(dq))
+            norm = math.sqrt(float(dq @ dq))
             if norm > trust:  # a step across a clearance is limited, then checked by the energy
                 dq, dy = dq * (trust / norm), dy * (trust / norm)
                 slope *= trust / norm
@@ -325,7 +338,7 @@ class BimeSolver:
             else:
                 raise NoEquilibriumError(f"line search failed (relative residual {residual:.2e}) for loads {loads}")
             point = trial
-            if np.linalg.norm(point.qs) > dw:
+            if float(point.qs @ point.qs) > dw * dw:
                 raise NoEquilibriumError(
                     f"no equilibrium for loads {loads}: the moving ring would move "
                     f"{np.linalg.norm(point.qs) * 1e3:.3g} mm, beyond the ball diameter ({dw * 1e3:g} mm); "
@@ -369,19 +382,20 @@ class BimeSolver:
         matrix-vector products only.
         """
         active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
-        rows = np.flatnonzero(np.repeat(active, 2))
-        if rows.size == 0:
+        if not active.any():
             self._reduced = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
         stiffness, op = self.assembly.stiffness, self._reduced
         if not fresh and op is not None:
-            # the ring may have turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-            op = turned_operator(op, self.jacobian, op.rows, op.active, mu)
+            if self._reduced_jacobian is not self._jacobian_rows:
+                # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
+                op = turned_operator(op, self.jacobian, op.rows, op.active, mu)
             if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
                 op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
         if fresh or op is None:
+            rows = np.flatnonzero(np.repeat(active, 2))
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)
-        self._reduced = op
+        self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         dq, y_new = newton_step(op, p, f_scaled)
         return dq, y_new - p.y
 

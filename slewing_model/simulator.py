@@ -239,7 +239,7 @@ class BearingSimulator:
         """Everything that affects the next step: the warm start, the rotation and
         the solver's reused Newton operator (numpy arrays, not copied: they are
         never changed in place). :func:`encode_state` makes it JSON data."""
-        operator = self.solver._reduced
+        operator = self.solver.operator
         return {"warm": self._warm, "previous": self._previous, "psi": self._psi,
                 "operator": None if operator is None else operator.as_tuple(), "friction": self._friction_warm}
 
@@ -249,7 +249,7 @@ class BearingSimulator:
         self._previous = None if state.get("previous") is None else np.asarray(state["previous"], dtype=float)
         self._psi = float(state["psi"])
         self.solver.set_rotation(self._psi)
-        self.solver._reduced = None if state["operator"] is None else ReducedOperator.from_tuple(state["operator"])
+        self.solver.operator = None if state["operator"] is None else ReducedOperator.from_tuple(state["operator"])
         self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
 
 
