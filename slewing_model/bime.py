@@ -58,7 +58,10 @@ from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the erro
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
 from .geometry import RING_CONTACTS, Bearing
-from .reduced_operator import assemble_operator, newton_step, turned_operator, update_operator
+from .reduced_operator import (
+    PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator, newton_step, start_operator,
+    turned_operator, update_operator,
+)
 from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
 
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
@@ -68,6 +71,10 @@ REFRESH = 0.25
 #: more iterations, which cost less than a new operator (pitch bearing: 3 of 0.1 ms against
 #: one operator of 2.5 ms, 4 ms when this was measured; docs/speed.md)
 FINISH_ITERATIONS = 3
+#: in a warm solve a new operator is inverted over this solve and the next, while the solver goes on
+#: with the one it has (:class:`slewing_model.reduced_operator.PendingOperator`); all at once when an
+#: iteration past this many in one solve is still slow (docs/speed.md)
+SPREAD_ITERATIONS = 8
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
 
@@ -116,6 +123,8 @@ class BimeSolver:
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
+        self._pending = None  # a new operator being inverted over two solves (flexible, warm solves)
+        self._stage_due = self._spread = False  # per solve: a stage of the pending operator is due; it may be spread
         self.assembly: Assembly | None = None
         self.set_rotation(psi, cage_angle)
 
@@ -128,6 +137,15 @@ class BimeSolver:
     @operator.setter
     def operator(self, op) -> None:
         self._reduced, self._reduced_jacobian = op, None     # its coupling is checked against the Jacobian
+
+    @property
+    def pending_operator(self) -> PendingOperator | None:
+        """A new operator being inverted over two solves, or None: part of the state too."""
+        return self._pending
+
+    @pending_operator.setter
+    def pending_operator(self, pending: PendingOperator | None) -> None:
+        self._pending = pending
 
     # ---- set-up -------------------------------------------------------------------
     def set_rotation(self, psi: float, cage_angle: float | None = None) -> None:
@@ -285,6 +303,7 @@ class BimeSolver:
         mu = 1e-12 * self.reference_stiffness
         iterations = 0
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
+        self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
         point = self._evaluate(qs, y, f_scaled)
         load_scale = float(np.abs(f_scaled).max())
         while True:
@@ -313,7 +332,7 @@ class BimeSolver:
                     # slow, but the iterations this rate still needs are few: they cost less than a new operator
                     fresh = math.log(self.rtol / residual) < FINISH_ITERATIONS * math.log(residual / last_residual)
                 last_residual = residual
-                dq, dy = self._flexible_direction(point, f_scaled, mu, fresh)
+                dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
                 m_dy = self.compliance @ dy       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
                 slope = float(grad_q @ dq) - float(mismatch @ m_dy)
             else:
@@ -369,7 +388,7 @@ class BimeSolver:
         h = jac.reshape(-1, 5).T @ (p.hess.reshape(-1, 2, 2) @ jac.reshape(-1, 2, 5)).reshape(-1, 5)
         return np.linalg.solve(h + mu * np.eye(5), -grad_q)
 
-    def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float, fresh: bool):
+    def _flexible_direction(self, p: "_Point", f_scaled: np.ndarray, mu: float, fresh: bool, iterations: int):
         """Newton step of the flexible model, reduced to the active contacts
         (:mod:`slewing_model.reduced_operator`): returns the increments of ``qs`` and ``y``.
 
@@ -380,12 +399,31 @@ class BimeSolver:
         solve loop asks for a fresh one when convergence slows. Between warm-started
         solves of slowly changing loads (the FMU's steps) an iteration then costs
         matrix-vector products only.
+
+        In a warm solve a fresh operator is formed at once but inverted over this solve and
+        the next (:class:`PendingOperator`), while the kept one goes on; at once when an
+        iteration past :data:`SPREAD_ITERATIONS` of one solve is still slow.
         """
         active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
         if not active.any():
-            self._reduced = None
+            self._reduced = self._pending = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
-        stiffness, op = self.assembly.stiffness, self._reduced
+        stiffness, op, pending = self.assembly.stiffness, self._reduced, self._pending
+        if pending is not None:
+            if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
+                pending = complete_operator(pending, self.jacobian, mu)
+            elif self._stage_due:                                              # one stage a solve
+                pending = advance_operator(pending, self.jacobian, mu)
+            self._stage_due = False
+            if isinstance(pending, ReducedOperator):     # inverted: its coupling is that of the Jacobian now
+                op, pending, fresh = pending, None, False
+                self._reduced_jacobian = self._jacobian_rows
+            else:
+                fresh = False
+        elif fresh and op is not None and self._spread:
+            pending = start_operator(p, self.compliance, stiffness, np.flatnonzero(np.repeat(active, 2)), active)
+            fresh = self._stage_due = False
+        self._pending = pending
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
@@ -395,6 +433,7 @@ class BimeSolver:
         if fresh or op is None:
             rows = np.flatnonzero(np.repeat(active, 2))
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)
+            self._pending = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         dq, y_new = newton_step(op, p, f_scaled)
         return dq, y_new - p.y

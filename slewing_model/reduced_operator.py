@@ -21,7 +21,7 @@ Run-time module: numpy.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -141,17 +141,36 @@ def spd_inverse(w: np.ndarray) -> np.ndarray:
     instead of 1e-11 on the 592 rows of the pitch bearing's cold start; symmetric, as
     ``np.linalg.inv``'s). The flops are matrix products, which BLAS
     runs near the machine's peak; ``np.linalg.inv`` (LU, then ``n`` triangular solves) is
-    twice as slow on one thread at 380 rows (``docs/speed.md``)."""
-    n = w.shape[0]
-    if n <= LEAF:
+    twice as slow on one thread at 380 rows (``docs/speed.md``).
+
+    The top level is three stages (:data:`HALVES`), which :class:`PendingOperator` spreads
+    over two steps."""
+    if w.shape[0] <= LEAF:
         inverse = np.linalg.inv(w)
         return 0.5 * (inverse + inverse.T)
-    h = n // 2
+    parts = ()
+    for stage in HALVES:
+        parts = stage(w, *parts)
+    return parts[0]
+
+
+def _first_half(w):
+    """``A^-1`` and ``X = A^-1 B`` (5/12 of the flops)."""
+    h = w.shape[0] // 2
     a_inv = spd_inverse(w[:h, :h])
-    b = w[:h, h:]
-    x = a_inv @ b
-    schur = w[h:, h:] - b.T @ x
-    s_inv = spd_inverse(0.5 * (schur + schur.T))
+    return a_inv, a_inv @ w[:h, h:]
+
+
+def _second_half(w, a_inv, x):
+    """... and ``S^-1``, ``S = D - B^T X`` (5/12)."""
+    h = w.shape[0] // 2
+    schur = w[h:, h:] - w[:h, h:].T @ x
+    return a_inv, x, spd_inverse(0.5 * (schur + schur.T))
+
+
+def _joined(w, a_inv, x, s_inv):
+    """... and ``w^-1`` from them (6/12)."""
+    h = w.shape[0] // 2
     y = x @ s_inv
     out = np.empty_like(w)
     corner = a_inv + y @ x.T
@@ -159,16 +178,82 @@ def spd_inverse(w: np.ndarray) -> np.ndarray:
     out[:h, h:] = -y
     out[h:, :h] = -y.T
     out[h:, h:] = s_inv
-    return out
+    return (out,)
 
 
-def assemble_operator(point, compliance, stiffness, jacobian, rows, active, mu) -> ReducedOperator:
-    """Form and invert ``W = (A^-1 + M)_aa`` at an iterate: O(n^3). ``W`` is symmetric positive
-    definite (``A^-1`` the springs' compliance, ``M`` the rings')."""
+#: the stages of :func:`spd_inverse`'s top level, each taking ``w`` and the last one's results
+HALVES = (_first_half, _second_half, _joined)
+#: the same as the steps of a :class:`PendingOperator`: ``A^-1 B`` on the step that forms ``W``
+#: (with ``W``'s gathering, about half the work), the rest on the next (measured against three
+#: steps and against the split 10/12 | 6/12: docs/speed.md)
+SPREAD_STAGES = ((_first_half,), (_second_half, _joined))
+
+
+@dataclass(frozen=True)
+class PendingOperator:
+    """A new reduced operator formed at an iterate and inverted over two steps.
+
+    Inverting ``W`` is about 2.5 ms on the pitch bearing, more than a whole step: made at
+    once, it is what the slowest steps of a co-simulation spend (the 95th and 99th
+    percentiles). :func:`start_operator` forms ``W`` and runs the first of
+    :data:`SPREAD_STAGES`, :func:`advance_operator` the next; meanwhile the solver goes on
+    with the operator it has (a modified Newton step: slower, as exact). ``parts`` are the
+    last stage's results (see :data:`HALVES`)."""
+
+    rows: np.ndarray
+    active: np.ndarray
+    contact_compliance: np.ndarray
+    matrix: np.ndarray
+    stage: int
+    parts: tuple
+
+    def as_tuple(self) -> tuple:
+        """The arrays (not copied) and the stage: a solver state to keep or serialise."""
+        return (self.rows, self.active, self.contact_compliance, self.matrix, self.stage, *self.parts)
+
+    @classmethod
+    def from_tuple(cls, values) -> "PendingOperator":
+        rows, active, a_inv, matrix, stage, *parts = values
+        return cls(*(np.asarray(v) for v in (rows, active, a_inv, matrix)), int(stage),
+                   tuple(np.asarray(v) for v in parts))
+
+
+def start_operator(point, compliance, stiffness, rows, active) -> PendingOperator:
+    """Form ``W = (A^-1 + M)_aa`` at an iterate (``A^-1`` the springs' compliance there, ``M``
+    the rings'; symmetric positive definite) and run the first stage of its inverse."""
     a_inv = contact_compliance_blocks(point, stiffness, active)
     w_mat = np.asarray(compliance).take(rows, axis=0).take(rows, axis=1)   # M_aa (3x faster than np.ix_)
     _add_blocks(w_mat, a_inv)
-    return reduced_operator(rows, active, a_inv, spd_inverse(w_mat), jacobian, mu)
+    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
+
+
+def advance_operator(pending: PendingOperator, jacobian, mu) -> "PendingOperator | ReducedOperator":
+    """The next of :data:`SPREAD_STAGES`; after the last, the operator with its coupling to the
+    Jacobian (4B, 5) of now (``jacobian`` None: the pending operator, inverted). A small ``W``
+    is inverted in one stage."""
+    if pending.stage < len(SPREAD_STAGES):
+        if pending.matrix.shape[0] <= LEAF:
+            pending = replace(pending, stage=len(SPREAD_STAGES), parts=(spd_inverse(pending.matrix),))
+        else:
+            parts = pending.parts
+            for stage in SPREAD_STAGES[pending.stage]:
+                parts = stage(pending.matrix, *parts)
+            pending = replace(pending, stage=pending.stage + 1, parts=parts)
+    if pending.stage < len(SPREAD_STAGES) or jacobian is None:
+        return pending
+    return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu)
+
+
+def complete_operator(pending: PendingOperator, jacobian, mu) -> ReducedOperator:
+    """The remaining stages at once."""
+    while isinstance(pending, PendingOperator):
+        pending = advance_operator(pending, jacobian, mu)
+    return pending
+
+
+def assemble_operator(point, compliance, stiffness, jacobian, rows, active, mu) -> ReducedOperator:
+    """Form and invert ``W = (A^-1 + M)_aa`` at an iterate: O(n^3)."""
+    return complete_operator(start_operator(point, compliance, stiffness, rows, active), jacobian, mu)
 
 
 def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu

@@ -21,7 +21,7 @@ from .blas import blas_threads
 from .friction import friction_torque, regularised_torque
 from .friction_kernel import compile_all, use_compiled
 from .geometry import Bearing
-from .reduced_operator import ReducedOperator
+from .reduced_operator import PendingOperator, ReducedOperator
 
 RING_MODELS = ("rigid", "flexible")
 LOAD_FRAMES = ("fixed", "rotating")
@@ -239,9 +239,10 @@ class BearingSimulator:
         """Everything that affects the next step: the warm start, the rotation and
         the solver's reused Newton operator (numpy arrays, not copied: they are
         never changed in place). :func:`encode_state` makes it JSON data."""
-        operator = self.solver.operator
+        operator, pending = self.solver.operator, self.solver.pending_operator
         return {"warm": self._warm, "previous": self._previous, "psi": self._psi,
-                "operator": None if operator is None else operator.as_tuple(), "friction": self._friction_warm}
+                "operator": None if operator is None else operator.as_tuple(),
+                "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm}
 
     def set_state(self, state: dict) -> None:
         """Restore :meth:`get_state` (or its :func:`decode_state`)."""
@@ -250,6 +251,8 @@ class BearingSimulator:
         self._psi = float(state["psi"])
         self.solver.set_rotation(self._psi)
         self.solver.operator = None if state["operator"] is None else ReducedOperator.from_tuple(state["operator"])
+        pending = state.get("pending")
+        self.solver.pending_operator = None if pending is None else PendingOperator.from_tuple(pending)
         self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
 
 

@@ -172,6 +172,31 @@ def test_inverse_by_halves_is_as_exact_as_lapack():
         assert np.abs(halves - lapack).max() <= 1e-8 * np.abs(lapack).max()
 
 
+def test_inverse_spread_over_two_steps_equals_the_inverse_at_once():
+    """The new operator's inverse in the stages of two steps, its state serialised between them
+    (a co-simulation's rollback), is :func:`spd_inverse`'s bit for bit."""
+    import json
+
+    from conftest import BEARINGS
+    from slewing_model import load_bearing
+    from slewing_model.reduced_operator import PendingOperator, advance_operator, spd_inverse
+    from slewing_model.ring_compliance import contact_compliance, ring_compliances
+    from slewing_model.simulator import decode_state, encode_state
+    from slewing_model.superelement import build_superelement
+
+    bearing = load_bearing(BEARINGS / "pitch_bearing.toml")
+    rings = np.asarray(contact_compliance(ring_compliances(build_superelement(bearing, mesh="coarse", bc="free"))))
+    rng = np.random.default_rng(2)
+    for rows in (40, 377):
+        w = rings[:rows, :rows] + np.diag(rng.uniform(0.2, 2.0, rows) * 1e-3 * np.abs(rings).max())
+        pending = advance_operator(PendingOperator(np.arange(rows), np.ones(rows // 2, bool), np.zeros((rows // 2, 2, 2)),
+                                                   w, 0, ()), None, None)
+        saved = json.loads(json.dumps(encode_state(pending.as_tuple())))
+        pending = advance_operator(PendingOperator.from_tuple(decode_state(saved)), None, None)
+        assert pending.stage == 2
+        assert np.array_equal(pending.parts[0], spd_inverse(w))
+
+
 def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing):
     """Contacts closing (the kept inverse bordered by their rows; those that opened keep theirs)
     give the inverse, coupling and Schur complement that forming and inverting the operator on

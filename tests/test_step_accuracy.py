@@ -79,3 +79,32 @@ def test_balls_balance_the_applied_load_at_every_step(stepped):
         assert np.abs(balance - applied).max() <= 1e-6 * scale, (
             f"{case.name}, step {k}: contact forces {balance} against applied {applied} (scale {scale:.3g} N)")
 
+
+
+def test_state_taken_while_a_new_operator_is_pending_repeats_the_steps():
+    """A new ring operator is inverted over two steps (``reduced_operator.PendingOperator``): a state
+    taken between them, serialised as the FMU does, repeats the next steps to the last bit."""
+    import json
+
+    from slewing_model.simulator import decode_state, encode_state
+
+    case = CASES["pitch"](STEPS)
+    bearing = load_bearing(case.bearing)
+    sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"), _settings(case))
+
+    def step(k):
+        r = sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k])
+        return r.distribution.contact_load, r.distribution.displacement, r.friction_torque
+
+    k = 0
+    while sim.solver.pending_operator is None:
+        step(k)
+        k += 1
+        assert k < STEPS - 5, "no new operator was pending within the case"
+    saved = json.loads(json.dumps(encode_state(sim.get_state())))
+    first = [step(j) for j in range(k, k + 5)]
+    sim.set_state(decode_state(saved))
+    assert sim.solver.pending_operator is not None
+    again = [step(j) for j in range(k, k + 5)]
+    for (q1, d1, t1), (q2, d2, t2) in zip(first, again):
+        assert np.array_equal(q1, q2) and np.array_equal(d1, d2) and t1 == t2
