@@ -105,7 +105,8 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     previous : Assembly, optional
         This bearing assembled at another rotation. Where neither ring has
         errors, every ball sees the same grooves at any ``psi`` (each ball keeps
-        its own diameter), so only the angles change: the rest is taken from it.
+        its own diameter), so only the angles change: the rest is taken from it;
+        where no ring has measured groove radii, so are the radii and stiffnesses.
 
     Returns
     -------
@@ -114,16 +115,18 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     n = bearing.ball_count
     cage = cage_ratio(bearing) * psi if cage_angle is None else cage_angle
     phi = bearing.ball_angles + cage
-    if previous is not None and not rings_have_errors(bearing):
+    if previous is not None:
         if previous.ball_diameter.shape != (n,) or previous.moving_sign != (1.0 if bearing.moving_ring == "inner" else -1.0):
             raise ValueError(f"previous: an assembly of {previous.ball_diameter.shape[0]} balls, moving sign "
                              f"{previous.moving_sign:+g}: not of this bearing ({n} balls, {bearing.moving_ring} ring moving)")
-        return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi)
+        if not rings_have_errors(bearing):
+            return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi)
     centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()
     radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
     dw = np.full(n, bearing.ball_diameter + bearing.preload)
 
     errors = bearing.errors
+    measured_radius = False
     if errors is not None:
         for ring in ("outer", "inner"):
             error_map = getattr(errors, ring)
@@ -136,9 +139,12 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
             centre[:, cols, 1] += d_axial
             if rc is not None:
                 radius[:, cols] = rc
+                measured_radius = True
         if errors.ball_diameter_deviation is not None:
             dw = dw + errors.ball_diameter_deviation
 
+    if previous is not None and not measured_radius:      # the same grooves' radii under every ball
+        return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi, groove_centre=centre)
     k = houpert_stiffness(dw[:, None], dw[:, None] / (2.0 * radius), bearing.youngs_modulus, bearing.poisson_ratio)
     k_tot = diagonal_stiffness(k[:, OUTER_OF_DIAGONAL], k[:, INNER_OF_DIAGONAL])
     natural = radius[:, OUTER_OF_DIAGONAL] + radius[:, INNER_OF_DIAGONAL] - dw[:, None]

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
+from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble, rings_have_errors
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -124,6 +124,7 @@ class BimeSolver:
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
         self._pending = None  # a new operator being inverted over two solves (flexible, warm solves)
+        self._rigid_turn = not rings_have_errors(bearing)  # a turn of the ring only turns the Jacobian's columns
         self._stage_due = self._spread = False  # per solve: a stage of the pending operator is due; it may be spread
         self.assembly: Assembly | None = None
         self.set_rotation(psi, cage_angle)
@@ -427,7 +428,7 @@ class BimeSolver:
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, op.rows, op.active, mu)
+                op = turned_operator(op, self.jacobian, op.rows, op.active, mu, may_turn=self._rigid_turn)
             if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
                 op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
         if fresh or op is None:

@@ -91,7 +91,8 @@ def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.nda
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
 
-def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu) -> ReducedOperator:
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu, may_turn: bool = True
+                    ) -> ReducedOperator:
     """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
 
     ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
@@ -100,13 +101,14 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu)
     ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
     ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``. ``T`` is
     fitted by least squares and used where it reproduces ``J_new`` to 1e-12; otherwise (errors
-    move the groove centres with the ring) the coupling is formed anew. The operator itself
-    when the Jacobian did not change."""
+    move the groove centres with the ring) the coupling is formed anew, without the fit where
+    the caller knows it (``may_turn`` False). The operator itself when the Jacobian did not
+    change."""
     ja = jacobian.reshape(-1, 5)[rows]
     if np.array_equal(op.jacobian, ja):
         return op
     coupling = None
-    if op.jacobian.shape == ja.shape:
+    if may_turn and op.jacobian.shape == ja.shape:
         old = op.jacobian
         try:            # J_a has rank < 5 on fewer than three loaded diagonals: then formed anew
             turn = np.linalg.solve(old.T @ old, old.T @ ja)

@@ -89,22 +89,28 @@ def test_errors_turn_with_their_ring(table3):
     assert np.allclose(a.groove_centre[:, 0, 0] - table3.groove_centres[0, 0], r_out[:, 0])
 
 
-@pytest.mark.parametrize("errors", ["none", "balls", "rings"])
+@pytest.mark.parametrize("errors", ["none", "balls", "rings", "radii"])
 def test_assembly_at_another_rotation_equals_one_made_anew(table3, errors):
     """Reassembling from the assembly at another rotation (what a solver does each step) gives
     what assembling anew gives: without ring errors only the angles change (ball diameter
-    deviations turn with their balls), with them the grooves under the balls are read again."""
+    deviations turn with their balls), with them the grooves under the balls are read again,
+    and with measured groove radii their stiffnesses too."""
     synthetic = synthetic_errors(table3.ball_count, seed=3)
+    outer = synthetic.outer
+    measured = RingErrorMap(outer.angle, outer.radial, outer.axial,
+                            table3.groove_radius[0] * (1.0 + 1e-3 * np.sin(outer.angle))[:, None] * np.ones(2))
     bearing = {"none": table3,
                "balls": table3.with_errors(ManufacturingErrors(ball_diameter_deviation=synthetic.ball_diameter_deviation)),
-               "rings": table3.with_errors(synthetic)}[errors]
+               "rings": table3.with_errors(synthetic),
+               "radii": table3.with_errors(ManufacturingErrors(outer=measured, inner=synthetic.inner))}[errors]
     previous = assemble(bearing, 0.2)
     for psi, cage in ((0.7, None), (-1.3, 0.4)):
         turned, fresh = assemble(bearing, psi, cage, previous=previous), assemble(bearing, psi, cage)
         for name in ("psi", "cage_angle", "ball_angle", "groove_centre", "groove_radius", "ball_diameter",
                      "contact_stiffness", "stiffness", "natural_length", "moving_sign"):
             assert np.array_equal(getattr(turned, name), getattr(fresh, name)), name
-    assert (turned.groove_centre is previous.groove_centre) == (errors != "rings")
+    assert (turned.groove_centre is previous.groove_centre) == (errors in ("none", "balls"))
+    assert (turned.stiffness is previous.stiffness) == (errors != "radii")
 
 
 def test_assembly_of_another_bearing_is_refused_as_previous(table3):
