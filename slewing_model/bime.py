@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble, rings_have_errors
+from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -124,7 +124,8 @@ class BimeSolver:
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
         self._pending = None  # a new operator being inverted over two solves (flexible, warm solves)
-        self._rigid_turn = not rings_have_errors(bearing)  # a turn of the ring only turns the Jacobian's columns
+        # a turn of the ring only turns the Jacobian's columns where the moving ring's grooves have no errors
+        self._rigid_turn = bearing.errors is None or getattr(bearing.errors, bearing.moving_ring) is None
         self._stage_due = self._spread = False  # per solve: a stage of the pending operator is due; it may be spread
         self.assembly: Assembly | None = None
         self.set_rotation(psi, cage_angle)
@@ -305,6 +306,8 @@ class BimeSolver:
         iterations = 0
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
+        if initial is None:
+            self._pending = None                  # a cold solve depends on nothing before it
         point = self._evaluate(qs, y, f_scaled)
         load_scale = float(np.abs(f_scaled).max())
         while True:
@@ -402,8 +405,9 @@ class BimeSolver:
         matrix-vector products only.
 
         In a warm solve a fresh operator is formed at once but inverted over this solve and
-        the next (:class:`PendingOperator`), while the kept one goes on; at once when an
-        iteration past :data:`SPREAD_ITERATIONS` of one solve is still slow.
+        the next (:class:`PendingOperator`), while the kept one goes on: at most one stage a
+        solve, and all at once when an iteration past :data:`SPREAD_ITERATIONS` of one solve
+        is still slow or the kept operator cannot follow the contacts that closed.
         """
         active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
         if not active.any():
@@ -421,7 +425,7 @@ class BimeSolver:
                 self._reduced_jacobian = self._jacobian_rows
             else:
                 fresh = False
-        elif fresh and op is not None and self._spread:
+        elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
             pending = start_operator(p, self.compliance, stiffness, np.flatnonzero(np.repeat(active, 2)), active)
             fresh = self._stage_due = False
         self._pending = pending
@@ -431,6 +435,10 @@ class BimeSolver:
                 op = turned_operator(op, self.jacobian, op.rows, op.active, mu, may_turn=self._rigid_turn)
             if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
                 op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
+            if op is None and self._pending is not None:     # too many closed: the pending one, at once
+                op, self._pending = complete_operator(self._pending, self.jacobian, mu), None
+                if np.any(active & ~op.active):
+                    op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
         if fresh or op is None:
             rows = np.flatnonzero(np.repeat(active, 2))
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)

@@ -197,6 +197,24 @@ def test_inverse_spread_over_two_steps_equals_the_inverse_at_once():
         assert np.array_equal(pending.parts[0], spd_inverse(w))
 
 
+def test_cold_solve_does_not_depend_on_the_solves_before(bearing):
+    """A solve without a warm start is the same whatever the solver did before, a new operator
+    left half inverted by a warm solve included (found by a review: it was completed later
+    in the cold solve instead of one formed there)."""
+    rings = synthetic_superelement(bearing.ball_count)
+    solver = BimeSolver(bearing, rings, rtol=1e-10)
+    result = solver.solve(Loads(Fz=5e4, My=1e4))
+    k = 0
+    while solver.pending_operator is None:              # warm solves of a growing moment, until one slows
+        k += 1
+        assert k < 40, "no new operator was left pending"
+        result = solver.solve(Loads(Fz=5e4, My=1e4 * (1 + 0.15 * k)), initial=result)
+    cold = solver.solve(Loads(Fz=5e4, My=1e4 * (1 + 0.15 * k)))
+    fresh = BimeSolver(bearing, rings, rtol=1e-10).solve(Loads(Fz=5e4, My=1e4 * (1 + 0.15 * k)))
+    assert solver.pending_operator is None
+    assert np.array_equal(cold.state, fresh.state) and cold.iterations == fresh.iterations
+
+
 def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing):
     """Contacts closing (the kept inverse bordered by their rows; those that opened keep theirs)
     give the inverse, coupling and Schur complement that forming and inverting the operator on
