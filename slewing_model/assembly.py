@@ -116,9 +116,11 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     cage = cage_ratio(bearing) * psi if cage_angle is None else cage_angle
     phi = bearing.ball_angles + cage
     if previous is not None:
-        if previous.ball_diameter.shape != (n,) or previous.moving_sign != (1.0 if bearing.moving_ring == "inner" else -1.0):
+        sign = 1.0 if bearing.moving_ring == "inner" else -1.0
+        if previous.ball_diameter.shape != (n,) or previous.moving_sign != sign:
             raise ValueError(f"previous: an assembly of {previous.ball_diameter.shape[0]} balls, moving sign "
-                             f"{previous.moving_sign:+g}: not of this bearing ({n} balls, {bearing.moving_ring} ring moving)")
+                             f"{previous.moving_sign:+g}: not of this bearing ({n} balls, "
+                             f"{bearing.moving_ring} ring moving)")
         if not rings_have_errors(bearing):
             return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi)
     centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()

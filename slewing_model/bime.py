@@ -59,8 +59,8 @@ from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the erro
 )
 from .geometry import RING_CONTACTS, Bearing
 from .reduced_operator import (
-    PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator, newton_step, start_operator,
-    turned_operator, update_operator,
+    PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator, newton_step,
+    start_operator, turned_operator, update_operator,
 )
 from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
 
