@@ -87,7 +87,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
 
 
 def ship_compiled_kernels(fmu) -> list[Path]:
-    """Add numba's cache of the friction loops to the FMU's copy of ``slewing_model``.
+    """Add numba's cache of the compiled loops (friction, contacts) to the FMU's copy of ``slewing_model``.
 
     An instance compiles the loops when it starts (:func:`slewing_model.friction_kernel.compile_all`),
     about ten seconds, unless numba's cache beside the source holds them: numba keys that cache
@@ -104,8 +104,9 @@ def ship_compiled_kernels(fmu) -> list[Path]:
     friction_kernel.compile_all()
     cache = Path(friction_kernel.__file__).parent / "__pycache__"
     tag = f"py{sys.version_info.major}{sys.version_info.minor}"      # numba adds the ABI flags (py311t)
-    files = [f for _, function in friction_kernel.KERNELS
-             for f in cache.glob(f"friction_kernel.{function.__name__}-{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
+    files = [f for _, function in friction_kernel.all_kernels()
+             for f in cache.glob(f"{function.__module__.rsplit('.', 1)[-1]}.{function.__name__}-"
+                                 f"{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
     if not files:
         warnings.warn(f"numba's cache of the friction loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
                       "writable): the FMU will compile them when instantiated (about 10 s)")

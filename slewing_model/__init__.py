@@ -18,9 +18,10 @@ from .friction import FrictionTorque, catalogue_torque, friction_torque
 __version__ = "0.1.0"
 
 #: the run-time part of the package (numpy and the standard library): the modules an FMU carries
-RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "assembly", "distribution", "ring_stiffness",
-                   "ring_compliance", "reduced_operator", "bime", "blas", "ellipse_quadrature", "contact_friction",
-                   "ball_kinematics", "friction_kernel", "catalogue", "friction_studies", "friction", "simulator")
+RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "contact_kernel", "assembly", "distribution",
+                   "ring_stiffness", "ring_compliance", "reduced_operator", "bime", "blas", "ellipse_quadrature",
+                   "contact_friction", "ball_kinematics", "friction_kernel", "catalogue", "friction_studies",
+                   "friction", "simulator")
 
 __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",

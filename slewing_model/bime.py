@@ -54,9 +54,11 @@ import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
+from .contact_kernel import compiled_spring_terms, ellipse_axes
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
+from .friction_kernel import use_compiled
 from .geometry import RING_CONTACTS, Bearing
 from .reduced_operator import (
     PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator, newton_step,
@@ -77,6 +79,7 @@ FINISH_ITERATIONS = 3
 SPREAD_ITERATIONS = 8
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
+INNER_CONTACT = CONTACT_RING == "inner"
 
 
 class BimeSolver:
@@ -103,10 +106,16 @@ class BimeSolver:
         (:class:`LoadCapacityError`). Default ``2 x 4200 MPa``: twice the ISO 76
         permanent-deformation limit (static safety factor 0.125), gross plastic
         deformation where the elastic Hertz model no longer holds.
+    kernel : {"auto", "numpy", "compiled"}
+        How the springs of the flexible model and the result's Hertz ellipses are
+        evaluated: numpy array operations, or compiled loops
+        (:mod:`slewing_model.contact_kernel`, needs numba); "auto" takes the compiled
+        loops where numba is installed. The same results to round-off.
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
-                 rtol: float = 1e-10, max_iterations: int = 200, pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT):
+                 rtol: float = 1e-10, max_iterations: int = 200, pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT,
+                 kernel: str = "auto"):
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
             raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
                              f"the bearing ball_count = {bearing.ball_count}")
@@ -116,6 +125,8 @@ class BimeSolver:
         self.rtol = rtol
         self.max_iterations = max_iterations
         self.pressure_limit = pressure_limit
+        self.kernel = kernel
+        self._compiled = use_compiled(kernel, "kernel")    # the springs and ellipses as compiled loops
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
         self.ring_compliance = None if superelement is None else ring_compliances(superelement)
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
@@ -294,7 +305,7 @@ class BimeSolver:
         elif flexible:
             # start from the rigid solution: the rings feel its contact forces
             rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, cage_angle=self.assembly.cage_angle, rtol=1e-6,
-                               max_iterations=self.max_iterations)
+                               max_iterations=self.max_iterations, kernel=self.kernel)
             rigid.edge_angle = np.full(4, np.pi)  # no capacity checks on the starting guess
             rigid.pressure_limit = math.inf
             start = rigid.solve(loads)
@@ -373,15 +384,22 @@ class BimeSolver:
                   my: np.ndarray | None = None) -> "_Point":
         """Contact terms and total energy at the unknowns ``(qs, y)``; ``my``: ``M y`` if known
         (along a search line it is linear in the step)."""
-        e = self._separation + (self._jacobian_rows @ qs).reshape(self.jacobian.shape[:-1])
         ring = 0.0
-        if self.compliance is not None:
-            if my is None:
-                my = self.compliance @ y
-            e = e - my.reshape(e.shape)       # e_D = -M y: groove centres moved by ring deformation
+        if self.compliance is not None and my is None:
+            my = self.compliance @ y
+        if self.compliance is not None and self._compiled:      # the same formulas, one compiled loop
+            a = self.assembly
+            e, delta, q, force, n, length, energy = compiled_spring_terms()(
+                self._separation, self._jacobian_rows, qs, my, a.natural_length, a.stiffness)
+            hess = None
             ring = 0.5 * float(y @ my)        # eq 15
-        # the flexible step takes the springs' compliance from n, delta, q (reduced_operator)
-        delta, q, force, energy, hess, n, length = self._contacts(e, hessian=self.compliance is None)
+        else:
+            e = self._separation + (self._jacobian_rows @ qs).reshape(self.jacobian.shape[:-1])
+            if self.compliance is not None:
+                e = e - my.reshape(e.shape)   # e_D = -M y: groove centres moved by ring deformation
+                ring = 0.5 * float(y @ my)    # eq 15
+            # the flexible step takes the springs' compliance from n, delta, q (reduced_operator)
+            delta, q, force, energy, hess, n, length = self._contacts(e, hessian=self.compliance is None)
         work = float(f_scaled @ qs)
         # the total is a difference of larger terms: its roundoff scales with them
         return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work), my)
@@ -461,9 +479,13 @@ class BimeSolver:
         ring_disp = None
         if flexible:
             ring_disp = self._ring_displacement(y)
-        ell = hertz_ellipse(contact_load, a.ball_diameter[:, None], a.groove_radius, contact_angle,
-                            b.pitch_diameter, CONTACT_RING, b.youngs_modulus, b.poisson_ratio)
-        semi_a, semi_b, pressure = ell.a, ell.b, ell.max_pressure
+        if self._compiled:                    # the same formulas, one compiled loop (contact_kernel)
+            semi_a, semi_b, pressure = ellipse_axes(contact_load, a.ball_diameter, a.groove_radius, contact_angle,
+                                                    b.pitch_diameter, INNER_CONTACT, b.youngs_modulus, b.poisson_ratio)
+        else:
+            ell = hertz_ellipse(contact_load, a.ball_diameter[:, None], a.groove_radius, contact_angle,
+                                b.pitch_diameter, CONTACT_RING, b.youngs_modulus, b.poisson_ratio)
+            semi_a, semi_b, pressure = ell.a, ell.b, ell.max_pressure
         # the contact point must stay on the raceway: beyond the groove edge the ball rides the
         # edge and the model (and the bearing) no longer carries the load
         off = (contact_load > 0.0) & (contact_angle >= self.edge_angle[None, :])

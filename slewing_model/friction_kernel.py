@@ -438,7 +438,15 @@ KERNELS = ((compiled_evaluate_points, _evaluate_points), (compiled_point_coeffic
            (compiled_minimise_balls, _minimise_balls), (compiled_tractions, _tractions))
 
 
+def all_kernels() -> tuple:
+    """The compiled loops of a step, the friction's and the load distribution's
+    (:mod:`slewing_model.contact_kernel`): (factory, Python function) pairs."""
+    from . import contact_kernel
+
+    return KERNELS + contact_kernel.KERNELS
+
+
 def compile_all() -> None:
     """Compile the loops, or load them from numba's cache (what an FMU instance does when it starts)."""
-    for factory, _ in KERNELS:
+    for factory, _ in all_kernels():
         factory()

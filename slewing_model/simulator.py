@@ -74,6 +74,9 @@ class SimulatorSettings:
         How the friction model runs its loops over points and balls (``kernel`` of
         :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loops
         where numba is installed, numpy otherwise; the results are the same to round-off.
+    contact_kernel : {"auto", "numpy", "compiled"}
+        The same for the load distribution's loops over the contacts (the springs of the
+        flexible model, the Hertz ellipses: ``kernel`` of :class:`slewing_model.bime.BimeSolver`).
     """
 
     ring_model: str = "flexible"
@@ -87,12 +90,14 @@ class SimulatorSettings:
     friction_tolerance: float = 1e-5
     blas_threads: int | None = 1
     friction_kernel: str = "auto"
+    contact_kernel: str = "auto"
 
     def __post_init__(self):
         _choice("ring_model", self.ring_model, RING_MODELS)
         _choice("moving_ring", self.moving_ring, ("inner", "outer"))
         _choice("load_frame", self.load_frame, LOAD_FRAMES)
         use_compiled(self.friction_kernel, "friction_kernel")
+        use_compiled(self.contact_kernel, "contact_kernel")
         for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation", "friction_tolerance"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
@@ -165,8 +170,8 @@ class BearingSimulator:
             bearing = bearing.with_preload(s.preload)
         self.bearing = bearing
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
-                                 rtol=s.tolerance)
-        if use_compiled(s.friction_kernel, "friction_kernel"):
+                                 rtol=s.tolerance, kernel=s.contact_kernel)
+        if use_compiled(s.friction_kernel, "friction_kernel") or use_compiled(s.contact_kernel, "contact_kernel"):
             compile_all()     # compiled (or loaded from numba's cache) now, not in a step
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm

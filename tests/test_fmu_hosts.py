@@ -303,10 +303,11 @@ def test_the_fmu_holds_no_path_of_the_building_machine_outside_its_python_file(t
         names = z.namelist()
         assert runtime in names and not any(n.endswith("python_paths.json") for n in names)
         for name in names:
-            # numba's cache of the friction loops (build_fmu.ship_compiled_kernels) is compiled code
+            # numba's cache of the compiled loops (build_fmu.ship_compiled_kernels) is compiled code
             # whose pickled debug records name the sources it was compiled from, as text for error
             # messages; numba takes the code where its source, numba and the CPU match, else compiles
-            if name == runtime or (name.startswith("resources/slewing_model/__pycache__/friction_kernel.")
+            if name == runtime or (name.startswith(("resources/slewing_model/__pycache__/friction_kernel.",
+                                                    "resources/slewing_model/__pycache__/contact_kernel."))
                                    and name.endswith(".nbc")):
                 continue
             data = z.read(name)

@@ -181,7 +181,7 @@ fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimula
                 instanceName="cache")
 fmu.instantiate()
 kernel = sys.modules["slewing_model.friction_kernel"]
-stats = [f().stats for f, _ in kernel.KERNELS]
+stats = [f().stats for f, _ in kernel.all_kernels()]
 print(json.dumps({{"inside": kernel.__file__.startswith(str(folder)), "hits": [sum(s.cache_hits.values()) for s in stats],
                    "misses": [sum(s.cache_misses.values()) for s in stats]}}))
 fmu.terminate()

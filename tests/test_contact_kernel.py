@@ -1,0 +1,82 @@
+"""The load distribution's compiled loops (:mod:`slewing_model.contact_kernel`) against its numpy code.
+
+The compiled springs and Hertz ellipses are the numpy formulas in the same order of
+operations: equal to round-off at a solver's iterate, and a co-simulation stepped with either
+gives the same outputs to the solver's tolerance.
+"""
+import sys
+
+import numpy as np
+import pytest
+
+from slewing_model import BimeSolver, Loads, load_bearing
+from slewing_model.bime import CONTACT_RING, INNER_CONTACT
+from slewing_model.contact import hertz_ellipse
+from slewing_model.contact_kernel import ellipse_axes
+from slewing_model.friction_kernel import AVAILABLE
+from slewing_model.superelement import build_superelement
+
+from conftest import BEARINGS, ROOT
+
+pytestmark = pytest.mark.skipif(not AVAILABLE, reason="numba is not installed: only the numpy path exists here")
+
+
+@pytest.fixture(scope="module")
+def pitch():
+    bearing = load_bearing(BEARINGS / "pitch_bearing.toml")
+    return bearing, build_superelement(bearing, mesh="coarse", bc="free")
+
+
+def test_compiled_springs_equal_the_numpy_springs(pitch):
+    bearing, superelement = pitch
+    solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
+    loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
+    state = solvers["numpy"].solve(loads).state
+    rng = np.random.default_rng(5)
+    for scale in (0.0, 1e-3, 2e-2):                      # the equilibrium, and points off it
+        x = state * (1.0 + scale * rng.standard_normal(state.size))
+        f_scaled = solvers["numpy"]._scaled_load(loads)
+        points = {k: s._evaluate(x[:5], x[5:], f_scaled) for k, s in solvers.items()}
+        for name in ("e", "delta", "q", "force", "n", "length"):
+            ref, got = getattr(points["numpy"], name), getattr(points["compiled"], name)
+            assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max(), name
+        assert points["compiled"].total == pytest.approx(points["numpy"].total, rel=1e-12)
+        assert (points["numpy"].delta > 0).sum() < points["numpy"].delta.size    # some springs open
+
+
+def test_compiled_ellipses_equal_hertz_ellipse(pitch):
+    bearing, _ = pitch
+    n = bearing.ball_count
+    rng = np.random.default_rng(6)
+    load = rng.uniform(0.0, 2e5, (n, 4)) * (rng.uniform(size=(n, 4)) > 0.3)    # a third unloaded
+    angle = rng.uniform(0.2, 1.3, (n, 4))
+    diameter = np.full(n, bearing.ball_diameter) * (1.0 + 1e-3 * rng.standard_normal(n))
+    radius = bearing.groove_radius * (1.0 + 1e-3 * rng.standard_normal((n, 4)))
+    ref = hertz_ellipse(load, diameter[:, None], radius, angle, bearing.pitch_diameter, CONTACT_RING,
+                        bearing.youngs_modulus, bearing.poisson_ratio)
+    got = ellipse_axes(load, diameter, radius, angle, bearing.pitch_diameter, INNER_CONTACT,
+                       bearing.youngs_modulus, bearing.poisson_ratio)
+    for value, expected in zip(got, (ref.a, ref.b, ref.max_pressure)):
+        assert np.array_equal(value == 0.0, load == 0.0)
+        assert np.abs(value - expected).max() <= 1e-14 * np.abs(expected).max()
+
+
+@pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
+def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from cases import CASES
+    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+
+    case = CASES[name](25)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    sims = {k: BearingSimulator(bearing, superelement, SimulatorSettings(
+        load_frame="rotating" if case.parameters["load_frame"] == 2 else "fixed", contact_kernel=k))
+        for k in ("numpy", "compiled")}
+    worst = 0.0
+    for k in range(case.steps):
+        out = {kernel: sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for kernel, sim in sims.items()}
+        ref, got = out["numpy"].distribution, out["compiled"].distribution
+        worst = max(worst, np.abs(got.contact_load - ref.contact_load).max() / ref.max_ball_load,
+                    abs(out["compiled"].friction_torque - out["numpy"].friction_torque) / abs(out["numpy"].friction_torque))
+    assert worst <= 1e-9, worst
