@@ -106,16 +106,18 @@ class BimeSolver:
         (:class:`LoadCapacityError`). Default ``2 x 4200 MPa``: twice the ISO 76
         permanent-deformation limit (static safety factor 0.125), gross plastic
         deformation where the elastic Hertz model no longer holds.
-    kernel : {"auto", "numpy", "compiled"}
+    kernel : {"numpy", "auto", "compiled"}
         How the springs of the flexible model and the result's Hertz ellipses are
         evaluated: numpy array operations, or compiled loops
         (:mod:`slewing_model.contact_kernel`, needs numba); "auto" takes the compiled
-        loops where numba is installed. The same results to round-off.
+        loops where numba is installed. The same results to round-off. Default numpy: a
+        few solves do not repay numba's import (0.5 s); the co-simulation's simulator
+        takes "auto" (``SimulatorSettings.contact_kernel``).
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
                  rtol: float = 1e-10, max_iterations: int = 200, pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT,
-                 kernel: str = "auto"):
+                 kernel: str = "numpy"):
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
             raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
                              f"the bearing ball_count = {bearing.ball_count}")
