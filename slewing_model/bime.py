@@ -67,8 +67,9 @@ from .reduced_operator import (
 from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
 
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
-#: residual by less than this factor (benchmarks/bench_flexible.py measured the choice)
-REFRESH = 0.25
+#: residual by less than this factor (0.25 until a new operator was spread over two steps;
+#: since, 0.4 measured better: pitch mean -3 %, yaw 95th percentile -35 %; docs/speed.md)
+REFRESH = 0.4
 #: ... unless, at the rate of that iteration, the residual reaches the tolerance within this many
 #: more iterations, which cost less than a new operator (pitch bearing: 3 of 0.1 ms against
 #: one operator of 2.5 ms, 4 ms when this was measured; docs/speed.md)
@@ -343,7 +344,7 @@ class BimeSolver:
 
             if flexible:
                 # a fresh reduced operator on the first iteration of a cold solve and whenever
-                # the residual fell by less than a factor 4 in the last iteration
+                # the residual fell by less than a factor 1 / REFRESH in the last iteration
                 fresh = last_residual is None or residual > REFRESH * last_residual
                 if fresh and last_residual is not None and residual < last_residual:
                     # slow, but the iterations this rate still needs are few: they cost less than a new operator
