@@ -108,7 +108,7 @@ def ship_compiled_kernels(fmu) -> list[Path]:
              for f in cache.glob(f"{function.__module__.rsplit('.', 1)[-1]}.{function.__name__}-"
                                  f"{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
     if not files:
-        warnings.warn(f"numba's cache of the friction loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
+        warnings.warn(f"numba's cache of the compiled loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
                       "writable): the FMU will compile them when instantiated (about 10 s)")
     with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive:
         for f in files:

@@ -142,14 +142,16 @@ def _compiled_helpers() -> None:
     import numba
 
     for name in ("_segment", "_interp"):
-        globals()[name] = numba.njit(cache=True, nogil=True)(globals()[name])
+        globals()[name] = numba.njit(cache=True, nogil=True, error_model="numpy")(globals()[name])
 
 
 def _compile(function, signature):
+    """numpy's floating-point semantics (``error_model="numpy"``): a division by zero gives inf or
+    NaN as the numpy code does, instead of raising."""
     import numba
 
     _compiled_helpers()
-    return numba.njit(signature, cache=True, nogil=True)(function)
+    return numba.njit(signature, cache=True, nogil=True, error_model="numpy")(function)
 
 
 @functools.lru_cache(maxsize=1)

@@ -438,15 +438,16 @@ KERNELS = ((compiled_evaluate_points, _evaluate_points), (compiled_point_coeffic
            (compiled_minimise_balls, _minimise_balls), (compiled_tractions, _tractions))
 
 
-def all_kernels() -> tuple:
+def all_kernels(friction: bool = True, contact: bool = True) -> tuple:
     """The compiled loops of a step, the friction's and the load distribution's
     (:mod:`slewing_model.contact_kernel`): (factory, Python function) pairs."""
     from . import contact_kernel
 
-    return KERNELS + contact_kernel.KERNELS
+    return (KERNELS if friction else ()) + (contact_kernel.KERNELS if contact else ())
 
 
-def compile_all() -> None:
-    """Compile the loops, or load them from numba's cache (what an FMU instance does when it starts)."""
-    for factory, _ in all_kernels():
+def compile_all(friction: bool = True, contact: bool = True) -> None:
+    """Compile the loops (the friction's, the contacts'), or load them from numba's cache (what an
+    FMU instance does when it starts)."""
+    for factory, _ in all_kernels(friction, contact):
         factory()

@@ -171,8 +171,10 @@ class BearingSimulator:
         self.bearing = bearing
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
                                  rtol=s.tolerance, kernel=s.contact_kernel)
-        if use_compiled(s.friction_kernel, "friction_kernel") or use_compiled(s.contact_kernel, "contact_kernel"):
-            compile_all()     # compiled (or loaded from numba's cache) now, not in a step
+        friction, contact = use_compiled(s.friction_kernel, "friction_kernel"), use_compiled(s.contact_kernel,
+                                                                                             "contact_kernel")
+        if friction or contact:
+            compile_all(friction, contact)     # compiled (or loaded from numba's cache) now, not in a step
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step

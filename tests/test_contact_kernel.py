@@ -27,10 +27,31 @@ def pitch():
     return bearing, build_superelement(bearing, mesh="coarse", bc="free")
 
 
-def test_compiled_springs_equal_the_numpy_springs(pitch):
-    bearing, superelement = pitch
+def _table3_with_measured_radii(table3):
+    """table3 whose balls each see other grooves, their radii measured too: every ball's and
+    diagonal's stiffness and natural length differ."""
+    from slewing_model import synthetic_errors
+    from slewing_model.errors import ManufacturingErrors, RingErrorMap
+
+    synthetic = synthetic_errors(table3.ball_count, seed=7)
+    outer = synthetic.outer
+    radii = table3.groove_radius[[0, 3]] * (1.0 + 2e-3 * np.stack([np.sin(outer.angle), np.cos(3 * outer.angle)], 1))
+    return table3.with_errors(ManufacturingErrors(outer=RingErrorMap(outer.angle, outer.radial, outer.axial, radii),
+                                                  inner=synthetic.inner,
+                                                  ball_diameter_deviation=synthetic.ball_diameter_deviation))
+
+
+@pytest.mark.parametrize("which", ["pitch", "table3 with errors"])
+def test_compiled_springs_equal_the_numpy_springs(pitch, table3, which):
+    if which == "pitch":
+        bearing, superelement = pitch
+        loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
+    else:
+        bearing = _table3_with_measured_radii(table3)
+        superelement = build_superelement(table3, mesh="coarse", bc="free")
+        loads = Loads(Fx=2e4, Fz=1e5, Mx=3e4, My=-2e4)
+        assert np.unique(BimeSolver(bearing, superelement).assembly.stiffness).size == bearing.ball_count * 2
     solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
-    loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
     state = solvers["numpy"].solve(loads).state
     rng = np.random.default_rng(5)
     for scale in (0.0, 1e-3, 2e-2):                      # the equilibrium, and points off it
@@ -80,3 +101,4 @@ def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
         worst = max(worst, np.abs(got.contact_load - ref.contact_load).max() / ref.max_ball_load,
                     abs(out["compiled"].friction_torque - out["numpy"].friction_torque) / abs(out["numpy"].friction_torque))
     assert worst <= 1e-9, worst
+

@@ -346,3 +346,11 @@ def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
         formed = reduced_operator(rows, active, op.contact_compliance, op.inverse, solver.jacobian, mu)
         assert np.abs(turned.coupling - formed.coupling).max() <= 1e-12 * np.abs(formed.coupling).max()
         solver.set_rotation(0.0)
+
+
+@pytest.mark.parametrize("where", ["solver", "settings"])
+def test_unknown_contact_kernel_is_refused(bearing, where):
+    from slewing_model.simulator import SimulatorSettings
+
+    with pytest.raises(ValueError, match="kernel = 'fortran': must be 'auto', 'numpy' or 'compiled'"):
+        BimeSolver(bearing, kernel="fortran") if where == "solver" else SimulatorSettings(contact_kernel="fortran")
