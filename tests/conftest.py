@@ -37,3 +37,23 @@ def table3_fmu(tmp_path_factory):
 
     path = tmp_path_factory.mktemp("fmu") / "SlewingBearing_table3.fmu"
     return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free")
+
+
+def simulators_per_kernel(name: str, steps: int, setting: str):
+    """A benchmark case (``benchmarks/cases.py``, coarse superelement, free rings) and two simulators
+    of it that differ only in the kernel ``setting`` (``"friction_kernel"`` or ``"contact_kernel"``):
+    ``{"numpy": ..., "compiled": ...}``."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from cases import CASES
+    from slewing_model import load_bearing
+    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.superelement import build_superelement
+
+    case = CASES[name](steps)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    frame = "rotating" if case.parameters["load_frame"] == 2 else "fixed"
+    return case, {k: BearingSimulator(bearing, superelement, SimulatorSettings(
+        ring_model="flexible", load_frame=frame, **{setting: k})) for k in ("numpy", "compiled")}

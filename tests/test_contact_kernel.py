@@ -4,8 +4,6 @@ The compiled springs and Hertz ellipses are the numpy formulas in the same order
 operations: equal to round-off at a solver's iterate, and a co-simulation stepped with either
 gives the same outputs to the solver's tolerance.
 """
-import sys
-
 import numpy as np
 import pytest
 
@@ -16,7 +14,7 @@ from slewing_model.contact_kernel import ellipse_axes
 from slewing_model.friction_kernel import AVAILABLE
 from slewing_model.superelement import build_superelement
 
-from conftest import BEARINGS, ROOT
+from conftest import BEARINGS, simulators_per_kernel
 
 pytestmark = pytest.mark.skipif(not AVAILABLE, reason="numba is not installed: only the numpy path exists here")
 
@@ -84,16 +82,7 @@ def test_compiled_ellipses_equal_hertz_ellipse(pitch):
 
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
 def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from cases import CASES
-    from slewing_model.simulator import BearingSimulator, SimulatorSettings
-
-    case = CASES[name](25)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="coarse", bc="free")
-    sims = {k: BearingSimulator(bearing, superelement, SimulatorSettings(
-        load_frame="rotating" if case.parameters["load_frame"] == 2 else "fixed", contact_kernel=k))
-        for k in ("numpy", "compiled")}
+    case, sims = simulators_per_kernel(name, 25, "contact_kernel")
     worst = 0.0
     for k in range(case.steps):
         out = {kernel: sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for kernel, sim in sims.items()}

@@ -20,7 +20,7 @@ from slewing_model.ball_kinematics import ContactPoints, ContactSet
 from slewing_model.ellipse_quadrature import ellipse_quadrature
 from slewing_model.friction_kernel import AVAILABLE
 
-from conftest import BEARINGS, ROOT
+from conftest import BEARINGS, ROOT, simulators_per_kernel
 
 needs_numba = pytest.mark.skipif(not AVAILABLE, reason="numba is not installed: only the numpy path exists here")
 
@@ -99,17 +99,7 @@ def test_compiled_torque_equals_the_numpy_torque(case):
 def test_compiled_steps_equal_the_numpy_steps(name):
     # the co-simulation's steps, warm-started from each other: the compiled minimisation (ball by
     # ball) takes the steps the numpy loop (batched) takes, so the torques agree to round-off
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from cases import CASES
-    from slewing_model.simulator import BearingSimulator, SimulatorSettings
-    from slewing_model.superelement import build_superelement
-
-    case = CASES[name](25)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="coarse", bc="free")
-    sims = {k: BearingSimulator(bearing, superelement, SimulatorSettings(
-        ring_model="flexible", load_frame="rotating" if case.parameters["load_frame"] == 2 else "fixed",
-        friction_kernel=k)) for k in ("numpy", "compiled")}
+    case, sims = simulators_per_kernel(name, 25, "friction_kernel")
     for k in range(case.steps):
         out = {kernel: sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for kernel, sim in sims.items()}
         assert out["compiled"].friction_torque == pytest.approx(out["numpy"].friction_torque, rel=1e-10), k
