@@ -447,13 +447,13 @@ class BimeSolver:
             else:
                 fresh = False
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
-            pending = start_operator(p, self.compliance, stiffness, np.flatnonzero(np.repeat(active, 2)), active)
+            pending = start_operator(p, self.compliance, stiffness, active)
             fresh = self._stage_due = False
         self._pending = pending
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, op.rows, op.active, mu, may_turn=self._rigid_turn)
+                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn)
             if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
                 op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
             if op is None and self._pending is not None:     # too many closed: the pending one, at once
@@ -461,8 +461,7 @@ class BimeSolver:
                 if np.any(active & ~op.active):
                     op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
         if fresh or op is None:
-            rows = np.flatnonzero(np.repeat(active, 2))
-            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, rows, active, mu)
+            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu)
             self._pending = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         dq, y_new = newton_step(op, p, f_scaled)

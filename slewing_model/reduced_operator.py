@@ -91,8 +91,7 @@ def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.nda
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
 
-def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu, may_turn: bool = True
-                    ) -> ReducedOperator:
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True) -> ReducedOperator:
     """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
 
     ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
@@ -104,7 +103,7 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu,
     move the groove centres with the ring) the coupling is formed anew, without the fit where
     the caller knows it (``may_turn`` False). The operator itself when the Jacobian did not
     change."""
-    ja = jacobian.reshape(-1, 5)[rows]
+    ja = jacobian.reshape(-1, 5)[op.rows]
     if np.array_equal(op.jacobian, ja):
         return op
     coupling = None
@@ -116,7 +115,7 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, rows, active, mu,
                 coupling = op.coupling @ turn
         except np.linalg.LinAlgError:
             pass
-    return reduced_operator(rows, active, op.contact_compliance, op.inverse, jacobian, mu, coupling)
+    return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, coupling)
 
 
 def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
@@ -220,9 +219,11 @@ class PendingOperator:
                    tuple(np.asarray(v) for v in parts))
 
 
-def start_operator(point, compliance, stiffness, rows, active) -> PendingOperator:
-    """Form ``W = (A^-1 + M)_aa`` at an iterate (``A^-1`` the springs' compliance there, ``M``
-    the rings'; symmetric positive definite) and run the first stage of its inverse."""
+def start_operator(point, compliance, stiffness, active) -> PendingOperator:
+    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (``A^-1`` the springs'
+    compliance there, ``M`` the rings'; symmetric positive definite) and run the first stage of
+    its inverse."""
+    rows = np.flatnonzero(np.repeat(active, 2))
     a_inv = contact_compliance_blocks(point, stiffness, active)
     w_mat = np.asarray(compliance).take(rows, axis=0).take(rows, axis=1)   # M_aa (3x faster than np.ix_)
     _add_blocks(w_mat, a_inv)
@@ -253,9 +254,9 @@ def complete_operator(pending: PendingOperator, jacobian, mu) -> ReducedOperator
     return pending
 
 
-def assemble_operator(point, compliance, stiffness, jacobian, rows, active, mu) -> ReducedOperator:
-    """Form and invert ``W = (A^-1 + M)_aa`` at an iterate: O(n^3)."""
-    return complete_operator(start_operator(point, compliance, stiffness, rows, active), jacobian, mu)
+def assemble_operator(point, compliance, stiffness, jacobian, active, mu) -> ReducedOperator:
+    """Form and invert ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate: O(n^3)."""
+    return complete_operator(start_operator(point, compliance, stiffness, active), jacobian, mu)
 
 
 def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu

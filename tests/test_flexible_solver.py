@@ -236,8 +236,7 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing):
         return active
 
     def formed(active):
-        rows = np.flatnonzero(np.repeat(active, 2))
-        return assemble_operator(point, solver.compliance, stiffness, jacobian, rows, active, mu)
+        return assemble_operator(point, solver.compliance, stiffness, jacobian, active, mu)
 
     for before, after in ((loaded[[0, 2] + list(range(5, loaded.size))], loaded),      # three close
                           (np.delete(loaded, [1, 7]), np.delete(loaded, [4, 9, 10]))):  # two close, three open
@@ -315,10 +314,10 @@ def test_operator_after_a_turn_equals_one_formed_anew(bearing, with_errors):
     old, new = op.jacobian, solver.jacobian.reshape(-1, 5)[op.rows]
     fit = old @ np.linalg.lstsq(old, new, rcond=None)[0] - new
     assert (np.abs(fit).max() > 1e-9 * np.abs(new).max()) == with_errors
-    turned = turned_operator(op, solver.jacobian, op.rows, op.active, mu)
+    turned = turned_operator(op, solver.jacobian, mu)
     formed = reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, solver.jacobian, mu)
     if with_errors:     # where the caller knows the ring's errors, no fit is tried: formed anew, the same
-        unfitted = turned_operator(op, solver.jacobian, op.rows, op.active, mu, may_turn=False)
+        unfitted = turned_operator(op, solver.jacobian, mu, may_turn=False)
         assert np.array_equal(unfitted.coupling, formed.coupling)
     assert np.array_equal(turned.jacobian, formed.jacobian)
     assert np.abs(turned.coupling - formed.coupling).max() <= 1e-12 * np.abs(formed.coupling).max()
@@ -340,9 +339,9 @@ def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
         active = np.zeros(point.delta.size, dtype=bool)
         active[loaded[:count]] = True
         rows = np.flatnonzero(np.repeat(active, 2))
-        op = assemble_operator(point, solver.compliance, solver.assembly.stiffness, solver.jacobian, rows, active, mu)
+        op = assemble_operator(point, solver.compliance, solver.assembly.stiffness, solver.jacobian, active, mu)
         solver.set_rotation(0.3 * count)
-        turned = turned_operator(op, solver.jacobian, rows, active, mu)
+        turned = turned_operator(op, solver.jacobian, mu)
         formed = reduced_operator(rows, active, op.contact_compliance, op.inverse, solver.jacobian, mu)
         assert np.abs(turned.coupling - formed.coupling).max() <= 1e-12 * np.abs(formed.coupling).max()
         solver.set_rotation(0.0)
