@@ -137,7 +137,8 @@ class BimeSolver:
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
-        self._pending = None  # a new operator being inverted over two solves (flexible, warm solves)
+        #: a new operator being inverted over two solves (flexible, warm solves), or None: state too
+        self.pending_operator: PendingOperator | None = None
         # a turn of the ring only turns the Jacobian's columns where the moving ring's grooves have no errors
         self._rigid_turn = bearing.errors is None or getattr(bearing.errors, bearing.moving_ring) is None
         self._stage_due = self._spread = False  # per solve: a stage of the pending operator is due; it may be spread
@@ -153,15 +154,6 @@ class BimeSolver:
     @operator.setter
     def operator(self, op) -> None:
         self._reduced, self._reduced_jacobian = op, None     # its coupling is checked against the Jacobian
-
-    @property
-    def pending_operator(self) -> PendingOperator | None:
-        """A new operator being inverted over two solves, or None: part of the state too."""
-        return self._pending
-
-    @pending_operator.setter
-    def pending_operator(self, pending: PendingOperator | None) -> None:
-        self._pending = pending
 
     # ---- set-up -------------------------------------------------------------------
     def set_rotation(self, psi: float, cage_angle: float | None = None) -> None:
@@ -321,7 +313,7 @@ class BimeSolver:
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
         if initial is None:
-            self._pending = None                  # a cold solve depends on nothing before it
+            self.pending_operator = None                  # a cold solve depends on nothing before it
         point = self._evaluate(qs, y, f_scaled)
         load_scale = float(np.abs(f_scaled).max())
         while True:
@@ -432,9 +424,9 @@ class BimeSolver:
         """
         active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
         if not active.any():
-            self._reduced = self._pending = None
+            self._reduced = self.pending_operator = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
-        stiffness, op, pending = self.assembly.stiffness, self._reduced, self._pending
+        stiffness, op, pending = self.assembly.stiffness, self._reduced, self.pending_operator
         if pending is not None:
             if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
                 pending = complete_operator(pending, self.jacobian, mu)
@@ -449,20 +441,20 @@ class BimeSolver:
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
             pending = start_operator(p, self.compliance, stiffness, active)
             fresh = self._stage_due = False
-        self._pending = pending
+        self.pending_operator = pending
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
                 op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn)
             if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
                 op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
-            if op is None and self._pending is not None:     # too many closed: the pending one, at once
-                op, self._pending = complete_operator(self._pending, self.jacobian, mu), None
+            if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
+                op, self.pending_operator = complete_operator(self.pending_operator, self.jacobian, mu), None
                 if np.any(active & ~op.active):
                     op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
         if fresh or op is None:
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu)
-            self._pending = None
+            self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         dq, y_new = newton_step(op, p, f_scaled)
         return dq, y_new - p.y
