@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from .friction_kernel import compile_loop
+
 _SPRING_SIGNATURE = ("Tuple((f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], f8[:, :], f8))("
                      "f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:, :], f8[:, :])")
 
@@ -135,23 +137,10 @@ def _ellipses(load, ball_diameter, groove_radius, contact_angle, pitch_diameter,
     return semi_a, semi_b, pressure
 
 
-@functools.lru_cache(maxsize=1)
-def _compiled_helpers() -> None:
-    """Compile the helpers the loops call in place of their Python definitions (numba takes a
-    compiled function's callees from the module's globals when it compiles it)."""
-    import numba
-
-    for name in ("_segment", "_interp"):
-        globals()[name] = numba.njit(cache=True, nogil=True, error_model="numpy")(globals()[name])
-
-
 def _compile(function, signature):
-    """numpy's floating-point semantics (``error_model="numpy"``): a division by zero gives inf or
-    NaN as the numpy code does, instead of raising."""
-    import numba
-
-    _compiled_helpers()
-    return numba.njit(signature, cache=True, nogil=True, error_model="numpy")(function)
+    """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
+    numpy code does, instead of raising."""
+    return compile_loop(function, signature, ("_segment", "_interp"), error_model="numpy")
 
 
 @functools.lru_cache(maxsize=1)

@@ -344,26 +344,30 @@ _MINIMISE_SIGNATURE = ("Tuple((f8[:, :], i8[:], f8[:], b1[:]))("
                        "f8[:], f8[:], f8[:], f8, f8, i8, f8, f8, f8)")
 
 
-@functools.lru_cache(maxsize=1)
-def _compiled_helpers() -> None:
-    """Compile the helpers the loops call, in place of their Python definitions.
+def compile_loop(function, signature: str, helpers: tuple = (), error_model: str = "python"):
+    """``function`` compiled by numba for ``signature`` (eager, numba's on-disk cache), after the
+    ``helpers`` it calls (names in its module).
 
     numba takes the functions a compiled function calls from the module's globals when it
-    compiles it: they must be compiled functions by then. The Python definitions are used
-    by nothing else (the numpy path is :mod:`slewing_model.ball_kinematics`' own code)."""
+    compiles it: they must be compiled functions by then, so each helper is compiled in place
+    of its Python definition, once. The Python definitions are used by nothing else (the numpy
+    paths are the library's own code). ``error_model`` "numpy": a division by zero gives inf or
+    NaN as numpy does, instead of raising."""
     import numba
 
-    module = globals()
-    for name in ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic",
-                 "_damped_step"):
-        module[name] = numba.njit(cache=True, nogil=True)(module[name])
+    module = function.__globals__
+    for name in helpers:
+        if not hasattr(module[name], "py_func"):          # not compiled yet
+            module[name] = numba.njit(cache=True, nogil=True, error_model=error_model)(module[name])
+    return numba.njit(signature, cache=True, nogil=True, error_model=error_model)(function)
+
+
+#: the helpers the friction's loops call
+_HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step")
 
 
 def _compile(function, signature):
-    import numba
-
-    _compiled_helpers()
-    return numba.njit(signature, cache=True, nogil=True)(function)
+    return compile_loop(function, signature, _HELPERS)
 
 
 @functools.lru_cache(maxsize=1)
