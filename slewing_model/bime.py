@@ -442,16 +442,19 @@ class BimeSolver:
             pending = start_operator(p, self.compliance, stiffness, active)
             fresh = self._stage_due = False
         self.pending_operator = pending
+
+        def bordered(op):                      # contacts closed: bordered in (those that opened stay)
+            closed = np.any(active & ~op.active)
+            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu) if closed else op
+
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
                 op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn)
-            if np.any(active & ~op.active):    # contacts closed: bordered in (those that opened stay)
-                op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
+            op = bordered(op)
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
-                op, self.pending_operator = complete_operator(self.pending_operator, self.jacobian, mu), None
-                if np.any(active & ~op.active):
-                    op = update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu)
+                op = bordered(complete_operator(self.pending_operator, self.jacobian, mu))
+                self.pending_operator = None
         if fresh or op is None:
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu)
             self.pending_operator = None
