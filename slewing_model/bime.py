@@ -55,6 +55,7 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import compiled_spring_terms, ellipse_axes
+from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
@@ -459,7 +460,7 @@ class BimeSolver:
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
-        dq, y_new = newton_step(op, p, f_scaled)
+        dq, y_new = (compiled_newton_step if self._compiled else newton_step)(op, p, f_scaled)
         return dq, y_new - p.y
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float) -> LoadDistribution:

@@ -63,6 +63,49 @@ def _spring_terms(separation, jacobian_rows, qs, ring_motion, natural_length, st
     return e, delta, q, force, n, length, 0.4 * energy
 
 
+_NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:], "
+                     "f8[:], f8[:], i8)")
+
+
+def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_inverse, force, ring_motion,
+                 f_scaled, n_rows):
+    """The modified Newton step with a kept reduced operator: ``dq`` (5,) and the contact forces
+    after the step (``n_rows``,), zero off the operator's ``rows``: the formulas of
+    :func:`slewing_model.reduced_operator.newton_step` (``force`` and ``ring_motion`` flat, (4B,)).
+
+    ``W^-1 rhs`` is summed column by column, ``sum_j rhs_j (W^-1)_j``: ``W^-1`` is symmetric
+    (to round-off, once bordered), and this form runs as vector operations where a row's dot
+    product is one chain of additions."""
+    n = rows.size
+    rhs = np.empty(n)
+    for k in range(n // 2):                 # A^-1 f of each diagonal, + (M y) on its rows
+        diagonal = rows[2 * k] // 2
+        f0, f1 = force[2 * diagonal], force[2 * diagonal + 1]
+        for c in range(2):
+            rhs[2 * k + c] = (contact_compliance[k, c, 0] * f0 + contact_compliance[k, c, 1] * f1
+                              + ring_motion[rows[2 * k + c]])
+    w = np.zeros(n)
+    for j in range(n):
+        r = rhs[j]
+        for i in range(n):
+            w[i] += inverse[j, i] * r
+    t = f_scaled.copy()                     # F - J_a^T w
+    for i in range(n):
+        for c in range(5):
+            t[c] -= jacobian[i, c] * w[i]
+    dq = np.zeros(5)
+    for r in range(5):
+        for c in range(5):
+            dq[r] += schur_inverse[r, c] * t[c]
+    y_new = np.zeros(n_rows)
+    for i in range(n):
+        value = w[i]
+        for c in range(5):
+            value += coupling[i, c] * dq[c]
+        y_new[rows[i]] = value
+    return dq, y_new
+
+
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
     by bisection, as ``np.interp`` searches)."""
@@ -156,8 +199,21 @@ def compiled_ellipses():
     return _compile(_ellipses, _ELLIPSE_SIGNATURE)
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_newton_step():
+    """The compiled :func:`_newton_step` (as :func:`compiled_spring_terms`)."""
+    return _compile(_newton_step, _NEWTON_SIGNATURE)
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_spring_terms, _spring_terms), (compiled_ellipses, _ellipses))
+KERNELS = ((compiled_spring_terms, _spring_terms), (compiled_ellipses, _ellipses), (compiled_newton_step, _newton_step))
+
+
+def newton_step(op, point, f_scaled):
+    """:func:`slewing_model.reduced_operator.newton_step` by the compiled loop."""
+    return compiled_newton_step()(np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
+                                  op.schur_inverse, point.force.reshape(-1), point.ring_motion, f_scaled,
+                                  point.y.size)
 
 
 def ellipse_axes(load, ball_diameter, groove_radius, contact_angle, pitch_diameter, inner, youngs_modulus,

@@ -80,6 +80,34 @@ def test_compiled_ellipses_equal_hertz_ellipse(pitch):
         assert np.abs(value - expected).max() <= 1e-14 * np.abs(expected).max()
 
 
+def test_compiled_newton_step_equals_the_numpy_step(pitch):
+    """The modified Newton step with a kept operator, formed or bordered by contacts that closed (whose
+    inverse is symmetric to round-off only), at an iterate away from the operator's own."""
+    from slewing_model.contact_kernel import newton_step as compiled_step
+    from slewing_model.reduced_operator import assemble_operator, newton_step, update_operator
+
+    bearing, superelement = pitch
+    loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
+    solver = BimeSolver(bearing, superelement)
+    state = solver.solve(loads).state
+    f_scaled = solver._scaled_load(loads)
+    point = solver._evaluate(state[:5], state[5:], f_scaled)
+    loaded = np.flatnonzero(point.delta.ravel() > 0.0)
+    mu = 1e-12 * solver.reference_stiffness
+    args = (point, solver.compliance, solver.assembly.stiffness)
+    masks = [np.isin(np.arange(point.delta.size), diagonals) for diagonals in (loaded, np.delete(loaded, np.s_[::8]), loaded)]
+    formed = assemble_operator(*args, solver.jacobian, masks[1], mu)
+    bordered = update_operator(formed, *args, solver.jacobian, masks[2], mu)
+    assert bordered is not None and bordered.rows.size == 2 * loaded.size
+    assert not np.array_equal(bordered.inverse, bordered.inverse.T)          # symmetric to round-off only
+    off = solver._evaluate(1.01 * state[:5], 0.98 * state[5:], f_scaled)
+    for op in (assemble_operator(*args, solver.jacobian, masks[0], mu), bordered):
+        (dq, y), (dq_c, y_c) = newton_step(op, off, f_scaled), compiled_step(op, off, f_scaled)
+        assert np.abs(dq_c - dq).max() <= 1e-11 * np.abs(dq).max()
+        assert np.abs(y_c - y).max() <= 1e-11 * np.abs(y).max()
+        assert np.array_equal(y_c == 0.0, y == 0.0)                          # zero off the operator's rows
+
+
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
 def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
     case, sims = simulators_per_kernel(name, 25, "contact_kernel")
