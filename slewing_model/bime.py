@@ -54,7 +54,7 @@ import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
-from .contact_kernel import compiled_spring_terms, ellipse_axes
+from .contact_kernel import compiled_trial_point, ellipse_axes
 from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -318,15 +318,9 @@ class BimeSolver:
         point = self._evaluate(qs, y, f_scaled)
         load_scale = float(np.abs(f_scaled).max())
         while True:
-            f = point.force.ravel()
-            grad_q = self._jacobian_rows.T @ f - f_scaled
-            scale = max(load_scale, float(point.q.max()), 1e-300)
-            residual = float(np.abs(grad_q).max())
-            if flexible:
-                mismatch = f - point.y            # the Hertz forces less those the rings feel
-                scale = max(scale, float(np.abs(point.y).max()))
-                residual = max(residual, float(np.abs(mismatch).max()))
-            residual /= scale
+            grad_q, mismatch = point.gradient, point.mismatch
+            scale = max(load_scale, point.peak_force, 1e-300)
+            residual = point.peak_residual / scale
             if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
             if iterations >= self.max_iterations:
@@ -359,8 +353,8 @@ class BimeSolver:
             # backtracking line search on the total energy (convex)
             t = 1.0
             for _ in range(60):
-                trial = self._evaluate(point.qs + t * dq, point.y + t * dy if flexible else point.y, f_scaled,
-                                       None if not flexible else point.ring_motion + t * m_dy)
+                trial = self._evaluate(point.qs, point.y, f_scaled, point.ring_motion,
+                                       (dq, dy, m_dy) if flexible else (dq, None, None), t)
                 roundoff = 1e-12 * max(point.energy_scale, trial.energy_scale)
                 if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + roundoff:
                     break
@@ -376,29 +370,47 @@ class BimeSolver:
 
         return self._result(loads, point, iterations, residual)
 
-    def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray,
-                  my: np.ndarray | None = None) -> "_Point":
-        """Contact terms and total energy at the unknowns ``(qs, y)``; ``my``: ``M y`` if known
-        (along a search line it is linear in the step)."""
+    def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray, my: np.ndarray | None = None,
+                  direction: tuple | None = None, t: float = 0.0) -> "_Point":
+        """Contact terms, total energy and residuals at the unknowns ``(qs, y)``, or at the trial
+        point ``(qs + t dq, y + t dy)`` of a line search along ``direction = (dq, dy, M dy)``;
+        ``my``: ``M y`` if known (along a search line it is linear in the step)."""
         ring = 0.0
-        if self.compliance is not None and my is None:
+        flexible = self.compliance is not None
+        if flexible and my is None:
             my = self.compliance @ y
-        if self.compliance is not None and self._compiled:      # the same formulas, one compiled loop
+        if flexible and self._compiled:      # the same formulas, one compiled loop
             a = self.assembly
-            e, delta, q, force, n, length, energy = compiled_spring_terms()(
-                self._separation, self._jacobian_rows, qs, my, a.natural_length, a.stiffness)
-            hess = None
-            ring = 0.5 * float(y @ my)        # eq 15
-        else:
-            e = self._separation + (self._jacobian_rows @ qs).reshape(self.jacobian.shape[:-1])
-            if self.compliance is not None:
-                e = e - my.reshape(e.shape)   # e_D = -M y: groove centres moved by ring deformation
-                ring = 0.5 * float(y @ my)    # eq 15
-            # the flexible step takes the springs' compliance from n, delta, q (reduced_operator)
-            delta, q, force, energy, hess, n, length = self._contacts(e, hessian=self.compliance is None)
+            dq, dy, m_dy = (np.zeros(5), np.zeros(y.size), np.zeros(y.size)) if direction is None else direction
+            (qs, y, my, e, delta, q, force, n, length, gradient, mismatch, terms) = compiled_trial_point()(
+                self._separation, self._jacobian_rows, qs, dq, y, dy, my, m_dy, t, a.natural_length, a.stiffness,
+                f_scaled)
+            energy, ring, work, peak_force, peak_residual = terms
+            return _Point(qs, y, e, delta, q, force, None, n, length, energy + ring - work, energy + ring + abs(work),
+                          gradient, mismatch, peak_force, peak_residual, my)
+        if direction is not None:
+            dq, dy, m_dy = direction
+            qs = qs + t * dq
+            if flexible:
+                y, my = y + t * dy, my + t * m_dy
+        e = self._separation + (self._jacobian_rows @ qs).reshape(self.jacobian.shape[:-1])
+        if flexible:
+            e = e - my.reshape(e.shape)   # e_D = -M y: groove centres moved by ring deformation
+            ring = 0.5 * float(y @ my)    # eq 15
+        # the flexible step takes the springs' compliance from n, delta, q (reduced_operator)
+        delta, q, force, energy, hess, n, length = self._contacts(e, hessian=not flexible)
+        f = force.ravel()
+        gradient = self._jacobian_rows.T @ f - f_scaled
+        peak_force, peak_residual = float(q.max()), float(np.abs(gradient).max())
+        mismatch = None
+        if flexible:
+            mismatch = f - y            # the Hertz forces less those the rings feel
+            peak_force = max(peak_force, float(np.abs(y).max()))
+            peak_residual = max(peak_residual, float(np.abs(mismatch).max()))
         work = float(f_scaled @ qs)
         # the total is a difference of larger terms: its roundoff scales with them
-        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work), my)
+        return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work),
+                      gradient, mismatch, peak_force, peak_residual, my)
 
     def _rigid_direction(self, p: "_Point", grad_q: np.ndarray, mu: float) -> np.ndarray:
         """Newton step of the rigid model: ``(sum J^T A J) dq = -grad``."""
@@ -543,6 +555,10 @@ class _Point:
     length: np.ndarray
     total: float
     energy_scale: float
+    gradient: np.ndarray                    # of the energy in qs (scaled): J^T f - F
+    mismatch: np.ndarray | None             # the Hertz forces less those the rings feel, f - y (flexible)
+    peak_force: float                       # the largest of q and |y|: the stop rule's scale
+    peak_residual: float                    # the largest of |gradient| and |mismatch|
     ring_motion: np.ndarray | None = None   # M y: the groove centres' relative motion from ring deformation (flexible)
 
 

@@ -22,34 +22,49 @@ import numpy as np
 
 from .friction_kernel import compile_loop
 
-_SPRING_SIGNATURE = ("Tuple((f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], f8[:, :], f8))("
-                     "f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:, :], f8[:, :])")
+_TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
+                    "f8[:, :], f8[:], f8[:], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], "
+                    "f8, f8[:, :], f8[:, :], f8[:])")
 
 
-def _spring_terms(separation, jacobian_rows, qs, ring_motion, natural_length, stiffness):
-    """The springs of the diagonals at the unknowns: relative vectors ``e`` (B, 2, 2), elongation
-    ``delta`` (B, 2), load ``q`` (B, 2), force vectors (B, 2, 2), unit vectors ``n`` (B, 2, 2),
-    lengths (B, 2) and the springs' energy.
+def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_motion_step, t, natural_length,
+                 stiffness, f_scaled):
+    """The flexible model's springs at the trial point ``(qs + t dq, y + t dy)`` of a line search,
+    with the ring motion ``M y`` there (``ring_motion + t ring_motion_step``, linear in ``t``), and
+    what the solver's stop rule and line search ask of it: the formulas of
+    ``BimeSolver._evaluate`` (:mod:`slewing_model.bime`).
 
-    ``e = separation + J qs - M y`` (``jacobian_rows`` (4B, 5), ``ring_motion = M y`` (4B,)),
-    ``delta = |e| - l_N`` (eq 7), ``q = K max(delta, 0)^1.5`` (eq 8), energy
-    ``sum 2/5 q max(delta, 0)`` (eq 1): the formulas of ``BimeSolver._evaluate``."""
+    ``e = separation + J qs - M y`` (``jacobian_rows`` (4B, 5)), ``delta = |e| - l_N`` (eq 7),
+    ``q = K max(delta, 0)^1.5`` (eq 8), the springs' energy ``sum 2/5 q max(delta, 0)`` (eq 1),
+    the rings' ``1/2 y . M y`` (eq 15) and the load's work ``F . qs``; the gradient on the moving
+    ring ``J^T f - F`` and the mismatch ``f - y`` of the Hertz forces and those the rings feel.
+
+    Returns ``qs``, ``y``, ``M y`` at the trial point, ``e``, ``delta``, ``q``, the force vectors
+    ``f`` and unit vectors ``n`` (B, 2, 2), the lengths ``|e|``, the gradient (5,), the mismatch
+    (4B,) and ``(springs' energy, rings' energy, work, largest force, largest residual)``, the
+    largest force over ``q`` and ``|y|``, the largest residual over the gradient and mismatch."""
     n_balls = separation.shape[0]
+    qs_t = qs + t * dq
+    y_t = y + t * dy
+    motion_t = ring_motion + t * ring_motion_step
     e = np.empty((n_balls, 2, 2))
     delta = np.empty((n_balls, 2))
     q = np.empty((n_balls, 2))
     force = np.empty((n_balls, 2, 2))
     n = np.empty((n_balls, 2, 2))
     length = np.empty((n_balls, 2))
-    energy = 0.0
+    gradient = -f_scaled
+    mismatch = np.empty(y.size)
+    energy = ring = 0.0
+    peak_force = peak_residual = 0.0
     for b in range(n_balls):
         for d in range(2):
             row = 4 * b + 2 * d
             for c in range(2):
                 motion = 0.0
                 for k in range(5):
-                    motion += jacobian_rows[row + c, k] * qs[k]
-                e[b, d, c] = separation[b, d, c] + motion - ring_motion[row + c]
+                    motion += jacobian_rows[row + c, k] * qs_t[k]
+                e[b, d, c] = separation[b, d, c] + motion - motion_t[row + c]
             size = math.sqrt(e[b, d, 0] ** 2 + e[b, d, 1] ** 2)
             length[b, d] = size
             n[b, d, 0] = e[b, d, 0] / size
@@ -58,9 +73,24 @@ def _spring_terms(separation, jacobian_rows, qs, ring_motion, natural_length, st
             closed = max(delta[b, d], 0.0)
             q[b, d] = stiffness[b, d] * (closed * math.sqrt(closed))
             energy += q[b, d] * closed
-            force[b, d, 0] = q[b, d] * n[b, d, 0]
-            force[b, d, 1] = q[b, d] * n[b, d, 1]
-    return e, delta, q, force, n, length, 0.4 * energy
+            peak_force = max(peak_force, q[b, d])
+            for c in range(2):
+                f = q[b, d] * n[b, d, c]
+                force[b, d, c] = f
+                for k in range(5):
+                    gradient[k] += jacobian_rows[row + c, k] * f
+                mismatch[row + c] = f - y_t[row + c]
+                ring += y_t[row + c] * motion_t[row + c]
+                peak_force = max(peak_force, abs(y_t[row + c]))
+                peak_residual = max(peak_residual, abs(mismatch[row + c]))
+    work = 0.0
+    for k in range(5):
+        work += f_scaled[k] * qs_t[k]
+        peak_residual = max(peak_residual, abs(gradient[k]))
+    if not math.isfinite(ring + work + gradient.sum() + mismatch.sum()):
+        peak_residual = math.nan           # as numpy's max: a NaN is never converged
+    return (qs_t, y_t, motion_t, e, delta, q, force, n, length, gradient, mismatch,
+            np.array([0.4 * energy, 0.5 * ring, work, peak_force, peak_residual]))
 
 
 _NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:], "
@@ -187,26 +217,26 @@ def _compile(function, signature):
 
 
 @functools.lru_cache(maxsize=1)
-def compiled_spring_terms():
-    """The compiled :func:`_spring_terms` (numba, eager signature, numba's on-disk cache; compiled
+def compiled_trial_point():
+    """The compiled :func:`_trial_point` (numba, eager signature, numba's on-disk cache; compiled
     when :class:`slewing_model.simulator.BearingSimulator` is built, never in a step)."""
-    return _compile(_spring_terms, _SPRING_SIGNATURE)
+    return _compile(_trial_point, _TRIAL_SIGNATURE)
 
 
 @functools.lru_cache(maxsize=1)
 def compiled_ellipses():
-    """The compiled :func:`_ellipses` (as :func:`compiled_spring_terms`)."""
+    """The compiled :func:`_ellipses` (as :func:`compiled_trial_point`)."""
     return _compile(_ellipses, _ELLIPSE_SIGNATURE)
 
 
 @functools.lru_cache(maxsize=1)
 def compiled_newton_step():
-    """The compiled :func:`_newton_step` (as :func:`compiled_spring_terms`)."""
+    """The compiled :func:`_newton_step` (as :func:`compiled_trial_point`)."""
     return _compile(_newton_step, _NEWTON_SIGNATURE)
 
 
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_spring_terms, _spring_terms), (compiled_ellipses, _ellipses), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_trial_point, _trial_point), (compiled_ellipses, _ellipses), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):

@@ -40,7 +40,7 @@ def _table3_with_measured_radii(table3):
 
 
 @pytest.mark.parametrize("which", ["pitch", "table3 with errors"])
-def test_compiled_springs_equal_the_numpy_springs(pitch, table3, which):
+def test_compiled_trial_points_equal_the_numpy_ones(pitch, table3, which):
     if which == "pitch":
         bearing, superelement = pitch
         loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
@@ -52,15 +52,23 @@ def test_compiled_springs_equal_the_numpy_springs(pitch, table3, which):
     solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
     state = solvers["numpy"].solve(loads).state
     rng = np.random.default_rng(5)
+    f_scaled = solvers["numpy"]._scaled_load(loads)
+    compliance = solvers["numpy"].compliance
     for scale in (0.0, 1e-3, 2e-2):                      # the equilibrium, and points off it
         x = state * (1.0 + scale * rng.standard_normal(state.size))
-        f_scaled = solvers["numpy"]._scaled_load(loads)
-        points = {k: s._evaluate(x[:5], x[5:], f_scaled) for k, s in solvers.items()}
-        for name in ("e", "delta", "q", "force", "n", "length"):
-            ref, got = getattr(points["numpy"], name), getattr(points["compiled"], name)
-            assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max(), name
-        assert points["compiled"].total == pytest.approx(points["numpy"].total, rel=1e-12)
-        assert (points["numpy"].delta > 0).sum() < points["numpy"].delta.size    # some springs open
+        direction = (1e-3 * x[:5] * rng.standard_normal(5), 1e-2 * x[5:] * rng.standard_normal(state.size - 5))
+        direction += (compliance @ direction[1],)
+        for along in ((), (compliance @ x[5:], direction, 0.37)):   # at x, and a trial point along a line
+            points = {k: s._evaluate(x[:5], x[5:], f_scaled, *along) for k, s in solvers.items()}
+            for name in ("qs", "y", "ring_motion", "e", "delta", "q", "force", "n", "length", "gradient", "mismatch"):
+                ref, got = getattr(points["numpy"], name), getattr(points["compiled"], name)
+                # the gradient and mismatch are differences of the forces: round-off on the forces' scale
+                floor = points["numpy"].peak_force if name in ("gradient", "mismatch") else 0.0
+                assert np.abs(got - ref).max() <= 1e-13 * max(np.abs(ref).max(), floor), name
+            for name in ("total", "peak_force"):
+                assert getattr(points["compiled"], name) == pytest.approx(getattr(points["numpy"], name), rel=1e-12)
+            assert abs(points["compiled"].peak_residual - points["numpy"].peak_residual) <= 1e-13 * floor
+            assert (points["numpy"].delta > 0).sum() < points["numpy"].delta.size    # some springs open
 
 
 def test_compiled_ellipses_equal_hertz_ellipse(pitch):
