@@ -479,16 +479,12 @@ class BimeSolver:
         a = self.assembly
         qs, y, e, delta, q = p.qs, p.y, p.e, p.delta, p.q
         b = self.bearing
-        flexible = self.compliance is not None
         # per contact 1..4 from the diagonals: contacts (1,3) <- diagonal 1, (2,4) <- diagonal 2
         per_contact = np.array([0, 1, 0, 1])
         contact_load = q[:, per_contact]
         alpha_diag = np.stack([np.arctan2(e[:, 0, 1], e[:, 0, 0]), np.arctan2(-e[:, 1, 1], e[:, 1, 0])], axis=1)
         contact_angle = alpha_diag[:, per_contact]
         deflection = contact_deflection(contact_load, a.contact_stiffness)
-        ring_disp = None
-        if flexible:
-            ring_disp = self._ring_displacement(y)
         if self._compiled:                    # the same formulas, one compiled loop (contact_kernel)
             semi_a, semi_b, pressure = ellipse_axes(contact_load, a.ball_diameter, a.groove_radius, contact_angle,
                                                     b.pitch_diameter, INNER_CONTACT, b.youngs_modulus, b.poisson_ratio)
@@ -519,25 +515,10 @@ class BimeSolver:
         return LoadDistribution(
             model=self.model, loads=loads, displacement=displacement, ball_angle=a.ball_angle.copy(),
             contact_load=contact_load, contact_angle=contact_angle, interference=delta.copy(),
-            contact_deflection=deflection, ring_displacement=ring_disp, semi_axis_a=semi_a, semi_axis_b=semi_b,
+            contact_deflection=deflection, semi_axis_a=semi_a, semi_axis_b=semi_b,
             contact_pressure=pressure, truncated=truncated, energy=p.total, iterations=iterations, residual=residual,
-            state=np.concatenate([qs, y]),
+            state=np.concatenate([qs, y]), rings=self.ring_compliance,
         )
-
-    def _ring_displacement(self, y: np.ndarray) -> np.ndarray:
-        """(B, 4, 2) groove-centre displacements of contacts 1..4 from the forces ``y``:
-        ``D_in = -G_in P_in^T y``, ``D_out = G_out P_out^T y``."""
-        n = self.bearing.ball_count
-        forces = y.reshape(n, 2, 2)
-        out = np.zeros((n, 4, 2))
-        for ring, slots, sign in (("outer", OUTER_SLOT, 1.0), ("inner", INNER_SLOT, -1.0)):
-            g = self.ring_compliance[ring]
-            load = np.zeros((n, 2, 2))
-            load[:, slots] = forces
-            d = (g @ load.ravel()).reshape(n, 2, 2) * sign
-            cols = [c - 1 for c in RING_CONTACTS[ring]]
-            out[:, cols] = d
-        return out
 
 
 @dataclass

@@ -5,6 +5,7 @@ Run-time module: numpy and the standard library.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -98,7 +99,9 @@ class LoadDistribution:
         Share ``delta_i = (Q/K_i)^(2/3)`` of each contact.
     ring_displacement : ndarray (B, 4, 2) or None, m
         (R, z) displacement of the groove centre of contacts 1..4 by ring
-        deformation (flexible model).
+        deformation (flexible model), computed from the forces on the rings when
+        first asked for (a co-simulation step does not ask: it costs two products
+        with the rings' compliance).
     semi_axis_a, semi_axis_b : ndarray (B, 4), m
         Hertz ellipse across the groove and along the rolling direction.
     contact_pressure : ndarray (B, 4), Pa
@@ -113,6 +116,10 @@ class LoadDistribution:
         Largest force residual at the end, relative to the load scale.
     state : ndarray
         Solver unknowns, for a warm start (:meth:`BimeSolver.solve` ``initial``).
+    rings : dict or None
+        The rings' compliances at the groove centres (flexible model,
+        :func:`slewing_model.ring_compliance.ring_compliances`), from which
+        ``ring_displacement`` follows.
     """
 
     model: str
@@ -123,7 +130,6 @@ class LoadDistribution:
     contact_angle: np.ndarray
     interference: np.ndarray
     contact_deflection: np.ndarray
-    ring_displacement: np.ndarray | None
     semi_axis_a: np.ndarray
     semi_axis_b: np.ndarray
     contact_pressure: np.ndarray
@@ -132,6 +138,24 @@ class LoadDistribution:
     iterations: int
     residual: float
     state: np.ndarray = field(repr=False)
+    rings: dict | None = field(default=None, repr=False, compare=False)
+
+    @functools.cached_property
+    def ring_displacement(self) -> np.ndarray | None:
+        """(B, 4, 2) groove-centre displacements by ring deformation, m (None for rigid rings)."""
+        if self.rings is None:
+            return None
+        from .ring_compliance import groove_displacement
+
+        return groove_displacement(self.rings, self.state[5:])
+
+    def __getstate__(self) -> dict:
+        """Pickled (a study's worker, a copy) with the ring displacements, not the rings'
+        compliance matrices they come from (megabytes)."""
+        state = dict(self.__dict__)
+        if state.get("rings") is not None:
+            state["ring_displacement"], state["rings"] = self.ring_displacement, None
+        return state
 
     @property
     def max_ball_load(self) -> float:

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly import INNER_SLOT, OUTER_SLOT
+from .geometry import RING_CONTACTS
 
 #: from this many balls on, products with a ring compliance go through the harmonics (FFT):
 #: for a (4B, 4B) matrix 12 us against 34 us dense at B = 150, 13 us against 6 us at B = 67
@@ -114,3 +115,18 @@ def ring_selector(n: int, slots: np.ndarray) -> np.ndarray:
     p = np.zeros((4 * n, 4 * n))
     p[np.arange(4 * n), ring_index(n, slots)] = 1.0
     return p
+
+
+def groove_displacement(rings: dict[str, BlockCirculant], forces: np.ndarray) -> np.ndarray:
+    """(B, 4, 2) displacements (R, z) of the groove centres of contacts 1..4 under the contact
+    forces ``forces`` (4B,) that the rings feel, ordered like the relative vectors ``e``:
+    ``D_in = -G_in P_in^T y``, ``D_out = G_out P_out^T y`` (paper eqs 14-15)."""
+    n = rings["outer"].shape[0] // 4
+    forces = forces.reshape(n, 2, 2)
+    out = np.zeros((n, 4, 2))
+    for ring, slots, sign in (("outer", OUTER_SLOT, 1.0), ("inner", INNER_SLOT, -1.0)):
+        load = np.zeros((n, 2, 2))
+        load[:, slots] = forces
+        d = (rings[ring] @ load.ravel()).reshape(n, 2, 2) * sign
+        out[:, [c - 1 for c in RING_CONTACTS[ring]]] = d
+    return out

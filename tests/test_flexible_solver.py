@@ -27,6 +27,20 @@ def test_structured_newton_equals_dense_newton(bearing, loads):
     assert np.allclose(d[:, [1, 2]].ravel(), x[5 + 4 * n:], atol=1e-12)   # inner ring: contacts 2, 3
 
 
+def test_ring_displacement_is_formed_when_asked_for_and_pickled_without_the_rings(bearing):
+    """The result keeps the rings' compliance, not their displacements, until asked (a co-simulation
+    step does not ask); pickled, it carries the displacements (the dense-Newton test above checks
+    their values), not the compliance matrices."""
+    import pickle
+
+    r = BimeSolver(bearing, synthetic_superelement(bearing.ball_count)).solve(LOADS[1])
+    assert "ring_displacement" not in r.__dict__
+    copy = pickle.loads(pickle.dumps(r))
+    assert copy.rings is None and np.array_equal(copy.ring_displacement, r.ring_displacement)
+    assert len(pickle.dumps(r)) < 0.1 * len(pickle.dumps(r.rings))
+    assert BimeSolver(bearing).solve(LOADS[1]).ring_displacement is None          # rigid rings
+
+
 def _contact_force_vectors(r):
     """(B, 2, 2) force of the outer ring on the inner ring's groove centre, per diagonal, (r, z)."""
     alpha1, alpha2 = r.contact_angle[:, 0], r.contact_angle[:, 1]
