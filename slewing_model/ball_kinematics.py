@@ -26,7 +26,8 @@ import numpy as np
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .friction_kernel import (
-    compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
+    compiled_contact_set, compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients,
+    compiled_tractions,
 )
 from .geometry import RING_CONTACTS, Bearing
 
@@ -82,28 +83,67 @@ def _workspace(tag: str) -> _Workspace:
     return spaces[tag]
 
 
+#: what :class:`ContactSet` takes of a load distribution, each (B, 4)
+_DISTRIBUTION_FIELDS = ("contact_load", "contact_angle", "semi_axis_a", "semi_axis_b")
+
+
+def _refuse(what) -> None:
+    """ValueError for a load distribution :class:`ContactSet` cannot take: a field name (a value
+    that is not finite), 5 (a negative load) or 6 (a loaded contact without an ellipse)."""
+    if what == 5:
+        raise ValueError("distribution.contact_load: must be >= 0 (N)")
+    if what == 6:
+        raise ValueError("distribution.semi_axis_a/b: must be > 0 (m) where the contact is loaded")
+    raise ValueError(f"distribution.{what}: must be finite (not NaN or infinite)")
+
+
 class ContactSet:
     """The loaded contacts of a load distribution, and what does not depend on
     the quadrature rule: ball of each contact, normal, ellipse, ring speed."""
 
-    def __init__(self, bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float):
+    def __init__(self, bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float,
+                 compiled: bool = False):
         n_balls = bearing.ball_count
         arrays = {}
-        for name in ("contact_load", "contact_angle", "semi_axis_a", "semi_axis_b"):
+        for name in _DISTRIBUTION_FIELDS:
             value = np.asarray(getattr(distribution, name), dtype=float)
             if value.shape != (n_balls, 4):
                 raise ValueError(f"distribution.{name} has shape {value.shape}, expected ({n_balls}, 4) "
                                  f"for this bearing ({bearing.name})")
-            if not np.all(np.isfinite(value)):
-                raise ValueError(f"distribution.{name}: must be finite (not NaN or infinite)")
             arrays[name] = value
-        q = arrays["contact_load"]
+        dw = np.full(n_balls, bearing.ball_diameter + bearing.preload)
+        if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
+            dw = dw + bearing.errors.ball_diameter_deviation
+        self.ball_radius = 0.5 * dw
+        self.pitch_radius = 0.5 * bearing.pitch_diameter
+        self.length_scale = 0.5 * bearing.ball_diameter
+        self.speed = speed
+        self.contact_load = q = arrays["contact_load"]
+        self.contact_angle = arrays["contact_angle"]
+        self.moving_ring = bearing.moving_ring
+        if compiled:            # the same, one compiled loop (friction_kernel)
+            (status, self.ball_index, self.contact_index, self.owner, self.active, self.inactive, rows,
+             moving, self.force_scale) = compiled_contact_set()(
+                q, self.contact_angle, arrays["semi_axis_a"], arrays["semi_axis_b"], self.ball_radius,
+                np.asarray(bearing.groove_radius, dtype=float), _IS_MOVING[bearing.moving_ring], _NORMAL_SIGN_R,
+                _NORMAL_SIGN_Z, mu, speed, sliding_regularisation)
+            if status:
+                _refuse(_DISTRIBUTION_FIELDS[status - 1] if status <= 4 else status)
+            self.loaded = q > 0.0
+            self.rb, self.rd, self.n_r, self.n_z, self.a, self.b, self.ring_speed = (row[:, None] for row in rows[:7])
+            self.mu_load, eps2 = rows[7], rows[8]
+            self.eps2 = eps2[:, None]
+            self.moving = moving[:, None]
+            self.normal = rows[2:4].T
+            return
+        for name, value in arrays.items():
+            if not np.all(np.isfinite(value)):
+                _refuse(name)
         if np.any(q < 0.0):
-            raise ValueError("distribution.contact_load: must be >= 0 (N)")
+            _refuse(5)
         loaded = q > 0.0
         if np.any(loaded & ((arrays["semi_axis_a"] <= 0.0) | (arrays["semi_axis_b"] <= 0.0))):
-            raise ValueError("distribution.semi_axis_a/b: must be > 0 (m) where the contact is loaded")
-        self.contact_load = q
+            _refuse(6)
         self.loaded = loaded
         self.ball_index, self.contact_index = np.nonzero(loaded)
         active_mask = loaded.any(axis=1)
@@ -112,14 +152,6 @@ class ContactSet:
         position = np.full(n_balls, -1)
         position[active] = np.arange(active.size)
         self.owner = position[self.ball_index]                # active-ball row of every contact
-        n_c = self.ball_index.size
-        dw = np.full(n_balls, bearing.ball_diameter + bearing.preload)
-        if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
-            dw = dw + bearing.errors.ball_diameter_deviation
-        self.ball_radius = 0.5 * dw
-        self.pitch_radius = 0.5 * bearing.pitch_diameter
-        self.length_scale = 0.5 * bearing.ball_diameter
-        self.speed = speed
         b_i, c_i = self.ball_index, self.contact_index
         self.rb = self.ball_radius[b_i][:, None]
         alpha = arrays["contact_angle"][b_i, c_i]
@@ -135,8 +167,6 @@ class ContactSet:
         self.mu_load = mu * q[b_i, c_i]
         self.eps2 = ((sliding_regularisation * abs(speed)) * self.a) ** 2
         self.force_scale = mu * q[active].max(axis=1) if active.size else np.zeros(0)
-        self.contact_angle = arrays["contact_angle"]
-        self.moving_ring = bearing.moving_ring
 
     @functools.cached_property
     def sum_matrix(self) -> np.ndarray:

@@ -309,7 +309,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     solve_quad = quad if solve_quadrature is None else as_quadrature(solve_quadrature)
     seal = seal_torque_of(bearing, seal_torque, seal_torque_per_length, seal_length)
     speed = omega if omega != 0.0 else 1.0
-    geometry = ContactSet(bearing, distribution, mu, speed, sliding_regularisation)
+    geometry = ContactSet(bearing, distribution, mu, speed, sliding_regularisation, compiled=compiled)
     n_balls = bearing.ball_count
     ls, big_r = geometry.length_scale, geometry.pitch_radius
     scale_u = np.array([ls, ls, big_r])                # solved: r w_r, r w_z, R w_c (w_t = 0)

@@ -392,6 +392,88 @@ def compiled_minimise_balls():
     return _compile(_minimise_balls, _MINIMISE_SIGNATURE)
 
 
+_CONTACT_SET_SIGNATURE = ("Tuple((i8, i8[:], i8[:], i8[:], i8[:], i8[:], f8[:, :], b1[:], f8[:]))("
+                          "f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:], f8, f8, f8)")
+
+#: the rows of the per-contact array :func:`_contact_set` returns
+CONTACT_ROWS = ("rb", "rd", "n_r", "n_z", "a", "b", "ring_speed", "mu_load", "eps2")
+
+
+def _contact_set(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
+                 sliding_regularisation):
+    """The loaded contacts of a load distribution (``ContactSet``, :mod:`slewing_model.ball_kinematics`,
+    whose formulas, checks and order these are: ball by ball, contact by contact).
+
+    ``load``, ``angle``, ``semi_a``, ``semi_b`` (B, 4) the distribution's; ``ball_radius`` (B,);
+    ``groove_radius``, ``moving``, ``sign_r``, ``sign_z`` (4,) per contact 1..4. Returns a
+    status (0, or what the numpy code refuses: ``1 + k`` the field ``k`` of the four has a
+    value that is not finite, 5 a negative load, 6 a loaded contact without an ellipse), the
+    ball and contact of every loaded contact (C,), the active-ball row of each, the active and
+    inactive balls, the (9, C) rows of :data:`CONTACT_ROWS`, ``moving`` (C,) and the force
+    scale (active balls,)."""
+    n_balls = load.shape[0]
+    for k, field in enumerate((load, angle, semi_a, semi_b)):
+        for b in range(n_balls):
+            for c in range(4):
+                if not math.isfinite(field[b, c]):
+                    return (1 + k, np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64),
+                            np.empty(0, np.int64), np.empty(0, np.int64), np.empty((9, 0)), np.empty(0, np.bool_),
+                            np.empty(0))
+    n_contacts = n_active = 0
+    negative = no_ellipse = False
+    for b in range(n_balls):
+        loaded_ball = False
+        for c in range(4):
+            if load[b, c] < 0.0:
+                negative = True
+            elif load[b, c] > 0.0:
+                no_ellipse = no_ellipse or semi_a[b, c] <= 0.0 or semi_b[b, c] <= 0.0
+                n_contacts += 1
+                loaded_ball = True
+        n_active += loaded_ball
+    status = 5 if negative else 6 if no_ellipse else 0
+    if status:
+        return (status, np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64),
+                np.empty(0, np.int64), np.empty((9, 0)), np.empty(0, np.bool_), np.empty(0))
+    ball_index, contact_index = np.empty(n_contacts, np.int64), np.empty(n_contacts, np.int64)
+    owner, active = np.empty(n_contacts, np.int64), np.empty(n_active, np.int64)
+    inactive = np.empty(n_balls - n_active, np.int64)
+    rows = np.empty((9, n_contacts))
+    moving_contact = np.empty(n_contacts, np.bool_)
+    force_scale = np.empty(n_active)
+    regularisation = sliding_regularisation * abs(speed)
+    j = row = idle = 0
+    for b in range(n_balls):
+        largest = -1.0
+        for c in range(4):
+            q = load[b, c]
+            if q <= 0.0:
+                continue
+            largest = max(largest, q)
+            ball_index[j], contact_index[j], owner[j] = b, c, row
+            rb = ball_radius[b]
+            rc = groove_radius[c]
+            rows[0, j] = rb
+            rows[1, j] = 2.0 * rb * rc / (rb + rc)                      # conformity_radius
+            rows[2, j] = sign_r[c] * math.cos(angle[b, c])
+            rows[3, j] = sign_z[c] * math.sin(angle[b, c])
+            rows[4, j] = semi_a[b, c]
+            rows[5, j] = semi_b[b, c]
+            rows[6, j] = speed if moving[c] else 0.0
+            rows[7, j] = mu * q
+            rows[8, j] = (regularisation * semi_a[b, c]) ** 2
+            moving_contact[j] = moving[c]
+            j += 1
+        if largest > 0.0:
+            active[row] = b
+            force_scale[row] = mu * largest
+            row += 1
+        else:
+            inactive[idle] = b
+            idle += 1
+    return status, ball_index, contact_index, owner, active, inactive, rows, moving_contact, force_scale
+
+
 _COEFFICIENT_SIGNATURE = ("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], b1[:], f8[:], "
                           "f8, f8)")
 
@@ -444,8 +526,14 @@ def compiled_point_coefficients():
     return _compile(_point_coefficients, _COEFFICIENT_SIGNATURE)
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_contact_set():
+    """The compiled :func:`_contact_set` (as :func:`compiled_evaluate_points`)."""
+    return _compile(_contact_set, _CONTACT_SET_SIGNATURE)
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
+KERNELS = ((compiled_contact_set, _contact_set), (compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
            (compiled_minimise_balls, _minimise_balls), (compiled_tractions, _tractions))
 
 

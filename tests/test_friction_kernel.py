@@ -82,6 +82,35 @@ def test_compiled_sums_equal_the_numpy_sums(case, quadrature):
 
 @needs_numba
 @pytest.mark.parametrize("case", range(3))
+def test_compiled_contact_set_equals_the_numpy_one(case):
+    """The loaded contacts of a distribution (ContactSet) gathered by the compiled loop: the same
+    contacts in the same order, the same geometry; and the same refusals of a distribution
+    that cannot be (a value not finite, a negative load, a loaded contact without an ellipse)."""
+    import dataclasses
+
+    bearing, distribution = _distributions()[case]
+    sets = {k: ContactSet(bearing, distribution, 0.1, 0.7, 1e-3, compiled=k) for k in (False, True)}
+    names = ("ball_index", "contact_index", "owner", "active", "inactive", "loaded", "rb", "rd", "n_r", "n_z", "normal",
+             "a", "b", "moving", "ring_speed", "mu_load", "eps2", "force_scale")
+    for name in names:
+        want, got = getattr(sets[False], name), getattr(sets[True], name)
+        assert want.shape == got.shape and np.allclose(got, want, rtol=1e-15, atol=0.0), name
+    assert sets[False].inactive.size + sets[False].active.size == bearing.ball_count
+    load = distribution.contact_load
+    loaded = tuple(np.argwhere(load > 0)[0])
+    for change, message in (({"contact_angle": np.where(load > 0, np.nan, distribution.contact_angle)},
+                             "contact_angle: must be finite"),
+                            ({"contact_load": load - 2.0 * (load > 0) * load.max()}, "contact_load: must be >= 0"),
+                            ({"semi_axis_b": np.where(np.arange(load.size).reshape(load.shape) == np.ravel_multi_index(
+                                loaded, load.shape), 0.0, distribution.semi_axis_b)}, "must be > 0 (m) where")):
+        bad = dataclasses.replace(distribution, **change)
+        for compiled in (False, True):
+            with pytest.raises(ValueError, match=message.replace("(", "\\(").replace(")", "\\)")):
+                ContactSet(bearing, bad, 0.1, 0.7, 1e-3, compiled=compiled)
+
+
+@needs_numba
+@pytest.mark.parametrize("case", range(3))
 def test_compiled_torque_equals_the_numpy_torque(case):
     bearing, distribution = _distributions()[case]
     cold = {k: friction_torque(bearing, distribution, kernel=k) for k in ("numpy", "compiled")}
