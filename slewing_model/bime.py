@@ -55,6 +55,7 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import compiled_trial_point, ellipse_axes
+from .contact_kernel import column_turn as compiled_column_turn
 from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -463,7 +464,8 @@ class BimeSolver:
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn)
+                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn,
+                                     turn=compiled_column_turn if self._compiled else None)
             op = bordered(op)
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
                 op = bordered(complete_operator(self.pending_operator, self.jacobian, mu))

@@ -136,6 +136,82 @@ def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_in
     return dq, y_new
 
 
+_TURN_SIGNATURE = "Tuple((b1, f8[:, :], f8[:, :]))(f8[:, :], f8[:, :], f8[:, :], f8)"
+
+
+def _solve_small(a, b):
+    """``a^-1 b`` for a small square ``a`` (m, m) and ``b`` (m, k): Gaussian elimination with
+    partial pivoting (as LAPACK's ``gesv``); and False where ``a`` is singular."""
+    m, k = b.shape
+    work = np.empty((m, m + k))
+    work[:, :m] = a
+    work[:, m:] = b
+    for col in range(m):
+        pivot = col
+        for r in range(col + 1, m):
+            if abs(work[r, col]) > abs(work[pivot, col]):
+                pivot = r
+        if work[pivot, col] == 0.0:
+            return False, work[:, m:]
+        if pivot != col:
+            for c in range(col, m + k):
+                work[col, c], work[pivot, c] = work[pivot, c], work[col, c]
+        for r in range(col + 1, m):
+            factor = work[r, col] / work[col, col]
+            for c in range(col, m + k):
+                work[r, c] -= factor * work[col, c]
+    x = np.empty((m, k))
+    for j in range(k):
+        for r in range(m - 1, -1, -1):
+            value = work[r, m + j]
+            for c in range(r + 1, m):
+                value -= work[r, c] * x[c, j]
+            x[r, j] = value / work[r, r]
+    return True, x
+
+
+def _column_turn(old, new, coupling, mu):
+    """:func:`slewing_model.reduced_operator.column_turn` as one compiled loop: whether the turn
+    ``T`` (``new = old T``, fitted by least squares to 1e-12) exists, the coupling ``coupling T``
+    and ``(new^T coupling T + mu I)^-1``."""
+    n = old.shape[0]
+    normal, right = np.zeros((5, 5)), np.zeros((5, 5))           # old^T old, old^T new
+    for i in range(n):
+        for r in range(5):
+            for c in range(5):
+                normal[r, c] += old[i, r] * old[i, c]
+                right[r, c] += old[i, r] * new[i, c]
+    found, turn = _solve_small(normal, right)
+    empty = np.empty((0, 5))
+    if not found:
+        return False, empty, empty
+    worst = scale = 0.0
+    for i in range(n):
+        for c in range(5):
+            value = 0.0
+            for k in range(5):
+                value += old[i, k] * turn[k, c]
+            worst = max(worst, abs(value - new[i, c]))
+            scale = max(scale, abs(new[i, c]))
+    if not worst <= 1e-12 * scale:
+        return False, empty, empty
+    turned = np.zeros((n, 5))
+    for i in range(n):
+        for k in range(5):
+            value = coupling[i, k]
+            for c in range(5):
+                turned[i, c] += value * turn[k, c]
+    schur = mu * np.eye(5)                                       # new^T coupling T + mu I
+    for i in range(n):
+        for r in range(5):
+            for c in range(5):
+                schur[r, c] += new[i, r] * turned[i, c]
+    found, schur_inverse = _solve_small(schur, np.eye(5))
+    if not found:
+        return False, empty, empty
+    return True, turned, schur_inverse
+
+
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
     by bisection, as ``np.interp`` searches)."""
@@ -213,7 +289,7 @@ def _ellipses(load, ball_diameter, groove_radius, contact_angle, pitch_diameter,
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
-    return compile_loop(function, signature, ("_segment", "_interp"), error_model="numpy")
+    return compile_loop(function, signature, ("_segment", "_interp", "_solve_small"), error_model="numpy")
 
 
 @functools.lru_cache(maxsize=1)
@@ -235,8 +311,20 @@ def compiled_newton_step():
     return _compile(_newton_step, _NEWTON_SIGNATURE)
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_column_turn():
+    """The compiled :func:`_column_turn` (as :func:`compiled_trial_point`)."""
+    return _compile(_column_turn, _TURN_SIGNATURE)
+
+
+def column_turn(old, new, coupling, mu):
+    """:func:`slewing_model.reduced_operator.column_turn` by the compiled loop."""
+    found, coupling, schur_inverse = compiled_column_turn()(old, new, coupling, mu)
+    return (coupling, schur_inverse) if found else None
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_trial_point, _trial_point), (compiled_ellipses, _ellipses), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_ellipses, _ellipses), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):

@@ -91,31 +91,44 @@ def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.nda
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
 
-def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True) -> ReducedOperator:
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True, turn=None
+                    ) -> ReducedOperator:
     """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
 
     ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
     ``W^-1 J_a`` follows the Jacobian. Where every ball keeps its groove centres (no
     manufacturing errors) turning the balls by an angle only mixes the Jacobian's columns,
     ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
-    ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``. ``T`` is
-    fitted by least squares and used where it reproduces ``J_new`` to 1e-12; otherwise (errors
-    move the groove centres with the ring) the coupling is formed anew, without the fit where
-    the caller knows it (``may_turn`` False). The operator itself when the Jacobian did not
-    change."""
+    ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``
+    (:func:`column_turn`, or ``turn``, the same as a compiled loop). Otherwise (errors move
+    the groove centres with the ring) the coupling is formed anew, without trying the turn
+    where the caller knows it (``may_turn`` False). The operator itself when the Jacobian did
+    not change."""
     ja = jacobian.reshape(-1, 5)[op.rows]
     if np.array_equal(op.jacobian, ja):
         return op
-    coupling = None
+    turned = None
     if may_turn and op.jacobian.shape == ja.shape:
-        old = op.jacobian
-        try:            # J_a has rank < 5 on fewer than three loaded diagonals: then formed anew
-            turn = np.linalg.solve(old.T @ old, old.T @ ja)
-            if np.abs(old @ turn - ja).max() <= 1e-12 * np.abs(ja).max():
-                coupling = op.coupling @ turn
-        except np.linalg.LinAlgError:
-            pass
-    return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, coupling)
+        turned = (column_turn if turn is None else turn)(op.jacobian, ja, op.coupling, mu)
+    if turned is None:
+        return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu)
+    coupling, schur_inverse = turned
+    return ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, ja, coupling, schur_inverse)
+
+
+def column_turn(old: np.ndarray, new: np.ndarray, coupling: np.ndarray, mu: float):
+    """The coupling ``coupling T`` and the Schur complement's inverse ``(J_new^T coupling T + mu I)^-1``
+    where the Jacobian ``new`` (n, 5) is ``old T`` (``T`` fitted by least squares, used where it
+    reproduces ``new`` to 1e-12: then ``coupling T = W^-1 old T = W^-1 new``), or None (no ``T``
+    does: errors move the grooves with the ring; or the fit's normal equations are singular)."""
+    try:
+        turn = np.linalg.solve(old.T @ old, old.T @ new)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.abs(old @ turn - new).max() <= 1e-12 * np.abs(new).max():
+        return None
+    coupling = coupling @ turn
+    return coupling, np.linalg.inv(new.T @ coupling + mu * np.eye(5))
 
 
 def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:

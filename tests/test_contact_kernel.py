@@ -116,6 +116,36 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
         assert np.array_equal(y_c == 0.0, y == 0.0)                          # zero off the operator's rows
 
 
+def test_compiled_column_turn_equals_the_numpy_turn(pitch, table3):
+    """After a turn of the ring the kept operator's coupling ``W^-1 J`` follows by a 5 x 5 column turn
+    where one exists: the compiled turn gives the numpy one's coupling and Schur complement, and
+    finds none where numpy finds none (grooves with errors turning with the ring)."""
+    from slewing_model import synthetic_errors
+    from slewing_model.contact_kernel import column_turn as compiled_turn
+    from slewing_model.reduced_operator import column_turn
+
+    bearing, superelement = pitch
+    solver = BimeSolver(bearing, superelement, psi=0.2)
+    solver.solve(Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6))
+    op, mu = solver.operator, 1e-12 * solver.reference_stiffness
+    solver.set_rotation(0.23)
+    new = solver.jacobian.reshape(-1, 5)[op.rows]
+    want, got = column_turn(op.jacobian, new, op.coupling, mu), compiled_turn(op.jacobian, new, op.coupling, mu)
+    assert want is not None and got is not None
+    for a, b in zip(got, want):
+        assert np.abs(a - b).max() <= 1e-11 * np.abs(b).max()
+    # the turn reproduces the coupling formed from the new Jacobian
+    assert np.abs(got[0] - op.inverse @ new).max() <= 1e-9 * np.abs(got[0]).max()
+    errors = table3.with_errors(synthetic_errors(table3.ball_count, seed=3))
+    moved = BimeSolver(errors, build_superelement(table3, mesh="coarse", bc="free"), psi=0.2)
+    moved.solve(Loads(Fz=1e5, My=2e4))
+    op_e = moved.operator
+    moved.set_rotation(0.25)
+    new_e = moved.jacobian.reshape(-1, 5)[op_e.rows]
+    assert column_turn(op_e.jacobian, new_e, op_e.coupling, mu) is None
+    assert compiled_turn(op_e.jacobian, new_e, op_e.coupling, mu) is None
+
+
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
 def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
     case, sims = simulators_per_kernel(name, 25, "contact_kernel")
