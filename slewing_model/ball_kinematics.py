@@ -26,7 +26,7 @@ import numpy as np
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .friction_kernel import (
-    compiled_contact_set, compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients,
+    compiled_ball_results, compiled_contact_set, compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients,
     compiled_tractions,
 )
 from .geometry import RING_CONTACTS, Bearing
@@ -617,6 +617,39 @@ def _minimise_compiled(contacts: ContactPoints, u: np.ndarray, tol: float, max_i
     # as the numpy loop counts: the most a ball took, or max_iterations when some ball ran out
     done = bool(converged.all())
     return u, int(iterations.max(initial=0)) if done else max_iterations, float(residual.max(initial=0.0)), done
+
+
+def ball_results(geometry: ContactSet, u: np.ndarray, contact_power: np.ndarray, n_balls: int, cage_speed: float,
+                 compiled: bool = False) -> tuple:
+    """What the friction torque reports of the solved ball motions ``u`` (scaled unknowns of the
+    active balls) and the contacts' dissipated powers (C,), per ball and contact 1..4:
+
+    the contact powers (B, 4), the power per ball over ``|speed|`` (B,), the balls' angular
+    velocities (B, 3: ``w_r, w_t, w_z``), their orbital speeds (B,; ``cage_speed``, rolling, for
+    the unloaded), the state (B, 4) of a warm start, the spin-to-roll ratio of each loaded
+    contact (B, 4) and the number of loaded contacts (B,). ``compiled``: one compiled loop
+    (:func:`slewing_model.friction_kernel.compiled_ball_results`), the same arithmetic."""
+    geo = geometry
+    ls, big_r, speed = geo.length_scale, geo.pitch_radius, geo.speed
+    if compiled:
+        return compiled_ball_results()(geo.ball_index, geo.contact_index, geo.owner, geo.active, geo.inactive,
+                                       contact_power, np.ascontiguousarray(u, dtype=float), np.ravel(geo.n_r),
+                                       np.ravel(geo.n_z), np.ravel(geo.ring_speed), ls, big_r, speed,
+                                       cage_speed, n_balls)
+    power = np.zeros((n_balls, 4))
+    power[geo.ball_index, geo.contact_index] = contact_power
+    per_ball = power.sum(axis=1) / abs(speed)
+    omega_ball = np.zeros((n_balls, 3))
+    orbital = np.zeros(n_balls)
+    state = np.zeros((n_balls, 4))
+    active = geo.active
+    if active.size:
+        omega_ball[active[:, None], [0, 2]] = u[:, :2] / ls
+        orbital[active] = u[:, 2] / big_r
+        state[active[:, None], SOLVED] = u / (speed * np.array([ls, ls, big_r]))
+    orbital[geo.inactive] = cage_speed          # unloaded balls: nominal rolling, for the record
+    return (power, per_ball, omega_ball, orbital, state, spin_roll_ratio(geo, u, n_balls),
+            np.count_nonzero(geo.loaded, axis=1))
 
 
 def spin_roll_ratio(geometry: ContactSet, u: np.ndarray, n_balls: int) -> np.ndarray:

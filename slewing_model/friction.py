@@ -53,7 +53,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ball_kinematics import SOLVED, ContactPoints, ContactSet, cold_start, minimise_power, spin_roll_ratio
+from .assembly import cage_ratio
+from .ball_kinematics import SOLVED, ContactPoints, ContactSet, ball_results, cold_start, minimise_power
 from .catalogue import CATALOGUE_MU, catalogue_torque  # noqa: F401  (part of this module's interface)
 from .contact_friction import (  # noqa: F401
     DEFAULT_MU, DEFAULT_SLIDING_REGULARISATION, EllipseFriction, check_number, conformity_radius, ellipse_friction,
@@ -335,29 +336,18 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     else:
         power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0
 
-    contact_power = np.zeros((n_balls, 4))
-    contact_power[geometry.ball_index, geometry.contact_index] = power_c
-    per_ball = contact_power.sum(axis=1) / abs(speed)
+    cage_speed = cage_ratio(bearing) * speed if geometry.inactive.size else 0.0
+    contact_power, per_ball, omega_ball, orbital, state, spin_roll, contact_count = ball_results(
+        geometry, u, power_c, n_balls, cage_speed, compiled)
     contact_part = float(per_ball.sum())
     contact_part_moments = -math.copysign(1.0, speed) * float(np.sum(torque_c))
     magnitude = contact_part + seal
 
-    omega_ball = np.zeros((n_balls, 3))
-    orbital = np.zeros(n_balls)
-    state = np.zeros((n_balls, 4))
-    if active.size:
-        omega_ball[active[:, None], [0, 2]] = u[:, :2] / ls
-        orbital[active] = u[:, 2] / big_r
-        state[active[:, None], SOLVED] = u / (speed * scale_u)
-    if geometry.inactive.size:       # unloaded balls: nominal rolling, for the record
-        from .assembly import cage_ratio
-        orbital[geometry.inactive] = cage_ratio(bearing) * speed
     return FrictionTorque(
         torque=regularised_torque(magnitude, omega, omega_regularisation),
         magnitude=magnitude, contact_part=contact_part, contact_part_moments=contact_part_moments,
         seal_part=seal, per_ball=per_ball, omega=omega, kinematics_speed=speed,
-        ball_angular_velocity=omega_ball, orbital_speed=orbital,
-        spin_roll_ratio=spin_roll_ratio(geometry, u, n_balls), contact_power=contact_power,
-        contact_count=np.count_nonzero(geometry.loaded, axis=1), power=float(np.sum(power_c)), mu=mu,
+        ball_angular_velocity=omega_ball, orbital_speed=orbital, spin_roll_ratio=spin_roll, contact_power=contact_power,
+        contact_count=contact_count, power=float(np.sum(power_c)), mu=mu,
         iterations=iterations, residual=residual, converged=converged, state=state,
     )

@@ -474,6 +474,51 @@ def _contact_set(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving
     return status, ball_index, contact_index, owner, active, inactive, rows, moving_contact, force_scale
 
 
+_BALL_RESULTS_SIGNATURE = ("Tuple((f8[:, :], f8[:], f8[:, :], f8[:], f8[:, :], f8[:, :], i8[:]))("
+                           "i8[:], i8[:], i8[:], i8[:], i8[:], f8[:], f8[:, :], f8[:], f8[:], f8[:], f8, f8, f8, f8, "
+                           "i8)")
+
+
+def _ball_results(ball_index, contact_index, owner, active, inactive, contact_power_c, u, n_r, n_z, ring_speed,
+                  length_scale, pitch_radius, speed, cage_speed, n_balls):
+    """Per ball and contact, what the friction torque reports of the solved ball motions ``u``
+    (active balls, 3) and the contacts' powers (C,): the formulas of
+    ``ball_kinematics.ball_results``, in the same order of operations. Returns the contact powers
+    (B, 4), the power per ball over ``|speed|`` (B,), the balls' angular velocities (B, 3), orbital
+    speeds (B,), the state (B, 4), the spin-to-roll ratios (B, 4) and the loaded contacts' count (B,)."""
+    contact_power = np.zeros((n_balls, 4))
+    spin_roll = np.zeros((n_balls, 4))
+    count = np.zeros(n_balls, np.int64)
+    for j in range(ball_index.size):
+        b, c, row = ball_index[j], contact_index[j], owner[j]
+        contact_power[b, c] = contact_power_c[j]
+        count[b] += 1
+        # raceway minus ball, W e_z - w, and its components along the normal and about g = (-n_z, 0, n_r)
+        rel_r = -u[row, 0] / length_scale
+        rel_z = -u[row, 1] / length_scale + ring_speed[j]
+        spin = rel_r * n_r[j] + rel_z * n_z[j]
+        roll = -rel_r * n_z[j] + rel_z * n_r[j]
+        spin_roll[b, c] = spin / roll if roll != 0.0 else 0.0
+    per_ball = np.empty(n_balls)
+    for b in range(n_balls):
+        per_ball[b] = (((contact_power[b, 0] + contact_power[b, 1]) + contact_power[b, 2]) + contact_power[b, 3]) \
+            / abs(speed)
+    omega_ball = np.zeros((n_balls, 3))
+    orbital = np.zeros(n_balls)
+    state = np.zeros((n_balls, 4))
+    for row in range(active.size):
+        b = active[row]
+        omega_ball[b, 0] = u[row, 0] / length_scale
+        omega_ball[b, 2] = u[row, 1] / length_scale
+        orbital[b] = u[row, 2] / pitch_radius
+        state[b, 0] = u[row, 0] / (speed * length_scale)          # the solved columns (SOLVED)
+        state[b, 2] = u[row, 1] / (speed * length_scale)
+        state[b, 3] = u[row, 2] / (speed * pitch_radius)
+    for b in inactive:
+        orbital[b] = cage_speed
+    return contact_power, per_ball, omega_ball, orbital, state, spin_roll, count
+
+
 _COEFFICIENT_SIGNATURE = ("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], b1[:], f8[:], "
                           "f8, f8)")
 
@@ -532,8 +577,14 @@ def compiled_contact_set():
     return _compile(_contact_set, _CONTACT_SET_SIGNATURE)
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_ball_results():
+    """The compiled :func:`_ball_results` (as :func:`compiled_evaluate_points`)."""
+    return _compile(_ball_results, _BALL_RESULTS_SIGNATURE)
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_contact_set, _contact_set), (compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
+KERNELS = ((compiled_ball_results, _ball_results), (compiled_contact_set, _contact_set), (compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
            (compiled_minimise_balls, _minimise_balls), (compiled_tractions, _tractions))
 
 

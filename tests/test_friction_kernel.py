@@ -89,13 +89,26 @@ def test_compiled_contact_set_equals_the_numpy_one(case):
     import dataclasses
 
     bearing, distribution = _distributions()[case]
+    unloaded = np.arange(bearing.ball_count) % 7 == 0                 # and some balls without load
+    distribution = dataclasses.replace(distribution, contact_load=np.where(unloaded[:, None], 0.0,
+                                                                           distribution.contact_load))
     sets = {k: ContactSet(bearing, distribution, 0.1, 0.7, 1e-3, compiled=k) for k in (False, True)}
     names = ("ball_index", "contact_index", "owner", "active", "inactive", "loaded", "rb", "rd", "n_r", "n_z", "normal",
              "a", "b", "moving", "ring_speed", "mu_load", "eps2", "force_scale")
     for name in names:
         want, got = getattr(sets[False], name), getattr(sets[True], name)
         assert want.shape == got.shape and np.allclose(got, want, rtol=1e-15, atol=0.0), name
-    assert sets[False].inactive.size + sets[False].active.size == bearing.ball_count
+    assert np.array_equal(sets[True].inactive, np.flatnonzero(unloaded))
+    # what the torque reports of the balls' motions, from the same motions and contact powers
+    from slewing_model.ball_kinematics import ball_results
+
+    rng = np.random.default_rng(case)
+    u = rng.standard_normal((sets[False].active.size, 3))
+    power = rng.uniform(0.0, 1.0, sets[False].ball_index.size)
+    results = [ball_results(sets[k], u, power, bearing.ball_count, 0.31, compiled=k) for k in (False, True)]
+    for want, got in zip(*results):
+        assert want.shape == got.shape and np.array_equal(want, got)
+    assert results[0][3][sets[False].inactive].tolist() == [0.31] * sets[False].inactive.size
     load = distribution.contact_load
     loaded = tuple(np.argwhere(load > 0)[0])
     for change, message in (({"contact_angle": np.where(load > 0, np.nan, distribution.contact_angle)},
