@@ -54,7 +54,7 @@ import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
-from .contact_kernel import compiled_trial_point, ellipse_axes
+from .contact_kernel import compiled_trial_point, contact_results
 from .contact_kernel import column_turn as compiled_column_turn
 from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
@@ -481,24 +481,30 @@ class BimeSolver:
         a = self.assembly
         qs, y, e, delta, q = p.qs, p.y, p.e, p.delta, p.q
         b = self.bearing
-        # per contact 1..4 from the diagonals: contacts (1,3) <- diagonal 1, (2,4) <- diagonal 2
-        per_contact = np.array([0, 1, 0, 1])
-        contact_load = q[:, per_contact]
-        alpha_diag = np.stack([np.arctan2(e[:, 0, 1], e[:, 0, 0]), np.arctan2(-e[:, 1, 1], e[:, 1, 0])], axis=1)
-        contact_angle = alpha_diag[:, per_contact]
-        deflection = contact_deflection(contact_load, a.contact_stiffness)
         if self._compiled:                    # the same formulas, one compiled loop (contact_kernel)
-            semi_a, semi_b, pressure = ellipse_axes(contact_load, a.ball_diameter, a.groove_radius, contact_angle,
-                                                    b.pitch_diameter, INNER_CONTACT, b.youngs_modulus, b.poisson_ratio)
+            (contact_load, contact_angle, deflection, semi_a, semi_b, pressure, truncated, first_off) = contact_results(
+                q, e, a.contact_stiffness, a.ball_diameter, a.groove_radius, b.pitch_diameter, INNER_CONTACT,
+                b.youngs_modulus, b.poisson_ratio, self.edge_angle)
+            off = None if first_off < 0 else divmod(first_off, 4)
         else:
+            # per contact 1..4 from the diagonals: contacts (1,3) <- diagonal 1, (2,4) <- diagonal 2
+            per_contact = np.array([0, 1, 0, 1])
+            contact_load = q[:, per_contact]
+            alpha_diag = np.stack([np.arctan2(e[:, 0, 1], e[:, 0, 0]), np.arctan2(-e[:, 1, 1], e[:, 1, 0])], axis=1)
+            contact_angle = alpha_diag[:, per_contact]
+            deflection = contact_deflection(contact_load, a.contact_stiffness)
             ell = hertz_ellipse(contact_load, a.ball_diameter[:, None], a.groove_radius, contact_angle,
                                 b.pitch_diameter, CONTACT_RING, b.youngs_modulus, b.poisson_ratio)
             semi_a, semi_b, pressure = ell.a, ell.b, ell.max_pressure
-        # the contact point must stay on the raceway: beyond the groove edge the ball rides the
-        # edge and the model (and the bearing) no longer carries the load
-        off = (contact_load > 0.0) & (contact_angle >= self.edge_angle[None, :])
-        if np.any(off):
-            ball, contact = map(int, np.argwhere(off)[0])
+            loaded = contact_load > 0.0
+            # the contact point must stay on the raceway: beyond the groove edge the ball rides the
+            # edge and the model (and the bearing) no longer carries the load
+            beyond = np.argwhere(loaded & (contact_angle >= self.edge_angle[None, :]))
+            off = tuple(map(int, beyond[0])) if beyond.size else None
+            # edge loading: the ellipse runs over the groove edge (reported, see LoadDistribution.truncated)
+            truncated = loaded & (contact_angle + semi_a / a.groove_radius >= self.edge_angle[None, :])
+        if off is not None:
+            ball, contact = off
             raise LoadCapacityError(
                 f"loads {loads} are beyond what the bearing can carry: at ball {ball + 1} the contact angle of "
                 f"contact {contact + 1} would be {math.degrees(contact_angle[ball, contact]):.1f} deg, past the "
@@ -510,8 +516,6 @@ class BimeSolver:
                 f"contact {contact + 1} would be {pressure.max() / 1e6:.0f} MPa, above the limit of "
                 f"{self.pressure_limit / 1e6:.0f} MPa (static safety factor "
                 f"{(ISO76_PRESSURE_LIMIT / pressure.max()) ** 3:.3f})")
-        # edge loading: the ellipse runs over the groove edge (reported, see LoadDistribution.truncated)
-        truncated = (contact_load > 0.0) & (contact_angle + semi_a / a.groove_radius >= self.edge_angle[None, :])
         displacement = qs.copy()
         displacement[3:] /= self.length
         return LoadDistribution(

@@ -245,51 +245,81 @@ def _interp(x, xp, fp, left, right, guess):
     return slope * (x - xp[j]) + fp[j], j
 
 
-_ELLIPSE_SIGNATURE = "UniTuple(f8[:, :], 3)(f8[:, :], f8[:], f8[:, :], f8[:, :], f8, b1[:], f8, f8[:], f8[:], f8[:])"
+_RESULTS_SIGNATURE = ("Tuple((f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], b1[:, :], i8))("
+                      "f8[:, :], f8[:, :, :], f8[:, :], f8[:], f8[:, :], f8, b1[:], f8, f8[:], f8[:], f8[:], f8[:])")
 
 
-def _ellipses(load, ball_diameter, groove_radius, contact_angle, pitch_diameter, inner, modulus,
-              f_table, log_kappa_table, e_table):
-    """Semi-axes ``a``, ``b`` and largest pressure (B, 4) of the contacts: the formulas of
-    :func:`slewing_model.contact.hertz_ellipse` (its tables of ``F(rho)``, ``log kappa`` and
-    ``E``; ``modulus`` is ``E'``) with the curvatures of
-    :func:`slewing_model.contact.raceway_curvatures`; ``inner`` (4,) which contacts are on the
-    inner ring. An unloaded contact's are zero, as there."""
-    n_balls, n_contacts = load.shape
-    semi_a = np.zeros((n_balls, n_contacts))
-    semi_b = np.zeros((n_balls, n_contacts))
-    pressure = np.zeros((n_balls, n_contacts))
+def _hertz_contact(q, dw, groove_radius, contact_angle, pitch_diameter, inner, modulus, f_table, log_kappa_table,
+                   e_table):
+    """Semi-axes ``a``, ``b`` and largest pressure of one loaded contact (``q > 0``): the formulas of
+    :func:`slewing_model.contact.hertz_ellipse` (its tables of ``F(rho)``, ``log kappa`` and ``E``;
+    ``modulus`` is ``E'``) with the curvatures of :func:`slewing_model.contact.raceway_curvatures`;
+    ``inner``: the contact is on the inner ring."""
     last = e_table.size - 1
+    gamma = dw * math.cos(contact_angle) / pitch_diameter
+    if inner:
+        rolling = 2.0 / dw * gamma / (1.0 - gamma)
+    else:
+        rolling = -2.0 / dw * gamma / (1.0 + gamma)
+    transverse = -1.0 / groove_radius
+    rho_ball = 2.0 / dw
+    sum_rho = 2.0 * rho_ball + rolling + transverse
+    f_rho = (rolling - transverse) / sum_rho
+    # F(rho) -> log kappa, then E of it: the same segment of the tables but at its ends
+    log_kappa, j = _interp(f_rho, f_table, log_kappa_table, 0.0, log_kappa_table[last], 0)
+    kappa = math.exp(log_kappa)
+    e_int, _ = _interp(log_kappa, log_kappa_table, e_table, e_table[0], e_table[last], j)
+    base = 3.0 * q / (sum_rho * modulus)
+    semi_a = (2.0 * (kappa * kappa) * e_int / math.pi * base) ** (1.0 / 3.0)
+    semi_b = (2.0 * e_int / (math.pi * kappa) * base) ** (1.0 / 3.0)
+    return semi_a, semi_b, 1.5 * q / (math.pi * semi_a * semi_b)
+
+
+def _contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner, modulus,
+                     f_table, log_kappa_table, e_table, edge_angle):
+    """What a load distribution reports of its contacts 1..4, from the diagonals' loads ``load``
+    (B, 2) and relative vectors ``e`` (B, 2, 2): the formulas of ``BimeSolver._result``
+    (:mod:`slewing_model.bime`) in the same order of operations.
+
+    Contacts 1 and 3 carry diagonal 1's load at its angle ``atan2(e_z, e_r)``, contacts 2 and 4
+    diagonal 2's at ``atan2(-e_z, e_r)``; the deflection ``(Q / K)^(2/3)``; the Hertz ellipse and
+    pressure of the loaded ones (:func:`_hertz_contact`; zero where unloaded); whether the ellipse
+    runs over the groove edge (``edge_angle`` (4,)). Returns those (B, 4) arrays and the first
+    contact (``4 ball + contact``) whose angle is past its groove edge, or -1."""
+    n_balls = load.shape[0]
+    contact_load = np.empty((n_balls, 4))
+    contact_angle = np.empty((n_balls, 4))
+    deflection = np.empty((n_balls, 4))
+    semi_a = np.zeros((n_balls, 4))
+    semi_b = np.zeros((n_balls, 4))
+    pressure = np.zeros((n_balls, 4))
+    truncated = np.zeros((n_balls, 4), np.bool_)
+    off = -1
     for b in range(n_balls):
-        dw = ball_diameter[b]
-        for c in range(n_contacts):
-            q = max(load[b, c], 0.0)
-            if q == 0.0:
-                continue
-            gamma = dw * math.cos(contact_angle[b, c]) / pitch_diameter
-            if inner[c]:
-                rolling = 2.0 / dw * gamma / (1.0 - gamma)
-            else:
-                rolling = -2.0 / dw * gamma / (1.0 + gamma)
-            transverse = -1.0 / groove_radius[b, c]
-            rho_ball = 2.0 / dw
-            sum_rho = 2.0 * rho_ball + rolling + transverse
-            f_rho = (rolling - transverse) / sum_rho
-            # F(rho) -> log kappa, then E of it: the same segment of the tables but at its ends
-            log_kappa, j = _interp(f_rho, f_table, log_kappa_table, 0.0, log_kappa_table[last], 0)
-            kappa = math.exp(log_kappa)
-            e_int, _ = _interp(log_kappa, log_kappa_table, e_table, e_table[0], e_table[last], j)
-            base = 3.0 * q / (sum_rho * modulus)
-            semi_a[b, c] = (2.0 * (kappa * kappa) * e_int / math.pi * base) ** (1.0 / 3.0)
-            semi_b[b, c] = (2.0 * e_int / (math.pi * kappa) * base) ** (1.0 / 3.0)
-            pressure[b, c] = 1.5 * q / (math.pi * semi_a[b, c] * semi_b[b, c])
-    return semi_a, semi_b, pressure
+        angle_1 = math.atan2(e[b, 0, 1], e[b, 0, 0])
+        angle_2 = math.atan2(-e[b, 1, 1], e[b, 1, 0])
+        for c in range(4):
+            d = c % 2                                     # contacts (1, 3) <- diagonal 1, (2, 4) <- diagonal 2
+            q = load[b, d]
+            angle = angle_1 if d == 0 else angle_2
+            contact_load[b, c] = q
+            contact_angle[b, c] = angle
+            deflection[b, c] = (max(q, 0.0) / contact_stiffness[b, c]) ** (2.0 / 3.0)
+            if q > 0.0:
+                semi_a[b, c], semi_b[b, c], pressure[b, c] = _hertz_contact(
+                    q, ball_diameter[b], groove_radius[b, c], angle, pitch_diameter, inner[c], modulus, f_table,
+                    log_kappa_table, e_table)
+                if off < 0 and angle >= edge_angle[c]:
+                    off = 4 * b + c
+                truncated[b, c] = angle + semi_a[b, c] / groove_radius[b, c] >= edge_angle[c]
+    return contact_load, contact_angle, deflection, semi_a, semi_b, pressure, truncated, off
 
 
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
-    return compile_loop(function, signature, ("_segment", "_interp", "_solve_small"), error_model="numpy")
+    return compile_loop(function, signature, ("_segment", "_interp", "_solve_small", "_hertz_contact"),
+                        error_model="numpy")
 
 
 @functools.lru_cache(maxsize=1)
@@ -300,9 +330,9 @@ def compiled_trial_point():
 
 
 @functools.lru_cache(maxsize=1)
-def compiled_ellipses():
-    """The compiled :func:`_ellipses` (as :func:`compiled_trial_point`)."""
-    return _compile(_ellipses, _ELLIPSE_SIGNATURE)
+def compiled_contact_results():
+    """The compiled :func:`_contact_results` (as :func:`compiled_trial_point`)."""
+    return _compile(_contact_results, _RESULTS_SIGNATURE)
 
 
 @functools.lru_cache(maxsize=1)
@@ -324,7 +354,7 @@ def column_turn(old, new, coupling, mu):
 
 
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_ellipses, _ellipses), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):
@@ -334,11 +364,12 @@ def newton_step(op, point, f_scaled):
                                   point.y.size)
 
 
-def ellipse_axes(load, ball_diameter, groove_radius, contact_angle, pitch_diameter, inner, youngs_modulus,
-                 poisson_ratio):
-    """``a``, ``b`` and the largest pressure (B, 4) of :func:`slewing_model.contact.hertz_ellipse`
-    by the compiled loop: ``ball_diameter`` (B,), ``inner`` (4,) bool, the rest as there."""
+def contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner, youngs_modulus,
+                    poisson_ratio, edge_angle):
+    """:func:`_contact_results` by the compiled loop: the moduli as :func:`slewing_model.contact.hertz_ellipse`
+    takes them, ``inner`` (4,) which contacts are on the inner ring."""
     from .contact import _E_TABLE, _F_TABLE, _LOG_KAPPA, effective_modulus
 
-    return compiled_ellipses()(load, ball_diameter, groove_radius, contact_angle, pitch_diameter, inner,
-                               effective_modulus(youngs_modulus, poisson_ratio), _F_TABLE, _LOG_KAPPA, _E_TABLE)
+    return compiled_contact_results()(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner,
+                                      effective_modulus(youngs_modulus, poisson_ratio), _F_TABLE, _LOG_KAPPA,
+                                      _E_TABLE, edge_angle)

@@ -8,9 +8,7 @@ import numpy as np
 import pytest
 
 from slewing_model import BimeSolver, Loads, load_bearing
-from slewing_model.bime import CONTACT_RING, INNER_CONTACT
-from slewing_model.contact import hertz_ellipse
-from slewing_model.contact_kernel import ellipse_axes
+from slewing_model.distribution import LoadCapacityError
 from slewing_model.friction_kernel import AVAILABLE
 from slewing_model.superelement import build_superelement
 
@@ -71,21 +69,51 @@ def test_compiled_trial_points_equal_the_numpy_ones(pitch, table3, which):
             assert (points["numpy"].delta > 0).sum() < points["numpy"].delta.size    # some springs open
 
 
-def test_compiled_ellipses_equal_hertz_ellipse(pitch):
-    bearing, _ = pitch
-    n = bearing.ball_count
-    rng = np.random.default_rng(6)
-    load = rng.uniform(0.0, 2e5, (n, 4)) * (rng.uniform(size=(n, 4)) > 0.3)    # a third unloaded
-    angle = rng.uniform(0.2, 1.3, (n, 4))
-    diameter = np.full(n, bearing.ball_diameter) * (1.0 + 1e-3 * rng.standard_normal(n))
-    radius = bearing.groove_radius * (1.0 + 1e-3 * rng.standard_normal((n, 4)))
-    ref = hertz_ellipse(load, diameter[:, None], radius, angle, bearing.pitch_diameter, CONTACT_RING,
-                        bearing.youngs_modulus, bearing.poisson_ratio)
-    got = ellipse_axes(load, diameter, radius, angle, bearing.pitch_diameter, INNER_CONTACT,
-                       bearing.youngs_modulus, bearing.poisson_ratio)
-    for value, expected in zip(got, (ref.a, ref.b, ref.max_pressure)):
-        assert np.array_equal(value == 0.0, load == 0.0)
-        assert np.abs(value - expected).max() <= 1e-14 * np.abs(expected).max()
+@pytest.mark.parametrize("which", ["pitch", "table3 with errors"])
+def test_compiled_contact_results_equal_the_numpy_ones(pitch, table3, which):
+    """What a result reports of its contacts (loads, angles, deflections, Hertz ellipses and pressures,
+    edge loading) and its refusals of loads past the groove edge or the pressure limit, by the
+    compiled loop and by numpy, at the same iterate: balls of other diameters and grooves of other
+    measured radii too."""
+    if which == "pitch":
+        bearing, superelement = pitch
+        loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
+    else:
+        bearing = _table3_with_measured_radii(table3)
+        superelement = build_superelement(table3, mesh="coarse", bc="free")
+        loads = Loads(Fx=2e4, Fz=1e5, Mx=3e4, My=-2e4)
+    solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
+    state = solvers["numpy"].solve(loads).state
+    f_scaled = solvers["numpy"]._scaled_load(loads)
+    point = solvers["numpy"]._evaluate(state[:5], state[5:], f_scaled)
+    results = {k: s._result(loads, point, 3, 1e-9) for k, s in solvers.items()}
+    for name in ("contact_load", "contact_angle", "contact_deflection", "semi_axis_a", "semi_axis_b",
+                 "contact_pressure"):
+        ref, got = getattr(results["numpy"], name), getattr(results["compiled"], name)
+        assert np.array_equal(got == 0.0, ref == 0.0) and np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max(), name
+    assert 0 < (results["numpy"].contact_load > 0).sum() < results["numpy"].contact_load.size   # some unloaded
+    loaded_angle = results["numpy"].contact_angle[results["numpy"].contact_load > 0]
+
+    def refusals(match, **settings):
+        messages = []
+        for s in solvers.values():
+            for name, value in settings.items():
+                setattr(s, name, value)
+            with pytest.raises(LoadCapacityError, match=match) as refused:
+                s._result(loads, point, 3, 1e-9)
+            messages.append(str(refused.value))
+        return messages
+
+    # groove edges just past the largest contact angle: no contact off the raceway, some ellipses over the edge
+    for s in solvers.values():
+        s.edge_angle = np.full(4, loaded_angle.max() + 1e-9)
+    truncated = {k: s._result(loads, point, 3, 1e-9).truncated for k, s in solvers.items()}
+    assert np.array_equal(truncated["compiled"], truncated["numpy"]) and 0 < truncated["numpy"].sum() < loaded_angle.size
+    first, second = refusals("past the groove edge", edge_angle=np.full(4, np.percentile(loaded_angle, 99)))
+    assert first == second
+    first, second = refusals("MPa, above the limit", edge_angle=np.full(4, 2.0),
+                             pressure_limit=0.5 * results["numpy"].max_contact_pressure)
+    assert first == second
 
 
 def test_compiled_newton_step_equals_the_numpy_step(pitch):
