@@ -54,7 +54,7 @@ import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
-from .contact_kernel import compiled_trial_point, contact_results
+from .contact_kernel import compiled_jacobian, compiled_trial_point, contact_results
 from .contact_kernel import column_turn as compiled_column_turn
 from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
@@ -168,17 +168,20 @@ class BimeSolver:
             self._separation = a.separation                    # e before loading, (B, 2, 2)
             k_mean = float(a.stiffness.mean())
             self.reference_stiffness = a.stiffness.size * k_mean * math.sqrt(1e-4 * self.bearing.ball_diameter)
-        phi = a.ball_angle[:, None]
-        r, z = self._moving_centre[..., 0], self._moving_centre[..., 1]
-        c, s = np.cos(phi), np.sin(phi)
-        L = self.length
-        # d(R, z of the moving groove centre)/d(X, Y, Z, L rx, L ry), eq 23: (B, 2 diag, 2 comp, 5)
-        jac = np.zeros(r.shape + (2, 5))
-        jac[:, :, 0, 0], jac[:, :, 0, 1] = c, s                              # R
-        jac[:, :, 0, 3], jac[:, :, 0, 4] = -z * s / L, z * c / L
-        jac[:, :, 1, 2] = 1.0                                                # z
-        jac[:, :, 1, 3], jac[:, :, 1, 4] = r * s / L, -r * c / L
-        self.jacobian = a.moving_sign * jac
+        if self._compiled:                     # the same formulas, one compiled loop (contact_kernel)
+            self.jacobian = compiled_jacobian()(a.ball_angle, self._moving_centre, self.length, a.moving_sign)
+        else:
+            phi = a.ball_angle[:, None]
+            r, z = self._moving_centre[..., 0], self._moving_centre[..., 1]
+            c, s = np.cos(phi), np.sin(phi)
+            L = self.length
+            # d(R, z of the moving groove centre)/d(X, Y, Z, L rx, L ry), eq 23: (B, 2 diag, 2 comp, 5)
+            jac = np.zeros(r.shape + (2, 5))
+            jac[:, :, 0, 0], jac[:, :, 0, 1] = c, s                              # R
+            jac[:, :, 0, 3], jac[:, :, 0, 4] = -z * s / L, z * c / L
+            jac[:, :, 1, 2] = 1.0                                                # z
+            jac[:, :, 1, 3], jac[:, :, 1, 4] = r * s / L, -r * c / L
+            self.jacobian = a.moving_sign * jac
         self._jacobian_rows = self.jacobian.reshape(-1, 5)     # (4B, 5): one matrix-vector product
 
     def _scaled_load(self, loads: Loads) -> np.ndarray:

@@ -212,6 +212,27 @@ def _column_turn(old, new, coupling, mu):
     return True, turned, schur_inverse
 
 
+_JACOBIAN_SIGNATURE = "f8[:, :, :, :](f8[:], f8[:, :, :], f8, f8)"
+
+
+def _jacobian(ball_angle, moving_centre, length, sign):
+    """d(R, z of the moving groove centres)/d(X, Y, Z, L rx, L ry) (B, 2 diagonals, 2, 5) at the
+    balls' angles, ``moving_centre`` (B, 2, 2) their (R, z), times the moving ring's ``sign``: the
+    formulas of ``BimeSolver.set_rotation`` (eq 23), in the same order of operations."""
+    n_balls = ball_angle.size
+    jac = np.zeros((n_balls, 2, 2, 5))
+    for b in range(n_balls):
+        c, s = math.cos(ball_angle[b]), math.sin(ball_angle[b])
+        for d in range(2):
+            r, z = moving_centre[b, d, 0], moving_centre[b, d, 1]
+            jac[b, d, 0, 0], jac[b, d, 0, 1] = sign * c, sign * s                        # R
+            jac[b, d, 0, 3], jac[b, d, 0, 4] = sign * (-z * s / length), sign * (z * c / length)
+            jac[b, d, 1, 2] = sign * 1.0                                                  # z
+            jac[b, d, 1, 3], jac[b, d, 1, 4] = sign * (r * s / length), sign * (-r * c / length)
+            jac[b, d, 0, 2] = jac[b, d, 1, 0] = jac[b, d, 1, 1] = sign * 0.0
+    return jac
+
+
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
     by bisection, as ``np.interp`` searches)."""
@@ -353,8 +374,14 @@ def column_turn(old, new, coupling, mu):
     return (coupling, schur_inverse) if found else None
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_jacobian():
+    """The compiled :func:`_jacobian` (as :func:`compiled_trial_point`)."""
+    return _compile(_jacobian, _JACOBIAN_SIGNATURE)
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):

@@ -48,6 +48,7 @@ def test_compiled_trial_points_equal_the_numpy_ones(pitch, table3, which):
         loads = Loads(Fx=2e4, Fz=1e5, Mx=3e4, My=-2e4)
         assert np.unique(BimeSolver(bearing, superelement).assembly.stiffness).size == bearing.ball_count * 2
     solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
+    assert np.array_equal(solvers["compiled"].jacobian, solvers["numpy"].jacobian)      # eq 23, set_rotation
     state = solvers["numpy"].solve(loads).state
     rng = np.random.default_rng(5)
     f_scaled = solvers["numpy"]._scaled_load(loads)
