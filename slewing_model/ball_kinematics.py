@@ -169,6 +169,13 @@ class ContactSet:
         self.force_scale = mu * q[active].max(axis=1) if active.size else np.zeros(0)
 
     @functools.cached_property
+    def columns(self) -> tuple:
+        """``a, b, rb, rd, n_r, n_z, ring_speed, moving`` as flat (C,) arrays, what the compiled loop
+        sets the points of each rule up from (:mod:`slewing_model.friction_kernel`)."""
+        return tuple(np.ascontiguousarray(x[:, 0]) for x in (self.a, self.b, self.rb, self.rd, self.n_r, self.n_z,
+                                                             self.ring_speed, self.moving))
+
+    @functools.cached_property
     def sum_matrix(self) -> np.ndarray:
         """(B_active, C): per-contact -> per-ball sums of the numpy path (the compiled loops
         sum by ``owner``), made when first asked for."""
@@ -260,17 +267,17 @@ class ContactPoints:
         self.compiled = compiled           # evaluate with the compiled loop (friction_kernel)
         u_nodes, t2, weight = quad.across_nodes, quad.along_squared, quad.folded_weight
         if compiled:                       # the same formulas, one compiled loop (friction_kernel)
-            column = [np.ascontiguousarray(x[:, 0]) for x in (geo.a, geo.b, geo.rb, geo.rd, geo.n_r, geo.n_z,
-                                                              geo.ring_speed, geo.moving)]
             (self.g10, self.g12, self.h1, self.s0, self.s1, self.hs, self.arm1,
-             self.arm2) = compiled_point_coefficients()(*column, np.array(u_nodes), geo.length_scale, geo.pitch_radius)
+             self.arm2) = compiled_point_coefficients()(*geo.columns, np.array(u_nodes), geo.length_scale,
+                                                        geo.pitch_radius)
         else:
             self._coefficients(geo, u_nodes)
         self.t2 = np.array(t2, dtype=float)          # writable (the compiled loop takes no read-only arrays)
         space = self._space = _workspace(workspace)
         shape = (self.t2.size, geo.ball_index.size, quad.n_across)
         self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))
-        self._s, self._k, self._k3 = (space.get(name, shape) for name in ("s", "k", "k3"))
+        if not compiled:                   # the numpy path's work arrays
+            self._s, self._k, self._k3 = (space.get(name, shape) for name in ("s", "k", "k3"))
         self._ones = np.ones(quad.n_across)
         self._products = None
 
