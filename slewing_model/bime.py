@@ -55,6 +55,7 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import compiled_jacobian, compiled_trial_point, contact_results
+from .contact_kernel import bordered_inverse as compiled_bordered_inverse
 from .contact_kernel import column_turn as compiled_column_turn
 from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
@@ -462,7 +463,10 @@ class BimeSolver:
 
         def bordered(op):                      # contacts closed: bordered in (those that opened stay)
             closed = np.any(active & ~op.active)
-            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu) if closed else op
+            if not closed:
+                return op
+            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu,
+                                   border=compiled_bordered_inverse if self._compiled else None)
 
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:

@@ -233,6 +233,85 @@ def _jacobian(ball_angle, moving_centre, length, sign):
     return jac
 
 
+_BORDER_SIGNATURE = ("Tuple((f8[:, ::1], f8[:, :], f8[:, :]))(f8[:, ::1], f8[:, :], f8[:, :], f8[:, :], f8[:, :], "
+                     "f8[:, :], f8)")
+
+
+def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
+    """:func:`slewing_model.reduced_operator.bordered_inverse` as one compiled loop: the same blocks,
+    with ``W^-1 B`` summed column by column (``W^-1`` symmetric to round-off, as in
+    :func:`_newton_step`) and ``W^-1 + X S X^T`` written in one pass over ``W^-1`` (numpy's
+    product and sum take three, with a temporary the size of ``W^-1``)."""
+    n, r = b_mat.shape
+    x_t = np.zeros((r, n))                         # X^T = (W^-1 B)^T, by rows: vector operations
+    for j in range(n):
+        for k in range(r):
+            b = b_mat[j, k]
+            for i in range(n):
+                x_t[k, i] += inverse[j, i] * b
+    reduced = np.empty((r, r))                     # C - B^T X
+    for k in range(r):
+        for m in range(r):
+            value = c_mat[k, m]
+            for i in range(n):
+                value -= b_mat[i, k] * x_t[m, i]
+            reduced[k, m] = value
+    found, schur = _solve_small(reduced, np.eye(r))
+    empty = np.empty((0, 0))
+    if not found:
+        return np.empty((0, 0)), empty, empty
+    for k in range(r):                             # exactly symmetric
+        for m in range(k + 1, r):
+            schur[k, m] = schur[m, k] = 0.5 * (schur[k, m] + schur[m, k])
+    xs = np.zeros((n, r))                          # X S
+    for i in range(n):
+        for k in range(r):
+            for m in range(r):
+                xs[i, k] += x_t[m, i] * schur[m, k]
+    bordered = np.empty((n + r, n + r))
+    for i in range(n):
+        for j in range(n):
+            bordered[i, j] = inverse[i, j]
+        for k in range(r):
+            factor = xs[i, k]
+            for j in range(n):
+                bordered[i, j] += factor * x_t[k, j]
+        for k in range(r):
+            bordered[i, n + k] = -xs[i, k]
+            bordered[n + k, i] = -xs[i, k]
+    for k in range(r):
+        for m in range(r):
+            bordered[n + k, n + m] = schur[k, m]
+    d = np.empty((r, 5))                           # J_r - X^T J
+    for k in range(r):
+        for c in range(5):
+            value = new_jacobian[k, c]
+            for i in range(n):
+                value -= x_t[k, i] * jacobian[i, c]
+            d[k, c] = value
+    new_coupling = np.zeros((n + r, 5))
+    for i in range(n):
+        for c in range(5):
+            value = coupling[i, c]
+            for k in range(r):
+                value -= xs[i, k] * d[k, c]
+            new_coupling[i, c] = value
+    for k in range(r):
+        for c in range(5):
+            for m in range(r):
+                new_coupling[n + k, c] += schur[k, m] * d[m, c]
+    normal = mu * np.eye(5)                        # J_new^T W_new^-1 J_new + mu I
+    for i in range(n + r):
+        for a in range(5):
+            row = jacobian[i, a] if i < n else new_jacobian[i - n, a]
+            for c in range(5):
+                normal[a, c] += row * new_coupling[i, c]
+    found, schur_inverse = _solve_small(normal, np.eye(5))
+    if not found:
+        return np.empty((0, 0)), empty, empty
+    return bordered, new_coupling, schur_inverse
+
+
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
     by bisection, as ``np.interp`` searches)."""
@@ -380,8 +459,24 @@ def compiled_jacobian():
     return _compile(_jacobian, _JACOBIAN_SIGNATURE)
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_bordered_inverse():
+    """The compiled :func:`_bordered_inverse` (as :func:`compiled_trial_point`)."""
+    return _compile(_bordered_inverse, _BORDER_SIGNATURE)
+
+
+def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
+    """:func:`slewing_model.reduced_operator.bordered_inverse` by the compiled loop (a singular
+    complement, not met, raises numpy's LinAlgError as the numpy one does)."""
+    bordered, new_coupling, schur_inverse = compiled_bordered_inverse()(
+        np.ascontiguousarray(inverse), b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
+    if bordered.size == 0:
+        raise np.linalg.LinAlgError("singular matrix in bordering the reduced operator")
+    return bordered, new_coupling, schur_inverse
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):

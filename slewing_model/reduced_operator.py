@@ -272,7 +272,7 @@ def assemble_operator(point, compliance, stiffness, jacobian, active, mu) -> Red
     return complete_operator(start_operator(point, compliance, stiffness, active), jacobian, mu)
 
 
-def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu
+def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu, border=None
                     ) -> ReducedOperator | None:
     """Follow contacts that closed by bordering the kept ``W^-1``; contacts that opened stay.
 
@@ -292,7 +292,8 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     rows are in the order they entered), and the coupling follows by the same blocks:
     ``W_new^-1 J_new = [W^-1 J - X S d, S d]``, ``d = J_r - X^T J``, with ``op`` turned to
     ``jacobian`` first (:func:`turned_operator`). Returns None (form anew) when more than a
-    quarter of the rows would be new."""
+    quarter of the rows would be new. The blocks are :func:`bordered_inverse`'s (or ``border``'s,
+    the same as a compiled loop)."""
     closed = active & ~op.active
     new_rows = np.flatnonzero(np.repeat(closed, 2))
     if new_rows.size > 0.25 * op.rows.size:
@@ -302,20 +303,32 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
     c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
     _add_blocks(c_mat, new_a_inv)
-    x_mat = op.inverse @ b_mat
+    inverse, coupling, schur_inverse = (bordered_inverse if border is None else border)(
+        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, jacobian.reshape(-1, 5)[new_rows], mu)
+    return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
+                           jacobian.reshape(-1, 5)[rows], coupling, schur_inverse)
+
+
+def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
+    """``W^-1`` (n, n) bordered by ``r`` rows (:func:`update_operator`): with ``X = W^-1 B`` (``b_mat``
+    (n, r)) and ``S = (C - B^T X)^-1`` (``c_mat`` (r, r)), the new inverse
+    ``[[W^-1 + X S X^T, -X S], [-S X^T, S]]``, its coupling ``[W^-1 J - X S d, S d]`` with
+    ``d = J_r - X^T J`` (``coupling = W^-1 J`` (n, 5), ``jacobian = J``, ``new_jacobian = J_r``
+    (r, 5)) and the new Schur complement's inverse ``(J_new^T W_new^-1 J_new + mu I)^-1``."""
+    x_mat = inverse @ b_mat
     schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
     schur = 0.5 * (schur + schur.T)
     xs = x_mat @ schur
-    n = op.rows.size
-    inverse = np.empty((rows.size, rows.size))
-    np.add(op.inverse, xs @ x_mat.T, out=inverse[:n, :n])
-    inverse[:n, n:] = -xs
-    inverse[n:, :n] = -xs.T
-    inverse[n:, n:] = schur
-    d = jacobian.reshape(-1, 5)[new_rows] - x_mat.T @ op.jacobian
-    coupling = np.concatenate([op.coupling - xs @ d, schur @ d])
-    return reduced_operator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
-                            jacobian, mu, coupling)
+    n, r = b_mat.shape
+    bordered = np.empty((n + r, n + r))
+    np.add(inverse, xs @ x_mat.T, out=bordered[:n, :n])
+    bordered[:n, n:] = -xs
+    bordered[n:, :n] = -xs.T
+    bordered[n:, n:] = schur
+    d = new_jacobian - x_mat.T @ jacobian
+    new_coupling = np.concatenate([coupling - xs @ d, schur @ d])
+    ja = np.concatenate([jacobian, new_jacobian])
+    return bordered, new_coupling, np.linalg.inv(ja.T @ new_coupling + mu * np.eye(5))
 
 
 def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):

@@ -229,11 +229,20 @@ def test_cold_solve_does_not_depend_on_the_solves_before(bearing):
     assert np.array_equal(cold.state, fresh.state) and cold.iterations == fresh.iterations
 
 
-def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing):
+@pytest.mark.parametrize("kernel", ["numpy", "compiled"])
+def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel):
     """Contacts closing (the kept inverse bordered by their rows; those that opened keep theirs)
     give the inverse, coupling and Schur complement that forming and inverting the operator on
-    the same contacts gives, at the same iterate, with the rows in another order."""
+    the same contacts gives, at the same iterate, with the rows in another order; the bordering's
+    blocks by numpy or by the compiled loop (``contact_kernel.bordered_inverse``)."""
+    from slewing_model.friction_kernel import AVAILABLE
     from slewing_model.reduced_operator import assemble_operator, newton_step, update_operator
+
+    if kernel == "compiled" and not AVAILABLE:
+        pytest.skip("numba is not installed: only the numpy path exists here")
+    border = None
+    if kernel == "compiled":
+        from slewing_model.contact_kernel import bordered_inverse as border
 
     loads = LOADS[1]
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
@@ -255,7 +264,7 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing):
     for before, after in ((loaded[[0, 2] + list(range(5, loaded.size))], loaded),      # three close
                           (np.delete(loaded, [1, 7]), np.delete(loaded, [4, 9, 10]))):  # two close, three open
         kept = formed(mask(before))
-        updated = update_operator(kept, point, solver.compliance, stiffness, jacobian, mask(after), mu)
+        updated = update_operator(kept, point, solver.compliance, stiffness, jacobian, mask(after), mu, border)
         assert np.array_equal(updated.rows[:kept.rows.size], kept.rows)     # the kept rows stay, opened or not
         fresh = formed(mask(before) | mask(after))
         order = np.argsort(updated.rows)
