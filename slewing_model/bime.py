@@ -138,6 +138,7 @@ class BimeSolver:
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
+        self._loaded_from = 1e-15 * bearing.ball_diameter     # a spring stretched more than this is loaded
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
         #: a new operator being inverted over two solves (flexible, warm solves), or None: state too
@@ -387,12 +388,12 @@ class BimeSolver:
         if flexible and self._compiled:      # the same formulas, one compiled loop
             a = self.assembly
             dq, dy, m_dy = (np.zeros(5), np.zeros(y.size), np.zeros(y.size)) if direction is None else direction
-            (qs, y, my, e, delta, q, force, n, length, gradient, mismatch, terms) = compiled_trial_point()(
+            (qs, y, my, e, delta, q, force, n, length, gradient, mismatch, loaded, terms) = compiled_trial_point()(
                 self._separation, self._jacobian_rows, qs, dq, y, dy, my, m_dy, t, a.natural_length, a.stiffness,
-                f_scaled)
-            energy, ring, work, peak_force, peak_residual = terms
+                f_scaled, self._loaded_from)
+            energy, ring, work, peak_force, peak_residual, n_loaded = terms
             return _Point(qs, y, e, delta, q, force, None, n, length, energy + ring - work, energy + ring + abs(work),
-                          gradient, mismatch, peak_force, peak_residual, my)
+                          gradient, mismatch, peak_force, peak_residual, loaded, n_loaded > 0, my)
         if direction is not None:
             dq, dy, m_dy = direction
             qs = qs + t * dq
@@ -413,9 +414,10 @@ class BimeSolver:
             peak_force = max(peak_force, float(np.abs(y).max()))
             peak_residual = max(peak_residual, float(np.abs(mismatch).max()))
         work = float(f_scaled @ qs)
+        loaded = (delta > self._loaded_from).ravel()
         # the total is a difference of larger terms: its roundoff scales with them
         return _Point(qs, y, e, delta, q, force, hess, n, length, energy + ring - work, energy + ring + abs(work),
-                      gradient, mismatch, peak_force, peak_residual, my)
+                      gradient, mismatch, peak_force, peak_residual, loaded, bool(loaded.any()), my)
 
     def _rigid_direction(self, p: "_Point", grad_q: np.ndarray, mu: float) -> np.ndarray:
         """Newton step of the rigid model: ``(sum J^T A J) dq = -grad``."""
@@ -440,8 +442,8 @@ class BimeSolver:
         solve, and all at once when an iteration past :data:`SPREAD_ITERATIONS` of one solve
         is still slow or the kept operator cannot follow the contacts that closed.
         """
-        active = (p.delta > 1e-15 * self.bearing.ball_diameter).ravel()
-        if not active.any():
+        active = p.loaded
+        if not p.any_loaded:
             self._reduced = self.pending_operator = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
         stiffness, op, pending = self.assembly.stiffness, self._reduced, self.pending_operator
@@ -462,7 +464,7 @@ class BimeSolver:
         self.pending_operator = pending
 
         def bordered(op):                      # contacts closed: bordered in (those that opened stay)
-            closed = np.any(active & ~op.active)
+            closed = np.any(active > op.active)             # active and not in the operator
             if not closed:
                 return op
             return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu,
@@ -553,6 +555,8 @@ class _Point:
     mismatch: np.ndarray | None             # the Hertz forces less those the rings feel, f - y (flexible)
     peak_force: float                       # the largest of q and |y|: the stop rule's scale
     peak_residual: float                    # the largest of |gradient| and |mismatch|
+    loaded: np.ndarray                      # (2B,) the diagonals whose springs are stretched (delta > 1e-15 Dw)
+    any_loaded: bool
     ring_motion: np.ndarray | None = None   # M y: the groove centres' relative motion from ring deformation (flexible)
 
 

@@ -23,12 +23,12 @@ import numpy as np
 from .friction_kernel import compile_loop
 
 _TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
-                    "f8[:, :], f8[:], f8[:], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], "
-                    "f8, f8[:, :], f8[:, :], f8[:])")
+                    "f8[:, :], f8[:], f8[:], b1[:], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:], f8[:], "
+                    "f8[:], f8, f8[:, :], f8[:, :], f8[:], f8)")
 
 
 def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_motion_step, t, natural_length,
-                 stiffness, f_scaled):
+                 stiffness, f_scaled, loaded_from):
     """The flexible model's springs at the trial point ``(qs + t dq, y + t dy)`` of a line search,
     with the ring motion ``M y`` there (``ring_motion + t ring_motion_step``, linear in ``t``), and
     what the solver's stop rule and line search ask of it: the formulas of
@@ -41,8 +41,9 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
 
     Returns ``qs``, ``y``, ``M y`` at the trial point, ``e``, ``delta``, ``q``, the force vectors
     ``f`` and unit vectors ``n`` (B, 2, 2), the lengths ``|e|``, the gradient (5,), the mismatch
-    (4B,) and ``(springs' energy, rings' energy, work, largest force, largest residual)``, the
-    largest force over ``q`` and ``|y|``, the largest residual over the gradient and mismatch."""
+    (4B,), the loaded diagonals (2B,; ``delta > loaded_from``) and ``(springs' energy, rings'
+    energy, work, largest force, largest residual, loaded diagonals)``, the largest force over
+    ``q`` and ``|y|``, the largest residual over the gradient and mismatch."""
     n_balls = separation.shape[0]
     qs_t = qs + t * dq
     y_t = y + t * dy
@@ -55,6 +56,8 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
     length = np.empty((n_balls, 2))
     gradient = -f_scaled
     mismatch = np.empty(y.size)
+    loaded = np.empty(2 * n_balls, np.bool_)
+    n_loaded = 0
     energy = ring = 0.0
     peak_force = peak_residual = 0.0
     for b in range(n_balls):
@@ -70,6 +73,8 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
             n[b, d, 0] = e[b, d, 0] / size
             n[b, d, 1] = e[b, d, 1] / size
             delta[b, d] = size - natural_length[b, d]
+            loaded[2 * b + d] = delta[b, d] > loaded_from
+            n_loaded += loaded[2 * b + d]
             closed = max(delta[b, d], 0.0)
             q[b, d] = stiffness[b, d] * (closed * math.sqrt(closed))
             energy += q[b, d] * closed
@@ -89,8 +94,8 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
         peak_residual = max(peak_residual, abs(gradient[k]))
     if not math.isfinite(ring + work + gradient.sum() + mismatch.sum()):
         peak_residual = math.nan           # as numpy's max: a NaN is never converged
-    return (qs_t, y_t, motion_t, e, delta, q, force, n, length, gradient, mismatch,
-            np.array([0.4 * energy, 0.5 * ring, work, peak_force, peak_residual]))
+    return (qs_t, y_t, motion_t, e, delta, q, force, n, length, gradient, mismatch, loaded,
+            np.array([0.4 * energy, 0.5 * ring, work, peak_force, peak_residual, n_loaded]))
 
 
 _NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:], "

@@ -67,6 +67,8 @@ def test_compiled_trial_points_equal_the_numpy_ones(pitch, table3, which):
             for name in ("total", "peak_force"):
                 assert getattr(points["compiled"], name) == pytest.approx(getattr(points["numpy"], name), rel=1e-12)
             assert abs(points["compiled"].peak_residual - points["numpy"].peak_residual) <= 1e-13 * floor
+            assert np.array_equal(points["compiled"].loaded, points["numpy"].loaded)
+            assert points["compiled"].any_loaded == points["numpy"].any_loaded
             assert (points["numpy"].delta > 0).sum() < points["numpy"].delta.size    # some springs open
 
 
