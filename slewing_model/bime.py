@@ -57,6 +57,7 @@ from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import compiled_jacobian, compiled_trial_point, contact_results
 from .contact_kernel import bordered_inverse as compiled_bordered_inverse
 from .contact_kernel import column_turn as compiled_column_turn
+from .contact_kernel import operator_matrix as compiled_operator_matrix
 from .contact_kernel import newton_step as compiled_newton_step
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -133,6 +134,7 @@ class BimeSolver:
         self.pressure_limit = pressure_limit
         self.kernel = kernel
         self._compiled = use_compiled(kernel, "kernel")    # the springs and ellipses as compiled loops
+        self._form = compiled_operator_matrix if self._compiled else None   # how a new operator's W is formed
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
         self.ring_compliance = None if superelement is None else ring_compliances(superelement)
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
@@ -459,7 +461,7 @@ class BimeSolver:
             else:
                 fresh = False
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
-            pending = start_operator(p, self.compliance, stiffness, active)
+            pending = start_operator(p, self.compliance, stiffness, active, self._form)
             fresh = self._stage_due = False
         self.pending_operator = pending
 
@@ -480,7 +482,7 @@ class BimeSolver:
                 op = bordered(complete_operator(self.pending_operator, self.jacobian, mu))
                 self.pending_operator = None
         if fresh or op is None:
-            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu)
+            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._form)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         dq, y_new = (compiled_newton_step if self._compiled else newton_step)(op, p, f_scaled)

@@ -317,6 +317,37 @@ def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, m
     return bordered, new_coupling, schur_inverse
 
 
+_MATRIX_SIGNATURE = ("Tuple((f8[:, :, :], f8[:, :]))(f8[:, ::1], i8[:], f8[:, :], f8[:], f8[:], f8[:], f8[:])")
+
+
+def _operator_matrix(compliance, rows, normal, delta, length, load, stiffness):
+    """``A^-1`` (k, 2, 2) of the diagonals of ``rows`` (two a diagonal) and ``W = (A^-1 + M)_aa``:
+    :func:`slewing_model.reduced_operator.operator_matrix`'s formulas (``normal`` (2B, 2) and
+    ``delta``, ``length``, ``load``, ``stiffness`` (2B,) of every diagonal), gathering ``M_aa``
+    row by row."""
+    n = rows.size
+    k = n // 2
+    a_inv = np.empty((k, 2, 2))
+    for j in range(k):
+        d = rows[2 * j] // 2
+        k_normal = 1.5 * stiffness[d] * math.sqrt(delta[d])
+        across = length[d] / load[d]
+        for r in range(2):
+            for c in range(2):
+                nn = normal[d, r] * normal[d, c]
+                a_inv[j, r, c] = nn / k_normal + across * ((1.0 if r == c else 0.0) - nn)
+    w = np.empty((n, n))
+    for i in range(n):
+        source = rows[i]
+        for j in range(n):
+            w[i, j] = compliance[source, rows[j]]
+    for j in range(k):
+        for r in range(2):
+            for c in range(2):
+                w[2 * j + r, 2 * j + c] += a_inv[j, r, c]
+    return a_inv, w
+
+
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
     by bisection, as ``np.interp`` searches)."""
@@ -480,8 +511,22 @@ def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu
     return bordered, new_coupling, schur_inverse
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_operator_matrix():
+    """The compiled :func:`_operator_matrix` (as :func:`compiled_trial_point`)."""
+    return _compile(_operator_matrix, _MATRIX_SIGNATURE)
+
+
+def operator_matrix(point, compliance, stiffness, active):
+    """:func:`slewing_model.reduced_operator.operator_matrix` by the compiled loop."""
+    rows = np.flatnonzero(np.repeat(active, 2))
+    a_inv, w = compiled_operator_matrix()(np.ascontiguousarray(compliance.dense), rows, point.n.reshape(-1, 2), point.delta.reshape(-1),
+                                         point.length.reshape(-1), point.q.reshape(-1), stiffness.reshape(-1))
+    return rows, a_inv, w
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_operator_matrix, _operator_matrix), (compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):

@@ -232,15 +232,22 @@ class PendingOperator:
                    tuple(np.asarray(v) for v in parts))
 
 
-def start_operator(point, compliance, stiffness, active) -> PendingOperator:
-    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (``A^-1`` the springs'
-    compliance there, ``M`` the rings'; symmetric positive definite) and run the first stage of
-    its inverse."""
+def start_operator(point, compliance, stiffness, active, form=None) -> PendingOperator:
+    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`,
+    or ``form``, the same as a compiled loop) and run the first stage of its inverse."""
+    rows, a_inv, w_mat = (operator_matrix if form is None else form)(point, compliance, stiffness, active)
+    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
+
+
+def operator_matrix(point, compliance, stiffness, active):
+    """The rows of the ``active`` diagonals, the springs' compliance ``A^-1`` there (k, 2, 2) at an
+    iterate (:func:`contact_compliance_blocks`) and ``W = (A^-1 + M)_aa`` (``M`` the rings';
+    symmetric positive definite)."""
     rows = np.flatnonzero(np.repeat(active, 2))
     a_inv = contact_compliance_blocks(point, stiffness, active)
     w_mat = np.asarray(compliance).take(rows, axis=0).take(rows, axis=1)   # M_aa (3x faster than np.ix_)
     _add_blocks(w_mat, a_inv)
-    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
+    return rows, a_inv, w_mat
 
 
 def advance_operator(pending: PendingOperator, jacobian, mu) -> "PendingOperator | ReducedOperator":
@@ -267,9 +274,9 @@ def complete_operator(pending: PendingOperator, jacobian, mu) -> ReducedOperator
     return pending
 
 
-def assemble_operator(point, compliance, stiffness, jacobian, active, mu) -> ReducedOperator:
+def assemble_operator(point, compliance, stiffness, jacobian, active, mu, form=None) -> ReducedOperator:
     """Form and invert ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate: O(n^3)."""
-    return complete_operator(start_operator(point, compliance, stiffness, active), jacobian, mu)
+    return complete_operator(start_operator(point, compliance, stiffness, active, form), jacobian, mu)
 
 
 def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu, border=None

@@ -140,6 +140,12 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
     assert bordered is not None and bordered.rows.size == 2 * loaded.size
     assert not np.array_equal(bordered.inverse, bordered.inverse.T)          # symmetric to round-off only
     off = solver._evaluate(1.01 * state[:5], 0.98 * state[5:], f_scaled)
+    # a new operator's W and springs' compliance, formed by the compiled loop: the same bit for bit
+    from slewing_model.contact_kernel import operator_matrix as compiled_matrix
+    from slewing_model.reduced_operator import operator_matrix
+
+    for want, got in zip(operator_matrix(*args, masks[0]), compiled_matrix(*args, masks[0])):
+        assert np.array_equal(want, got)
     for op in (assemble_operator(*args, solver.jacobian, masks[0], mu), bordered):
         (dq, y), (dq_c, y_c) = newton_step(op, off, f_scaled), compiled_step(op, off, f_scaled)
         assert np.abs(dq_c - dq).max() <= 1e-11 * np.abs(dq).max()
