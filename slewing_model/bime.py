@@ -55,17 +55,14 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import compiled_jacobian, compiled_trial_point, contact_results
-from .contact_kernel import bordered_inverse as compiled_bordered_inverse
-from .contact_kernel import column_turn as compiled_column_turn
-from .contact_kernel import operator_matrix as compiled_operator_matrix
-from .contact_kernel import newton_step as compiled_newton_step
+from .contact_kernel import COMPILED_LOOPS
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
 from .friction_kernel import use_compiled
 from .geometry import RING_CONTACTS, Bearing
 from .reduced_operator import (
-    PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator, newton_step,
+    NUMPY_LOOPS, PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator,
     start_operator, turned_operator, update_operator,
 )
 from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
@@ -134,7 +131,7 @@ class BimeSolver:
         self.pressure_limit = pressure_limit
         self.kernel = kernel
         self._compiled = use_compiled(kernel, "kernel")    # the springs and ellipses as compiled loops
-        self._form = compiled_operator_matrix if self._compiled else None   # how a new operator's W is formed
+        self._loops = COMPILED_LOOPS if self._compiled else NUMPY_LOOPS     # the reduced operator's arithmetic
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
         self.ring_compliance = None if superelement is None else ring_compliances(superelement)
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
@@ -451,9 +448,9 @@ class BimeSolver:
         stiffness, op, pending = self.assembly.stiffness, self._reduced, self.pending_operator
         if pending is not None:
             if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
-                pending = complete_operator(pending, self.jacobian, mu)
+                pending = complete_operator(pending, self.jacobian, mu, self._loops)
             elif self._stage_due:                                              # one stage a solve
-                pending = advance_operator(pending, self.jacobian, mu)
+                pending = advance_operator(pending, self.jacobian, mu, self._loops)
             self._stage_due = False
             if isinstance(pending, ReducedOperator):     # inverted: its coupling is that of the Jacobian now
                 op, pending, fresh = pending, None, False
@@ -461,7 +458,7 @@ class BimeSolver:
             else:
                 fresh = False
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
-            pending = start_operator(p, self.compliance, stiffness, active, self._form)
+            pending = start_operator(p, self.compliance, stiffness, active, self._loops)
             fresh = self._stage_due = False
         self.pending_operator = pending
 
@@ -469,23 +466,21 @@ class BimeSolver:
             closed = np.any(active > op.active)             # active and not in the operator
             if not closed:
                 return op
-            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu,
-                                   border=compiled_bordered_inverse if self._compiled else None)
+            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._loops)
 
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn,
-                                     turn=compiled_column_turn if self._compiled else None)
+                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn, loops=self._loops)
             op = bordered(op)
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
-                op = bordered(complete_operator(self.pending_operator, self.jacobian, mu))
+                op = bordered(complete_operator(self.pending_operator, self.jacobian, mu, self._loops))
                 self.pending_operator = None
         if fresh or op is None:
-            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._form)
+            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._loops)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
-        dq, y_new = (compiled_newton_step if self._compiled else newton_step)(op, p, f_scaled)
+        dq, y_new = self._loops.step(op, p, f_scaled)
         return dq, y_new - p.y
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float) -> LoadDistribution:

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from .friction_kernel import compile_loop
+from .reduced_operator import OperatorLoops
 
 _TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
                     "f8[:, :], f8[:], f8[:], b1[:], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:], f8[:], "
@@ -348,6 +349,29 @@ def _operator_matrix(compliance, rows, normal, delta, length, load, stiffness):
     return a_inv, w
 
 
+_COUPLING_SIGNATURE = "Tuple((f8[:, :], f8[:, :]))(f8[:, ::1], f8[:, :], f8)"
+
+
+def _operator_coupling(inverse, ja, mu):
+    """:func:`slewing_model.reduced_operator.operator_coupling` as one compiled loop: ``W^-1 J_a``
+    summed column by column (``W^-1`` symmetric to round-off, as in :func:`_newton_step`) and
+    ``(J_a^T W^-1 J_a + mu I)^-1``, or an empty inverse where that is singular."""
+    n = ja.shape[0]
+    coupling_t = np.zeros((5, n))
+    for j in range(n):
+        for c in range(5):
+            value = ja[j, c]
+            for i in range(n):
+                coupling_t[c, i] += inverse[j, i] * value
+    normal = mu * np.eye(5)
+    for a in range(5):
+        for c in range(5):
+            for i in range(n):
+                normal[a, c] += ja[i, a] * coupling_t[c, i]
+    found, schur_inverse = _solve_small(normal, np.eye(5))
+    return np.ascontiguousarray(coupling_t.T), schur_inverse if found else np.empty((0, 0))
+
+
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
     by bisection, as ``np.interp`` searches)."""
@@ -525,8 +549,23 @@ def operator_matrix(point, compliance, stiffness, active):
     return rows, a_inv, w
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_operator_coupling():
+    """The compiled :func:`_operator_coupling` (as :func:`compiled_trial_point`)."""
+    return _compile(_operator_coupling, _COUPLING_SIGNATURE)
+
+
+def operator_coupling(inverse, ja, mu):
+    """:func:`slewing_model.reduced_operator.operator_coupling` by the compiled loop (a singular
+    complement, not met, raises numpy's LinAlgError as the numpy one does)."""
+    coupling, schur_inverse = compiled_operator_coupling()(np.ascontiguousarray(inverse), ja, mu)
+    if schur_inverse.size == 0:
+        raise np.linalg.LinAlgError("singular matrix: the Schur complement of the reduced operator")
+    return coupling, schur_inverse
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_operator_matrix, _operator_matrix), (compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_operator_coupling, _operator_coupling), (compiled_operator_matrix, _operator_matrix), (compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):
@@ -545,3 +584,7 @@ def contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, pi
     return compiled_contact_results()(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner,
                                       effective_modulus(youngs_modulus, poisson_ratio), _F_TABLE, _LOG_KAPPA,
                                       _E_TABLE, edge_angle)
+
+
+#: the reduced operator's arithmetic as compiled loops (:class:`slewing_model.reduced_operator.OperatorLoops`)
+COMPILED_LOOPS = OperatorLoops(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)

@@ -82,17 +82,22 @@ def contact_compliance_blocks(point, stiffness: np.ndarray, active: np.ndarray) 
 
 
 def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.ndarray, mu: float,
-                     coupling: np.ndarray | None = None) -> ReducedOperator:
-    """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5),
-    ``W^-1 J_a`` unless given, and the Schur complement's inverse."""
+                     loops: "OperatorLoops | None" = None) -> ReducedOperator:
+    """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5) and the
+    Schur complement's inverse (:func:`operator_coupling`)."""
     ja = jacobian.reshape(-1, 5)[rows]
-    coupling = inverse @ ja if coupling is None else coupling
-    schur_inverse = np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
+    coupling, schur_inverse = _loops(loops).couple(inverse, ja, mu)
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
 
-def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True, turn=None
-                    ) -> ReducedOperator:
+def operator_coupling(inverse: np.ndarray, ja: np.ndarray, mu: float):
+    """``W^-1 J_a`` and ``(J_a^T W^-1 J_a + mu I)^-1``."""
+    coupling = inverse @ ja
+    return coupling, np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
+
+
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True,
+                    loops: "OperatorLoops | None" = None) -> ReducedOperator:
     """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
 
     ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
@@ -100,18 +105,19 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: boo
     manufacturing errors) turning the balls by an angle only mixes the Jacobian's columns,
     ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
     ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``
-    (:func:`column_turn`, or ``turn``, the same as a compiled loop). Otherwise (errors move
+    (:func:`column_turn`). Otherwise (errors move
     the groove centres with the ring) the coupling is formed anew, without trying the turn
     where the caller knows it (``may_turn`` False). The operator itself when the Jacobian did
     not change."""
     ja = jacobian.reshape(-1, 5)[op.rows]
     if np.array_equal(op.jacobian, ja):
         return op
+    loops = _loops(loops)
     turned = None
     if may_turn and op.jacobian.shape == ja.shape:
-        turned = (column_turn if turn is None else turn)(op.jacobian, ja, op.coupling, mu)
+        turned = loops.turn(op.jacobian, ja, op.coupling, mu)
     if turned is None:
-        return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu)
+        return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, loops)
     coupling, schur_inverse = turned
     return ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, ja, coupling, schur_inverse)
 
@@ -232,10 +238,10 @@ class PendingOperator:
                    tuple(np.asarray(v) for v in parts))
 
 
-def start_operator(point, compliance, stiffness, active, form=None) -> PendingOperator:
-    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`,
-    or ``form``, the same as a compiled loop) and run the first stage of its inverse."""
-    rows, a_inv, w_mat = (operator_matrix if form is None else form)(point, compliance, stiffness, active)
+def start_operator(point, compliance, stiffness, active, loops: "OperatorLoops | None" = None) -> PendingOperator:
+    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
+    and run the first stage of its inverse."""
+    rows, a_inv, w_mat = _loops(loops).form(point, compliance, stiffness, active)
     return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
 
 
@@ -250,7 +256,8 @@ def operator_matrix(point, compliance, stiffness, active):
     return rows, a_inv, w_mat
 
 
-def advance_operator(pending: PendingOperator, jacobian, mu) -> "PendingOperator | ReducedOperator":
+def advance_operator(pending: PendingOperator, jacobian, mu, loops: "OperatorLoops | None" = None
+                     ) -> "PendingOperator | ReducedOperator":
     """The next of :data:`SPREAD_STAGES`; after the last, the operator with its coupling to the
     Jacobian (4B, 5) of now (``jacobian`` None: the pending operator, inverted). A small ``W``
     is inverted in one stage."""
@@ -264,23 +271,26 @@ def advance_operator(pending: PendingOperator, jacobian, mu) -> "PendingOperator
             pending = replace(pending, stage=pending.stage + 1, parts=parts)
     if pending.stage < len(SPREAD_STAGES) or jacobian is None:
         return pending
-    return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu)
+    return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
+                            loops)
 
 
-def complete_operator(pending: PendingOperator, jacobian, mu) -> ReducedOperator:
+def complete_operator(pending: PendingOperator, jacobian, mu, loops: "OperatorLoops | None" = None
+                      ) -> ReducedOperator:
     """The remaining stages at once."""
     while isinstance(pending, PendingOperator):
-        pending = advance_operator(pending, jacobian, mu)
+        pending = advance_operator(pending, jacobian, mu, loops)
     return pending
 
 
-def assemble_operator(point, compliance, stiffness, jacobian, active, mu, form=None) -> ReducedOperator:
+def assemble_operator(point, compliance, stiffness, jacobian, active, mu, loops: "OperatorLoops | None" = None
+                      ) -> ReducedOperator:
     """Form and invert ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate: O(n^3)."""
-    return complete_operator(start_operator(point, compliance, stiffness, active, form), jacobian, mu)
+    return complete_operator(start_operator(point, compliance, stiffness, active, loops), jacobian, mu, loops)
 
 
-def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu, border=None
-                    ) -> ReducedOperator | None:
+def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu,
+                    loops: "OperatorLoops | None" = None) -> ReducedOperator | None:
     """Follow contacts that closed by bordering the kept ``W^-1``; contacts that opened stay.
 
     A diagonal that opened keeps its row in the operator with the stiffness it had when the
@@ -299,8 +309,7 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     rows are in the order they entered), and the coupling follows by the same blocks:
     ``W_new^-1 J_new = [W^-1 J - X S d, S d]``, ``d = J_r - X^T J``, with ``op`` turned to
     ``jacobian`` first (:func:`turned_operator`). Returns None (form anew) when more than a
-    quarter of the rows would be new. The blocks are :func:`bordered_inverse`'s (or ``border``'s,
-    the same as a compiled loop)."""
+    quarter of the rows would be new. The blocks are :func:`bordered_inverse`'s."""
     closed = active & ~op.active
     new_rows = np.flatnonzero(np.repeat(closed, 2))
     if new_rows.size > 0.25 * op.rows.size:
@@ -310,8 +319,8 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
     c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
     _add_blocks(c_mat, new_a_inv)
-    inverse, coupling, schur_inverse = (bordered_inverse if border is None else border)(
-        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, jacobian.reshape(-1, 5)[new_rows], mu)
+    inverse, coupling, schur_inverse = _loops(loops).border(op.inverse, b_mat, c_mat, op.jacobian, op.coupling,
+                                                             jacobian.reshape(-1, 5)[new_rows], mu)
     return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
                            jacobian.reshape(-1, 5)[rows], coupling, schur_inverse)
 
@@ -351,3 +360,25 @@ def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
     y_new = np.zeros_like(point.y)
     y_new[op.rows] = w_vec + op.coupling @ dq
     return dq, y_new
+
+
+@dataclass(frozen=True)
+class OperatorLoops:
+    """The loops of the reduced operator's arithmetic: this module's numpy functions
+    (:data:`NUMPY_LOOPS`), or the same as compiled loops
+    (:data:`slewing_model.contact_kernel.COMPILED_LOOPS`), which every function above takes as
+    ``loops`` (default numpy)."""
+
+    form: object        # operator_matrix
+    couple: object      # operator_coupling
+    turn: object        # column_turn
+    border: object      # bordered_inverse
+    step: object        # newton_step
+
+
+#: this module's numpy functions
+NUMPY_LOOPS = OperatorLoops(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
+
+
+def _loops(loops: OperatorLoops | None) -> OperatorLoops:
+    return NUMPY_LOOPS if loops is None else loops

@@ -121,7 +121,8 @@ def test_compiled_contact_results_equal_the_numpy_ones(pitch, table3, which):
 
 def test_compiled_newton_step_equals_the_numpy_step(pitch):
     """The modified Newton step with a kept operator, formed or bordered by contacts that closed (whose
-    inverse is symmetric to round-off only), at an iterate away from the operator's own."""
+    inverse is symmetric to round-off only), at an iterate away from the operator's own; and the
+    operator's matrix and coupling formed by the compiled loops."""
     from slewing_model.contact_kernel import newton_step as compiled_step
     from slewing_model.reduced_operator import assemble_operator, newton_step, update_operator
 
@@ -146,6 +147,13 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
 
     for want, got in zip(operator_matrix(*args, masks[0]), compiled_matrix(*args, masks[0])):
         assert np.array_equal(want, got)
+    # ... and its coupling to the ring's motions, W^-1 J_a and the Schur complement's inverse
+    from slewing_model.contact_kernel import operator_coupling as compiled_coupling
+    from slewing_model.reduced_operator import operator_coupling
+
+    ja = solver.jacobian.reshape(-1, 5)[bordered.rows]
+    for want, got in zip(operator_coupling(bordered.inverse, ja, mu), compiled_coupling(bordered.inverse, ja, mu)):
+        assert np.abs(got - want).max() <= 1e-11 * np.abs(want).max()
     for op in (assemble_operator(*args, solver.jacobian, masks[0], mu), bordered):
         (dq, y), (dq_c, y_c) = newton_step(op, off, f_scaled), compiled_step(op, off, f_scaled)
         assert np.abs(dq_c - dq).max() <= 1e-11 * np.abs(dq).max()

@@ -240,9 +240,9 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
 
     if kernel == "compiled" and not AVAILABLE:
         pytest.skip("numba is not installed: only the numpy path exists here")
-    border = None
+    loops = None
     if kernel == "compiled":
-        from slewing_model.contact_kernel import bordered_inverse as border
+        from slewing_model.contact_kernel import COMPILED_LOOPS as loops
 
     loads = LOADS[1]
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
@@ -264,7 +264,7 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
     for before, after in ((loaded[[0, 2] + list(range(5, loaded.size))], loaded),      # three close
                           (np.delete(loaded, [1, 7]), np.delete(loaded, [4, 9, 10]))):  # two close, three open
         kept = formed(mask(before))
-        updated = update_operator(kept, point, solver.compliance, stiffness, jacobian, mask(after), mu, border)
+        updated = update_operator(kept, point, solver.compliance, stiffness, jacobian, mask(after), mu, loops)
         assert np.array_equal(updated.rows[:kept.rows.size], kept.rows)     # the kept rows stay, opened or not
         fresh = formed(mask(before) | mask(after))
         order = np.argsort(updated.rows)
