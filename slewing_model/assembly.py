@@ -91,7 +91,7 @@ class Assembly:
 
 
 def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None,
-             previous: Assembly | None = None) -> Assembly:
+             previous: Assembly | None = None, compiled: bool = False) -> Assembly:
     """Groove centres, groove radii, ball diameters and spring constants at ``psi``.
 
     Parameters
@@ -107,6 +107,10 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
         errors, every ball sees the same grooves at any ``psi`` (each ball keeps
         its own diameter), so only the angles change: the rest is taken from it;
         where no ring has measured groove radii, so are the radii and stiffnesses.
+    compiled : bool
+        Interpolate the rings' error tables by a compiled loop
+        (:func:`slewing_model.contact_kernel.periodic_interp`, needs numba): numpy's
+        arithmetic, the same values.
 
     Returns
     -------
@@ -135,7 +139,7 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
             if error_map is None:
                 continue
             theta = phi - psi if ring == bearing.moving_ring else phi
-            d_radial, d_axial, rc = error_map.at(theta)
+            d_radial, d_axial, rc = _errors_at(error_map, theta, compiled)
             cols = [c - 1 for c in RING_CONTACTS[ring]]
             centre[:, cols, 0] += d_radial
             centre[:, cols, 1] += d_axial
@@ -155,6 +159,16 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
         contact_stiffness=k, stiffness=k_tot, natural_length=natural,
         moving_sign=1.0 if bearing.moving_ring == "inner" else -1.0,
     )
+
+
+def _errors_at(error_map, theta: np.ndarray, compiled: bool):
+    """:meth:`slewing_model.errors.RingErrorMap.at`, or the same by a compiled loop."""
+    if not compiled:
+        return error_map.at(theta)
+    from .contact_kernel import periodic_interp
+
+    values = periodic_interp(theta, *error_map.table)
+    return values[:, 0:2], values[:, 2:4], values[:, 4:6] if values.shape[1] > 4 else None
 
 
 def rings_have_errors(bearing: Bearing) -> bool:

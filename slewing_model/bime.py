@@ -163,7 +163,7 @@ class BimeSolver:
         """Re-assemble at another rotation of the moving ring (errors move with
         the rings; the ring matrices do not change: the rings are axisymmetric)."""
         previous = self.assembly
-        self.assembly = a = assemble(self.bearing, psi, cage_angle, previous=previous)
+        self.assembly = a = assemble(self.bearing, psi, cage_angle, previous=previous, compiled=self._compiled)
         if previous is None or a.groove_centre is not previous.groove_centre:   # other grooves under the balls
             self._moving_centre = a.moving_centre
             self._separation = a.separation                    # e before loading, (B, 2, 2)

@@ -475,6 +475,26 @@ def _contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, p
     return contact_load, contact_angle, deflection, semi_a, semi_b, pressure, truncated, off
 
 
+_PERIODIC_SIGNATURE = "f8[:, :](f8[:], f8[:], f8[:, :])"
+
+
+def _periodic_interp(theta, angle, table):
+    """The columns of ``table`` (K, N) at the angles ``theta`` (B,) taken modulo ``2 pi``:
+    ``np.interp(theta % (2 pi), angle, column)`` of each column, in numpy's arithmetic
+    (:meth:`slewing_model.errors.RingErrorMap.at`), (B, K)."""
+    n_columns = table.shape[0]
+    out = np.empty((theta.size, n_columns))
+    period = 2.0 * np.pi
+    last = angle.size - 1
+    segment = 0
+    for b in range(theta.size):
+        x = theta[b] % period
+        for k in range(n_columns):
+            out[b, k], j = _interp(x, angle, table[k], table[k, 0], table[k, last], segment)
+            segment = max(j, 0)
+    return out
+
+
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
@@ -564,8 +584,19 @@ def operator_coupling(inverse, ja, mu):
     return coupling, schur_inverse
 
 
+@functools.lru_cache(maxsize=1)
+def compiled_periodic_interp():
+    """The compiled :func:`_periodic_interp` (as :func:`compiled_trial_point`)."""
+    return _compile(_periodic_interp, _PERIODIC_SIGNATURE)
+
+
+def periodic_interp(theta, angle, table):
+    """:func:`_periodic_interp` by the compiled loop."""
+    return compiled_periodic_interp()(np.ascontiguousarray(theta, dtype=float), angle, table)
+
+
 #: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_operator_coupling, _operator_coupling), (compiled_operator_matrix, _operator_matrix), (compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
+KERNELS = ((compiled_periodic_interp, _periodic_interp), (compiled_operator_coupling, _operator_coupling), (compiled_operator_matrix, _operator_matrix), (compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
 
 
 def newton_step(op, point, f_scaled):

@@ -85,6 +85,14 @@ class RingErrorMap:
                 columns.append(np.concatenate((fp[-1:], fp, fp[0:1])))
         return angle, columns
 
+    @functools.cached_property
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """The periodic table of :meth:`at` as the angles (N + 2,) and one array of its columns
+        (4 or 6, N + 2): what a compiled loop interpolates
+        (:func:`slewing_model.contact_kernel.periodic_interp`)."""
+        angle, columns = self._periodic_table
+        return angle, np.array(columns)
+
     def to_dict(self) -> dict:
         return {
             "angle": self.angle.tolist(),

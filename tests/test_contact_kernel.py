@@ -191,6 +191,22 @@ def test_compiled_column_turn_equals_the_numpy_turn(pitch, table3):
     assert compiled_turn(op_e.jacobian, new_e, op_e.coupling, mu) is None
 
 
+def test_compiled_error_tables_equal_numpy_interp(table3):
+    """The grooves under the balls at a new rotation, from the rings' error tables interpolated by
+    the compiled loop: numpy's values bit for bit, with measured groove radii and without, at
+    angles past a turn and negative."""
+    from slewing_model import synthetic_errors
+    from slewing_model.assembly import assemble
+
+    for bearing in (table3.with_errors(synthetic_errors(table3.ball_count, seed=3)),
+                    _table3_with_measured_radii(table3)):
+        for psi in (0.0, 0.37, -2.5, 7.1):
+            want, got = assemble(bearing, psi), assemble(bearing, psi, compiled=True)
+            assert np.array_equal(got.groove_centre, want.groove_centre)
+            assert np.array_equal(got.groove_radius, want.groove_radius)
+            assert np.array_equal(got.stiffness, want.stiffness)
+
+
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
 def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
     case, sims = simulators_per_kernel(name, 25, "contact_kernel")
