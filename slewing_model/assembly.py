@@ -166,6 +166,9 @@ def _errors_at(error_map, theta: np.ndarray, compiled: bool):
     if not compiled:
         return error_map.at(theta)
     from .contact_kernel import periodic_interp
+    from .friction_kernel import use_compiled
+
+    use_compiled("compiled", "compiled")               # a clear ValueError where numba is not installed
 
     values = periodic_interp(theta, *error_map.table)
     return values[:, 0:2], values[:, 2:4], values[:, 4:6] if values.shape[1] > 4 else None

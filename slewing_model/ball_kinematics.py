@@ -26,8 +26,8 @@ import numpy as np
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .friction_kernel import (
-    compiled_ball_results, compiled_contact_set, compiled_evaluate_points, compiled_minimise_balls, compiled_point_coefficients,
-    compiled_tractions,
+    NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
+    compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
 )
 from .geometry import RING_CONTACTS, Bearing
 
@@ -87,14 +87,27 @@ def _workspace(tag: str) -> _Workspace:
 _DISTRIBUTION_FIELDS = ("contact_load", "contact_angle", "semi_axis_a", "semi_axis_b")
 
 
-def _refuse(what) -> None:
-    """ValueError for a load distribution :class:`ContactSet` cannot take: a field name (a value
-    that is not finite), 5 (a negative load) or 6 (a loaded contact without an ellipse)."""
-    if what == 5:
-        raise ValueError("distribution.contact_load: must be >= 0 (N)")
-    if what == 6:
-        raise ValueError("distribution.semi_axis_a/b: must be > 0 (m) where the contact is loaded")
-    raise ValueError(f"distribution.{what}: must be finite (not NaN or infinite)")
+def _refuse(status: int, where: int, arrays: dict) -> None:
+    """ValueError for a load distribution :class:`ContactSet` cannot take, naming the field, the
+    ball and contact (``where = 4 ball + contact``), the value and the rule: ``status`` as
+    :func:`slewing_model.friction_kernel._contact_set` returns it."""
+    ball, contact = divmod(where, 4)
+    at = f"of ball {ball + 1}, contact {contact + 1}"
+    if status == NEGATIVE_LOAD:
+        raise ValueError(f"distribution.contact_load {at} = {float(arrays['contact_load'][ball, contact])!r} N: "
+                         "must be >= 0")
+    if status == NO_ELLIPSE:
+        a, b, q = (float(arrays[name][ball, contact]) for name in ("semi_axis_a", "semi_axis_b", "contact_load"))
+        raise ValueError(f"distribution.semi_axis_a/b {at} = {a!r} / {b!r} m: must be > 0 where the contact is "
+                         f"loaded ({q!r} N)")
+    name = _DISTRIBUTION_FIELDS[status - 1]
+    raise ValueError(f"distribution.{name} {at} = {float(arrays[name][ball, contact])!r}: must be finite "
+                     "(not NaN or infinite)")
+
+
+def _first(mask: np.ndarray) -> int:
+    """``4 ball + contact`` of the first True of a (B, 4) mask, ball by ball."""
+    return int(np.flatnonzero(mask)[0])
 
 
 class ContactSet:
@@ -107,6 +120,8 @@ class ContactSet:
         arrays = {}
         for name in _DISTRIBUTION_FIELDS:
             value = np.asarray(getattr(distribution, name), dtype=float)
+            if compiled and not value.flags.writeable:       # the compiled loop takes writable arrays
+                value = value.copy()
             if value.shape != (n_balls, 4):
                 raise ValueError(f"distribution.{name} has shape {value.shape}, expected ({n_balls}, 4) "
                                  f"for this bearing ({bearing.name})")
@@ -122,13 +137,13 @@ class ContactSet:
         self.contact_angle = arrays["contact_angle"]
         self.moving_ring = bearing.moving_ring
         if compiled:            # the same, one compiled loop (friction_kernel)
-            (status, self.ball_index, self.contact_index, self.owner, self.active, self.inactive, rows,
+            (status, where, self.ball_index, self.contact_index, self.owner, self.active, self.inactive, rows,
              moving, self.force_scale) = compiled_contact_set()(
                 q, self.contact_angle, arrays["semi_axis_a"], arrays["semi_axis_b"], self.ball_radius,
                 np.asarray(bearing.groove_radius, dtype=float), _IS_MOVING[bearing.moving_ring], _NORMAL_SIGN_R,
                 _NORMAL_SIGN_Z, mu, speed, sliding_regularisation)
             if status:
-                _refuse(_DISTRIBUTION_FIELDS[status - 1] if status <= 4 else status)
+                _refuse(status, where, arrays)
             self.loaded = q > 0.0
             self.rb, self.rd, self.n_r, self.n_z, self.a, self.b, self.ring_speed = (row[:, None] for row in rows[:7])
             self.mu_load, eps2 = rows[7], rows[8]
@@ -136,14 +151,15 @@ class ContactSet:
             self.moving = moving[:, None]
             self.normal = rows[2:4].T
             return
-        for name, value in arrays.items():
+        for k, value in enumerate(arrays.values()):
             if not np.all(np.isfinite(value)):
-                _refuse(name)
+                _refuse(1 + k, _first(~np.isfinite(value)), arrays)
         if np.any(q < 0.0):
-            _refuse(5)
+            _refuse(NEGATIVE_LOAD, _first(q < 0.0), arrays)
         loaded = q > 0.0
-        if np.any(loaded & ((arrays["semi_axis_a"] <= 0.0) | (arrays["semi_axis_b"] <= 0.0))):
-            _refuse(6)
+        no_ellipse = loaded & ((arrays["semi_axis_a"] <= 0.0) | (arrays["semi_axis_b"] <= 0.0))
+        if np.any(no_ellipse):
+            _refuse(NO_ELLIPSE, _first(no_ellipse), arrays)
         self.loaded = loaded
         self.ball_index, self.contact_index = np.nonzero(loaded)
         active_mask = loaded.any(axis=1)

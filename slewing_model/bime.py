@@ -55,14 +55,14 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import compiled_jacobian, compiled_trial_point, contact_results
-from .contact_kernel import COMPILED_LOOPS
+from .contact_kernel import COMPILED_ARITHMETIC
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
 from .friction_kernel import use_compiled
 from .geometry import RING_CONTACTS, Bearing
 from .reduced_operator import (
-    NUMPY_LOOPS, PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator,
+    NUMPY_ARITHMETIC, PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator,
     start_operator, turned_operator, update_operator,
 )
 from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
@@ -109,8 +109,9 @@ class BimeSolver:
         permanent-deformation limit (static safety factor 0.125), gross plastic
         deformation where the elastic Hertz model no longer holds.
     kernel : {"numpy", "auto", "compiled"}
-        How the springs of the flexible model and the result's Hertz ellipses are
-        evaluated: numpy array operations, or compiled loops
+        How the solver's per-contact work is done (a new rotation's grooves and Jacobian, the
+        trial points, the reduced operator's steps, forming, turning and bordering, the
+        result's contacts): numpy array operations, or compiled loops
         (:mod:`slewing_model.contact_kernel`, needs numba); "auto" takes the compiled
         loops where numba is installed. The same results to round-off. Default numpy: a
         few solves do not repay numba's import (0.5 s); the co-simulation's simulator
@@ -130,8 +131,8 @@ class BimeSolver:
         self.max_iterations = max_iterations
         self.pressure_limit = pressure_limit
         self.kernel = kernel
-        self._compiled = use_compiled(kernel, "kernel")    # the springs and ellipses as compiled loops
-        self._loops = COMPILED_LOOPS if self._compiled else NUMPY_LOOPS     # the reduced operator's arithmetic
+        self._compiled = use_compiled(kernel, "kernel")    # the per-contact work as compiled loops
+        self._arithmetic = COMPILED_ARITHMETIC if self._compiled else NUMPY_ARITHMETIC     # the operator's too
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
         self.ring_compliance = None if superelement is None else ring_compliances(superelement)
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
@@ -326,6 +327,9 @@ class BimeSolver:
             grad_q, mismatch = point.gradient, point.mismatch
             scale = max(load_scale, point.peak_force, 1e-300)
             residual = point.peak_residual / scale
+            if not math.isfinite(residual):
+                raise NoEquilibriumError(f"no equilibrium for loads {loads}: a non-finite force residual "
+                                         f"({residual}) after {iterations} Newton iterations")
             if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
             if iterations >= self.max_iterations:
@@ -448,9 +452,9 @@ class BimeSolver:
         stiffness, op, pending = self.assembly.stiffness, self._reduced, self.pending_operator
         if pending is not None:
             if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
-                pending = complete_operator(pending, self.jacobian, mu, self._loops)
+                pending = complete_operator(pending, self.jacobian, mu, self._arithmetic)
             elif self._stage_due:                                              # one stage a solve
-                pending = advance_operator(pending, self.jacobian, mu, self._loops)
+                pending = advance_operator(pending, self.jacobian, mu, self._arithmetic)
             self._stage_due = False
             if isinstance(pending, ReducedOperator):     # inverted: its coupling is that of the Jacobian now
                 op, pending, fresh = pending, None, False
@@ -458,29 +462,30 @@ class BimeSolver:
             else:
                 fresh = False
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
-            pending = start_operator(p, self.compliance, stiffness, active, self._loops)
+            pending = start_operator(p, self.compliance, stiffness, active, self._arithmetic)
             fresh = self._stage_due = False
         self.pending_operator = pending
 
         def bordered(op):                      # contacts closed: bordered in (those that opened stay)
-            closed = np.any(active > op.active)             # active and not in the operator
+            closed = np.any(active & ~op.active)
             if not closed:
                 return op
-            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._loops)
+            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
 
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn, loops=self._loops)
+                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn,
+                                     arithmetic=self._arithmetic)
             op = bordered(op)
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
-                op = bordered(complete_operator(self.pending_operator, self.jacobian, mu, self._loops))
+                op = bordered(complete_operator(self.pending_operator, self.jacobian, mu, self._arithmetic))
                 self.pending_operator = None
         if fresh or op is None:
-            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._loops)
+            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
-        dq, y_new = self._loops.step(op, p, f_scaled)
+        dq, y_new = self._arithmetic.step(op, p, f_scaled)
         return dq, y_new - p.y
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float) -> LoadDistribution:

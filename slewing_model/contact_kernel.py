@@ -1,12 +1,26 @@
-"""The per-contact loops of the load distribution, compiled with numba where it is installed.
+"""The loops of the load distribution, compiled with numba where it is installed.
 
-Every Newton iteration of :mod:`slewing_model.bime` evaluates the Hertz springs of every
-diagonal at a trial point (eqs 1, 7, 8: :meth:`slewing_model.bime.BimeSolver._evaluate`), and
-every result the contact ellipses of every contact (:func:`slewing_model.contact.hertz_ellipse`).
-With numpy these are some twenty and fifty array operations on a few hundred entries, whose
-call overhead, not their arithmetic, sets the time. :func:`_spring_terms` and :func:`_ellipses`
-are the same formulas, in the same order of operations, as one loop each (pitch bearing: 19
--> 4.6 us and 70 -> 28 us, the latter computing the semi-axes and pressure only where loaded).
+A co-simulation step of :mod:`slewing_model.bime` assembles the bearing at the new rotation,
+runs a few Newton iterations, each a step with the kept reduced ring operator
+(:mod:`slewing_model.reduced_operator`) and a trial point on the search line, sometimes forms,
+borders or turns that operator, and reports the contacts of the solution. With numpy each of
+these is some ten to fifty array operations on a few hundred entries, whose call overhead, not
+their arithmetic, sets the time. The loops here are the same formulas, most in the same order
+of operations, one loop each:
+
+* a new rotation: the rings' error tables (:func:`_periodic_interp`), the Jacobian of eq 23
+  (:func:`_jacobian`);
+* an iteration: the trial point, its springs (eqs 1, 7, 8) and stop-rule terms
+  (:func:`_trial_point`), the modified Newton step (:func:`_newton_step`);
+* the operator (:data:`COMPILED_ARITHMETIC`, numpy's :data:`slewing_model.reduced_operator.NUMPY_ARITHMETIC`):
+  formed (:func:`_operator_matrix`), coupled to the ring's motions (:func:`_operator_coupling`),
+  turned with the ring (:func:`_column_turn`), bordered by contacts that close
+  (:func:`_bordered_inverse`);
+* the result: the contacts' loads, angles, Hertz ellipses and edge checks
+  (:func:`_contact_results`).
+
+Where a loop sums ``W^-1 v`` it does so column by column (``W^-1`` symmetric), which differs from
+numpy's row sums by round-off. docs/speed.md has what each gave.
 
 numba is optional, as for the friction's loops (:mod:`slewing_model.friction_kernel`, whose
 :func:`~slewing_model.friction_kernel.compile_all` compiles these too, and whose
@@ -20,8 +34,9 @@ import math
 
 import numpy as np
 
-from .friction_kernel import compile_loop
-from .reduced_operator import OperatorLoops
+from .contact import _E_TABLE, _F_TABLE, _LOG_KAPPA, effective_modulus
+from .friction_kernel import compile_loop, loop_factory
+from .reduced_operator import OperatorArithmetic
 
 _TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
                     "f8[:, :], f8[:], f8[:], b1[:], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:], f8[:], "
@@ -99,6 +114,21 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
             np.array([0.4 * energy, 0.5 * ring, work, peak_force, peak_residual, n_loaded]))
 
 
+def _symmetric_times(matrix, vectors):
+    """``(M V)^T`` (k, n) for a symmetric ``M`` (n, n) and ``V^T = vectors`` (k, n), summed column by
+    column, ``sum_j v_j M_j`` with ``M``'s rows for its columns: a loop of vector operations, where
+    a row's dot product is one chain of additions. ``M`` symmetric to round-off (a bordered
+    ``W^-1``) gives ``M^T V``, which differs from ``M V`` by round-off."""
+    k, n = vectors.shape
+    out = np.zeros((k, n))
+    for j in range(n):
+        for m in range(k):
+            value = vectors[m, j]
+            for i in range(n):
+                out[m, i] += matrix[j, i] * value
+    return out
+
+
 _NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:], "
                      "f8[:], f8[:], i8)")
 
@@ -109,9 +139,7 @@ def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_in
     after the step (``n_rows``,), zero off the operator's ``rows``: the formulas of
     :func:`slewing_model.reduced_operator.newton_step` (``force`` and ``ring_motion`` flat, (4B,)).
 
-    ``W^-1 rhs`` is summed column by column, ``sum_j rhs_j (W^-1)_j``: ``W^-1`` is symmetric
-    (to round-off, once bordered), and this form runs as vector operations where a row's dot
-    product is one chain of additions."""
+    ``W^-1 rhs`` is summed column by column (:func:`_symmetric_times`)."""
     n = rows.size
     rhs = np.empty(n)
     for k in range(n // 2):                 # A^-1 f of each diagonal, + (M y) on its rows
@@ -120,11 +148,7 @@ def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_in
         for c in range(2):
             rhs[2 * k + c] = (contact_compliance[k, c, 0] * f0 + contact_compliance[k, c, 1] * f1
                               + ring_motion[rows[2 * k + c]])
-    w = np.zeros(n)
-    for j in range(n):
-        r = rhs[j]
-        for i in range(n):
-            w[i] += inverse[j, i] * r
+    w = _symmetric_times(inverse, rhs.reshape(1, n))[0]
     t = f_scaled.copy()                     # F - J_a^T w
     for i in range(n):
         for c in range(5):
@@ -191,15 +215,17 @@ def _column_turn(old, new, coupling, mu):
     empty = np.empty((0, 5))
     if not found:
         return False, empty, empty
-    worst = scale = 0.0
+    worst = scale = total = 0.0
     for i in range(n):
         for c in range(5):
             value = 0.0
             for k in range(5):
                 value += old[i, k] * turn[k, c]
-            worst = max(worst, abs(value - new[i, c]))
+            difference = abs(value - new[i, c])
+            worst = max(worst, difference)
+            total += difference                        # NaN or inf shows here, not in max
             scale = max(scale, abs(new[i, c]))
-    if not worst <= 1e-12 * scale:
+    if not (math.isfinite(total) and worst <= 1e-12 * scale):        # NaN or inf: no turn, as numpy finds
         return False, empty, empty
     turned = np.zeros((n, 5))
     for i in range(n):
@@ -245,16 +271,11 @@ _BORDER_SIGNATURE = ("Tuple((f8[:, ::1], f8[:, :], f8[:, :]))(f8[:, ::1], f8[:, 
 
 def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
     """:func:`slewing_model.reduced_operator.bordered_inverse` as one compiled loop: the same blocks,
-    with ``W^-1 B`` summed column by column (``W^-1`` symmetric to round-off, as in
-    :func:`_newton_step`) and ``W^-1 + X S X^T`` written in one pass over ``W^-1`` (numpy's
-    product and sum take three, with a temporary the size of ``W^-1``)."""
+    with ``W^-1 B`` summed column by column (:func:`_symmetric_times`) and ``W^-1 + X S X^T``
+    written in one pass over ``W^-1`` (numpy's product and sum take three, with a temporary the
+    size of ``W^-1``)."""
     n, r = b_mat.shape
-    x_t = np.zeros((r, n))                         # X^T = (W^-1 B)^T, by rows: vector operations
-    for j in range(n):
-        for k in range(r):
-            b = b_mat[j, k]
-            for i in range(n):
-                x_t[k, i] += inverse[j, i] * b
+    x_t = _symmetric_times(inverse, np.ascontiguousarray(b_mat.T))        # X^T = (W^-1 B)^T
     reduced = np.empty((r, r))                     # C - B^T X
     for k in range(r):
         for m in range(r):
@@ -354,15 +375,10 @@ _COUPLING_SIGNATURE = "Tuple((f8[:, :], f8[:, :]))(f8[:, ::1], f8[:, :], f8)"
 
 def _operator_coupling(inverse, ja, mu):
     """:func:`slewing_model.reduced_operator.operator_coupling` as one compiled loop: ``W^-1 J_a``
-    summed column by column (``W^-1`` symmetric to round-off, as in :func:`_newton_step`) and
+    summed column by column (:func:`_symmetric_times`) and
     ``(J_a^T W^-1 J_a + mu I)^-1``, or an empty inverse where that is singular."""
     n = ja.shape[0]
-    coupling_t = np.zeros((5, n))
-    for j in range(n):
-        for c in range(5):
-            value = ja[j, c]
-            for i in range(n):
-                coupling_t[c, i] += inverse[j, i] * value
+    coupling_t = _symmetric_times(inverse, np.ascontiguousarray(ja.T))
     normal = mu * np.eye(5)
     for a in range(5):
         for c in range(5):
@@ -498,51 +514,36 @@ def _periodic_interp(theta, angle, table):
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
-    return compile_loop(function, signature, ("_segment", "_interp", "_solve_small", "_hertz_contact"),
-                        error_model="numpy")
+    return compile_loop(function, signature, ("_segment", "_interp", "_solve_small", "_hertz_contact",
+                                              "_symmetric_times"), error_model="numpy")
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_trial_point():
-    """The compiled :func:`_trial_point` (numba, eager signature, numba's on-disk cache; compiled
-    when :class:`slewing_model.simulator.BearingSimulator` is built, never in a step)."""
-    return _compile(_trial_point, _TRIAL_SIGNATURE)
+#: (factory, Python function) of each compiled loop of the load distribution
+KERNELS: list = []
+compiled_trial_point = loop_factory(KERNELS, _compile, _trial_point, _TRIAL_SIGNATURE)
+compiled_newton_step = loop_factory(KERNELS, _compile, _newton_step, _NEWTON_SIGNATURE)
+compiled_column_turn = loop_factory(KERNELS, _compile, _column_turn, _TURN_SIGNATURE)
+compiled_jacobian = loop_factory(KERNELS, _compile, _jacobian, _JACOBIAN_SIGNATURE)
+compiled_bordered_inverse = loop_factory(KERNELS, _compile, _bordered_inverse, _BORDER_SIGNATURE)
+compiled_operator_matrix = loop_factory(KERNELS, _compile, _operator_matrix, _MATRIX_SIGNATURE)
+compiled_operator_coupling = loop_factory(KERNELS, _compile, _operator_coupling, _COUPLING_SIGNATURE)
+compiled_contact_results = loop_factory(KERNELS, _compile, _contact_results, _RESULTS_SIGNATURE)
+compiled_periodic_interp = loop_factory(KERNELS, _compile, _periodic_interp, _PERIODIC_SIGNATURE)
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_contact_results():
-    """The compiled :func:`_contact_results` (as :func:`compiled_trial_point`)."""
-    return _compile(_contact_results, _RESULTS_SIGNATURE)
+# ---- the loops with the interfaces of the numpy functions they stand for ----------------------
 
-
-@functools.lru_cache(maxsize=1)
-def compiled_newton_step():
-    """The compiled :func:`_newton_step` (as :func:`compiled_trial_point`)."""
-    return _compile(_newton_step, _NEWTON_SIGNATURE)
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_column_turn():
-    """The compiled :func:`_column_turn` (as :func:`compiled_trial_point`)."""
-    return _compile(_column_turn, _TURN_SIGNATURE)
+def newton_step(op, point, f_scaled):
+    """:func:`slewing_model.reduced_operator.newton_step` by the compiled loop."""
+    return compiled_newton_step()(np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian,
+                                  op.coupling, op.schur_inverse, point.force.reshape(-1), point.ring_motion, f_scaled,
+                                  point.y.size)
 
 
 def column_turn(old, new, coupling, mu):
     """:func:`slewing_model.reduced_operator.column_turn` by the compiled loop."""
     found, coupling, schur_inverse = compiled_column_turn()(old, new, coupling, mu)
     return (coupling, schur_inverse) if found else None
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_jacobian():
-    """The compiled :func:`_jacobian` (as :func:`compiled_trial_point`)."""
-    return _compile(_jacobian, _JACOBIAN_SIGNATURE)
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_bordered_inverse():
-    """The compiled :func:`_bordered_inverse` (as :func:`compiled_trial_point`)."""
-    return _compile(_bordered_inverse, _BORDER_SIGNATURE)
 
 
 def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
@@ -555,24 +556,13 @@ def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu
     return bordered, new_coupling, schur_inverse
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_operator_matrix():
-    """The compiled :func:`_operator_matrix` (as :func:`compiled_trial_point`)."""
-    return _compile(_operator_matrix, _MATRIX_SIGNATURE)
-
-
 def operator_matrix(point, compliance, stiffness, active):
     """:func:`slewing_model.reduced_operator.operator_matrix` by the compiled loop."""
     rows = np.flatnonzero(np.repeat(active, 2))
-    a_inv, w = compiled_operator_matrix()(np.ascontiguousarray(compliance.dense), rows, point.n.reshape(-1, 2), point.delta.reshape(-1),
-                                         point.length.reshape(-1), point.q.reshape(-1), stiffness.reshape(-1))
+    a_inv, w = compiled_operator_matrix()(np.ascontiguousarray(np.asarray(compliance)), rows, point.n.reshape(-1, 2),
+                                         point.delta.reshape(-1), point.length.reshape(-1), point.q.reshape(-1),
+                                         stiffness.reshape(-1))
     return rows, a_inv, w
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_operator_coupling():
-    """The compiled :func:`_operator_coupling` (as :func:`compiled_trial_point`)."""
-    return _compile(_operator_coupling, _COUPLING_SIGNATURE)
 
 
 def operator_coupling(inverse, ja, mu):
@@ -584,38 +574,18 @@ def operator_coupling(inverse, ja, mu):
     return coupling, schur_inverse
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_periodic_interp():
-    """The compiled :func:`_periodic_interp` (as :func:`compiled_trial_point`)."""
-    return _compile(_periodic_interp, _PERIODIC_SIGNATURE)
-
-
 def periodic_interp(theta, angle, table):
     """:func:`_periodic_interp` by the compiled loop."""
     return compiled_periodic_interp()(np.ascontiguousarray(theta, dtype=float), angle, table)
-
-
-#: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_periodic_interp, _periodic_interp), (compiled_operator_coupling, _operator_coupling), (compiled_operator_matrix, _operator_matrix), (compiled_bordered_inverse, _bordered_inverse), (compiled_jacobian, _jacobian), (compiled_column_turn, _column_turn), (compiled_trial_point, _trial_point), (compiled_contact_results, _contact_results), (compiled_newton_step, _newton_step))
-
-
-def newton_step(op, point, f_scaled):
-    """:func:`slewing_model.reduced_operator.newton_step` by the compiled loop."""
-    return compiled_newton_step()(np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
-                                  op.schur_inverse, point.force.reshape(-1), point.ring_motion, f_scaled,
-                                  point.y.size)
 
 
 def contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner, youngs_modulus,
                     poisson_ratio, edge_angle):
     """:func:`_contact_results` by the compiled loop: the moduli as :func:`slewing_model.contact.hertz_ellipse`
     takes them, ``inner`` (4,) which contacts are on the inner ring."""
-    from .contact import _E_TABLE, _F_TABLE, _LOG_KAPPA, effective_modulus
-
     return compiled_contact_results()(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner,
                                       effective_modulus(youngs_modulus, poisson_ratio), _F_TABLE, _LOG_KAPPA,
                                       _E_TABLE, edge_angle)
 
-
-#: the reduced operator's arithmetic as compiled loops (:class:`slewing_model.reduced_operator.OperatorLoops`)
-COMPILED_LOOPS = OperatorLoops(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
+#: the reduced operator's arithmetic as compiled loops (:class:`slewing_model.reduced_operator.OperatorArithmetic`)
+COMPILED_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)

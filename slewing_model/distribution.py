@@ -116,10 +116,10 @@ class LoadDistribution:
         Largest force residual at the end, relative to the load scale.
     state : ndarray
         Solver unknowns, for a warm start (:meth:`BimeSolver.solve` ``initial``).
-    rings : dict or None
+    rings : dict, ndarray or None
         The rings' compliances at the groove centres (flexible model,
         :func:`slewing_model.ring_compliance.ring_compliances`), from which
-        ``ring_displacement`` follows.
+        ``ring_displacement`` follows; or those displacements, (B, 4, 2).
     """
 
     model: str
@@ -138,23 +138,23 @@ class LoadDistribution:
     iterations: int
     residual: float
     state: np.ndarray = field(repr=False)
-    rings: dict | None = field(default=None, repr=False, compare=False)
+    rings: dict | np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @functools.cached_property
     def ring_displacement(self) -> np.ndarray | None:
         """(B, 4, 2) groove-centre displacements by ring deformation, m (None for rigid rings)."""
-        if self.rings is None:
-            return None
+        if self.rings is None or isinstance(self.rings, np.ndarray):
+            return self.rings
         from .ring_compliance import groove_displacement
 
         return groove_displacement(self.rings, self.state[5:])
 
     def __getstate__(self) -> dict:
-        """Pickled (a study's worker, a copy) with the ring displacements, not the rings'
+        """Pickled (a study's worker, a copy) with the ring displacements in place of the rings'
         compliance matrices they come from (megabytes)."""
         state = dict(self.__dict__)
-        if state.get("rings") is not None:
-            state["ring_displacement"], state["rings"] = self.ring_displacement, None
+        state["rings"] = self.ring_displacement
+        state.pop("ring_displacement", None)
         return state
 
     @property

@@ -6,9 +6,12 @@ Weiszfeld majorant ``M - H``) over the quadrature points of every loaded contact
 With numpy that is some sixty array operations per evaluation, each a few microseconds of
 call overhead for a few thousand points: for a 150-ball bearing the overhead, not the
 arithmetic, sets the time. :func:`_evaluate_points`, compiled, is the same sum as one loop
-over contacts, across-groove nodes and folded along-groove nodes. :func:`_point_coefficients`
-is, likewise, the set-up of the points' velocity coefficients (``ContactPoints``), some twenty
-array operations done twice a step (the rule the balls are solved on and the torque's).
+over contacts, across-groove nodes and folded along-groove nodes. The rest of a friction torque
+is likewise compiled: the loaded contacts of the distribution (:func:`_contact_set`), the set-up
+of the points' velocity coefficients, twice a step (:func:`_point_coefficients`, for the rule the
+balls are solved on and the torque's), the balls' equilibrium ball by ball
+(:func:`_minimise_balls`), the contacts' powers and torques (:func:`_tractions`) and what is
+reported per ball (:func:`_ball_results`).
 
 numba is optional (it is not part of the FMU's run-time requirements): without it
 :data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
@@ -370,33 +373,13 @@ def _compile(function, signature):
     return compile_loop(function, signature, _HELPERS)
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_evaluate_points():
-    """The compiled :func:`_evaluate_points` (numba, eager signature, numba's on-disk cache).
-
-    The first call compiles (about a second) or loads it from the cache;
-    :class:`slewing_model.simulator.BearingSimulator` makes that call when it is built, so
-    that it lands in the FMU's instantiation and never in a step."""
-    return _compile(_evaluate_points, _SIGNATURE)
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_tractions():
-    """The compiled :func:`_tractions` (as :func:`compiled_evaluate_points`)."""
-    return _compile(_tractions, _TRACTIONS_SIGNATURE)
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_minimise_balls():
-    """The compiled :func:`_minimise_balls` (as :func:`compiled_evaluate_points`)."""
-    return _compile(_minimise_balls, _MINIMISE_SIGNATURE)
-
-
-_CONTACT_SET_SIGNATURE = ("Tuple((i8, i8[:], i8[:], i8[:], i8[:], i8[:], f8[:, :], b1[:], f8[:]))("
+_CONTACT_SET_SIGNATURE = ("Tuple((i8, i8, i8[:], i8[:], i8[:], i8[:], i8[:], f8[:, :], b1[:], f8[:]))("
                           "f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:], f8, f8, f8)")
 
 #: the rows of the per-contact array :func:`_contact_set` returns
 CONTACT_ROWS = ("rb", "rd", "n_r", "n_z", "a", "b", "ring_speed", "mu_load", "eps2")
+#: what :func:`_contact_set` refuses, after ``1 + k`` for a value of its field ``k`` that is not finite
+NEGATIVE_LOAD, NO_ELLIPSE = 5, 6
 
 
 def _contact_set(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
@@ -407,34 +390,34 @@ def _contact_set(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving
     ``load``, ``angle``, ``semi_a``, ``semi_b`` (B, 4) the distribution's; ``ball_radius`` (B,);
     ``groove_radius``, ``moving``, ``sign_r``, ``sign_z`` (4,) per contact 1..4. Returns a
     status (0, or what the numpy code refuses: ``1 + k`` the field ``k`` of the four has a
-    value that is not finite, 5 a negative load, 6 a loaded contact without an ellipse), the
-    ball and contact of every loaded contact (C,), the active-ball row of each, the active and
-    inactive balls, the (9, C) rows of :data:`CONTACT_ROWS`, ``moving`` (C,) and the force
-    scale (active balls,)."""
+    value that is not finite, :data:`NEGATIVE_LOAD`, :data:`NO_ELLIPSE` a loaded contact
+    without an ellipse) with the first contact it refuses (``4 ball + contact``), the ball and
+    contact of every loaded contact (C,), the active-ball row of each, the active and inactive
+    balls, the (9, C) rows of :data:`CONTACT_ROWS`, ``moving`` (C,) and the force scale
+    (active balls,)."""
     n_balls = load.shape[0]
+    status, where = 0, -1
     for k, field in enumerate((load, angle, semi_a, semi_b)):
         for b in range(n_balls):
             for c in range(4):
-                if not math.isfinite(field[b, c]):
-                    return (1 + k, np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64),
-                            np.empty(0, np.int64), np.empty(0, np.int64), np.empty((9, 0)), np.empty(0, np.bool_),
-                            np.empty(0))
+                if status == 0 and not math.isfinite(field[b, c]):
+                    status, where = 1 + k, 4 * b + c
     n_contacts = n_active = 0
-    negative = no_ellipse = False
     for b in range(n_balls):
         loaded_ball = False
         for c in range(4):
             if load[b, c] < 0.0:
-                negative = True
+                if status == 0 or status == NO_ELLIPSE:
+                    status, where = NEGATIVE_LOAD, 4 * b + c
             elif load[b, c] > 0.0:
-                no_ellipse = no_ellipse or semi_a[b, c] <= 0.0 or semi_b[b, c] <= 0.0
+                if status == 0 and (semi_a[b, c] <= 0.0 or semi_b[b, c] <= 0.0):
+                    status, where = NO_ELLIPSE, 4 * b + c
                 n_contacts += 1
                 loaded_ball = True
         n_active += loaded_ball
-    status = 5 if negative else 6 if no_ellipse else 0
     if status:
-        return (status, np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.int64),
-                np.empty(0, np.int64), np.empty((9, 0)), np.empty(0, np.bool_), np.empty(0))
+        none = np.empty(0, np.int64)
+        return status, where, none, none, none, none, none, np.empty((9, 0)), np.empty(0, np.bool_), np.empty(0)
     ball_index, contact_index = np.empty(n_contacts, np.int64), np.empty(n_contacts, np.int64)
     owner, active = np.empty(n_contacts, np.int64), np.empty(n_active, np.int64)
     inactive = np.empty(n_balls - n_active, np.int64)
@@ -471,7 +454,7 @@ def _contact_set(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving
         else:
             inactive[idle] = b
             idle += 1
-    return status, ball_index, contact_index, owner, active, inactive, rows, moving_contact, force_scale
+    return status, where, ball_index, contact_index, owner, active, inactive, rows, moving_contact, force_scale
 
 
 _BALL_RESULTS_SIGNATURE = ("Tuple((f8[:, :], f8[:], f8[:, :], f8[:], f8[:, :], f8[:, :], i8[:]))("
@@ -538,7 +521,7 @@ def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, len
     sin_t = np.empty(n_across)
     for c in range(n_contacts):
         rb_c, rd_c, nr, nz, speed, half_width = rb[c], rd[c], n_r[c], n_z[c], ring_speed[c], b[c]
-        arm = 1.0 if moving[c] else 0.0              # the fixed ring's contacts take no torque arm
+        arm = moving[c]                              # the fixed ring's contacts take no torque arm
         # the sines first: sin is odd and the nodes symmetric, the node n_across - 1 - i has -sin;
         # the loop below, free of calls, then runs as vector operations (measured 1.6 times faster)
         for i in range(n_neg, n_across):
@@ -560,32 +543,34 @@ def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, len
             s0[c, k] = -half * t2_z / length_scale
             s1[c, k] = half * t2_r / length_scale
             hs[c, k] = -half * speed * t2_r
-            arm1[c, k] = arm * (pitch_radius + r_r)
-            arm2[c, k] = arm * (-t2_r * half)
+            arm1[c, k] = pitch_radius + r_r if arm else 0.0
+            arm2[c, k] = -t2_r * half if arm else 0.0
     return g10, g12, h1, s0, s1, hs, arm1, arm2
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_point_coefficients():
-    """The compiled :func:`_point_coefficients` (as :func:`compiled_evaluate_points`)."""
-    return _compile(_point_coefficients, _COEFFICIENT_SIGNATURE)
+def loop_factory(registry: list, compile_function, function, signature: str):
+    """The factory of ``function`` compiled by ``compile_function`` for ``signature``: its first call
+    compiles the loop (or loads it from numba's on-disk cache), later calls return it. Entered in
+    ``registry`` (a module's :data:`KERNELS`), from which :func:`compile_all` compiles them all
+    when a simulator is built, so that compiling lands in an FMU's instantiation and never in a
+    step, and ``build_fmu.py`` ships their cache."""
+    @functools.lru_cache(maxsize=1)
+    def factory():
+        return compile_function(function, signature)
+
+    factory.__doc__ = f"The compiled :func:`{function.__name__}` (numba, eager signature, numba's on-disk cache)."
+    registry.append((factory, function))
+    return factory
 
 
-@functools.lru_cache(maxsize=1)
-def compiled_contact_set():
-    """The compiled :func:`_contact_set` (as :func:`compiled_evaluate_points`)."""
-    return _compile(_contact_set, _CONTACT_SET_SIGNATURE)
-
-
-@functools.lru_cache(maxsize=1)
-def compiled_ball_results():
-    """The compiled :func:`_ball_results` (as :func:`compiled_evaluate_points`)."""
-    return _compile(_ball_results, _BALL_RESULTS_SIGNATURE)
-
-
-#: the compiled loops' factories and the Python functions they compile
-KERNELS = ((compiled_ball_results, _ball_results), (compiled_contact_set, _contact_set), (compiled_evaluate_points, _evaluate_points), (compiled_point_coefficients, _point_coefficients),
-           (compiled_minimise_balls, _minimise_balls), (compiled_tractions, _tractions))
+#: (factory, Python function) of each compiled loop of the friction model
+KERNELS: list = []
+compiled_evaluate_points = loop_factory(KERNELS, _compile, _evaluate_points, _SIGNATURE)
+compiled_tractions = loop_factory(KERNELS, _compile, _tractions, _TRACTIONS_SIGNATURE)
+compiled_minimise_balls = loop_factory(KERNELS, _compile, _minimise_balls, _MINIMISE_SIGNATURE)
+compiled_point_coefficients = loop_factory(KERNELS, _compile, _point_coefficients, _COEFFICIENT_SIGNATURE)
+compiled_contact_set = loop_factory(KERNELS, _compile, _contact_set, _CONTACT_SET_SIGNATURE)
+compiled_ball_results = loop_factory(KERNELS, _compile, _ball_results, _BALL_RESULTS_SIGNATURE)
 
 
 def all_kernels(friction: bool = True, contact: bool = True) -> tuple:
@@ -593,7 +578,7 @@ def all_kernels(friction: bool = True, contact: bool = True) -> tuple:
     (:mod:`slewing_model.contact_kernel`): (factory, Python function) pairs."""
     from . import contact_kernel
 
-    return (KERNELS if friction else ()) + (contact_kernel.KERNELS if contact else ())
+    return tuple(KERNELS if friction else ()) + tuple(contact_kernel.KERNELS if contact else ())
 
 
 def compile_all(friction: bool = True, contact: bool = True) -> None:

@@ -82,11 +82,11 @@ def contact_compliance_blocks(point, stiffness: np.ndarray, active: np.ndarray) 
 
 
 def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.ndarray, mu: float,
-                     loops: "OperatorLoops | None" = None) -> ReducedOperator:
+                     arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
     """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5) and the
     Schur complement's inverse (:func:`operator_coupling`)."""
     ja = jacobian.reshape(-1, 5)[rows]
-    coupling, schur_inverse = _loops(loops).couple(inverse, ja, mu)
+    coupling, schur_inverse = _arithmetic(arithmetic).couple(inverse, ja, mu)
     return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
 
 
@@ -97,7 +97,7 @@ def operator_coupling(inverse: np.ndarray, ja: np.ndarray, mu: float):
 
 
 def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True,
-                    loops: "OperatorLoops | None" = None) -> ReducedOperator:
+                    arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
     """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
 
     ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
@@ -112,12 +112,12 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: boo
     ja = jacobian.reshape(-1, 5)[op.rows]
     if np.array_equal(op.jacobian, ja):
         return op
-    loops = _loops(loops)
+    arithmetic = _arithmetic(arithmetic)
     turned = None
     if may_turn and op.jacobian.shape == ja.shape:
-        turned = loops.turn(op.jacobian, ja, op.coupling, mu)
+        turned = arithmetic.turn(op.jacobian, ja, op.coupling, mu)
     if turned is None:
-        return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, loops)
+        return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, arithmetic)
     coupling, schur_inverse = turned
     return ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, ja, coupling, schur_inverse)
 
@@ -129,7 +129,7 @@ def column_turn(old: np.ndarray, new: np.ndarray, coupling: np.ndarray, mu: floa
     does: errors move the grooves with the ring; or the fit's normal equations are singular)."""
     try:
         turn = np.linalg.solve(old.T @ old, old.T @ new)
-    except np.linalg.LinAlgError:
+    except np.linalg.LinAlgError:      # J_a of rank < 5 (fewer than three loaded diagonals)
         return None
     if not np.abs(old @ turn - new).max() <= 1e-12 * np.abs(new).max():
         return None
@@ -238,10 +238,11 @@ class PendingOperator:
                    tuple(np.asarray(v) for v in parts))
 
 
-def start_operator(point, compliance, stiffness, active, loops: "OperatorLoops | None" = None) -> PendingOperator:
+def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None
+                   ) -> PendingOperator:
     """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
     and run the first stage of its inverse."""
-    rows, a_inv, w_mat = _loops(loops).form(point, compliance, stiffness, active)
+    rows, a_inv, w_mat = _arithmetic(arithmetic).form(point, compliance, stiffness, active)
     return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
 
 
@@ -256,7 +257,7 @@ def operator_matrix(point, compliance, stiffness, active):
     return rows, a_inv, w_mat
 
 
-def advance_operator(pending: PendingOperator, jacobian, mu, loops: "OperatorLoops | None" = None
+def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
                      ) -> "PendingOperator | ReducedOperator":
     """The next of :data:`SPREAD_STAGES`; after the last, the operator with its coupling to the
     Jacobian (4B, 5) of now (``jacobian`` None: the pending operator, inverted). A small ``W``
@@ -272,25 +273,26 @@ def advance_operator(pending: PendingOperator, jacobian, mu, loops: "OperatorLoo
     if pending.stage < len(SPREAD_STAGES) or jacobian is None:
         return pending
     return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
-                            loops)
+                            arithmetic)
 
 
-def complete_operator(pending: PendingOperator, jacobian, mu, loops: "OperatorLoops | None" = None
+def complete_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
                       ) -> ReducedOperator:
     """The remaining stages at once."""
     while isinstance(pending, PendingOperator):
-        pending = advance_operator(pending, jacobian, mu, loops)
+        pending = advance_operator(pending, jacobian, mu, arithmetic)
     return pending
 
 
-def assemble_operator(point, compliance, stiffness, jacobian, active, mu, loops: "OperatorLoops | None" = None
-                      ) -> ReducedOperator:
+def assemble_operator(point, compliance, stiffness, jacobian, active, mu,
+                      arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
     """Form and invert ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate: O(n^3)."""
-    return complete_operator(start_operator(point, compliance, stiffness, active, loops), jacobian, mu, loops)
+    return complete_operator(start_operator(point, compliance, stiffness, active, arithmetic), jacobian, mu,
+                             arithmetic)
 
 
 def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu,
-                    loops: "OperatorLoops | None" = None) -> ReducedOperator | None:
+                    arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator | None:
     """Follow contacts that closed by bordering the kept ``W^-1``; contacts that opened stay.
 
     A diagonal that opened keeps its row in the operator with the stiffness it had when the
@@ -319,8 +321,8 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
     c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
     _add_blocks(c_mat, new_a_inv)
-    inverse, coupling, schur_inverse = _loops(loops).border(op.inverse, b_mat, c_mat, op.jacobian, op.coupling,
-                                                             jacobian.reshape(-1, 5)[new_rows], mu)
+    inverse, coupling, schur_inverse = _arithmetic(arithmetic).border(
+        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, jacobian.reshape(-1, 5)[new_rows], mu)
     return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
                            jacobian.reshape(-1, 5)[rows], coupling, schur_inverse)
 
@@ -363,11 +365,11 @@ def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
 
 
 @dataclass(frozen=True)
-class OperatorLoops:
-    """The loops of the reduced operator's arithmetic: this module's numpy functions
-    (:data:`NUMPY_LOOPS`), or the same as compiled loops
-    (:data:`slewing_model.contact_kernel.COMPILED_LOOPS`), which every function above takes as
-    ``loops`` (default numpy)."""
+class OperatorArithmetic:
+    """Who does the reduced operator's arithmetic: this module's numpy functions
+    (:data:`NUMPY_ARITHMETIC`), or the same as compiled loops
+    (:data:`slewing_model.contact_kernel.COMPILED_ARITHMETIC`); the functions above take it as
+    ``arithmetic`` (default numpy)."""
 
     form: object        # operator_matrix
     couple: object      # operator_coupling
@@ -377,8 +379,8 @@ class OperatorLoops:
 
 
 #: this module's numpy functions
-NUMPY_LOOPS = OperatorLoops(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
+NUMPY_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
 
 
-def _loops(loops: OperatorLoops | None) -> OperatorLoops:
-    return NUMPY_LOOPS if loops is None else loops
+def _arithmetic(arithmetic: OperatorArithmetic | None) -> OperatorArithmetic:
+    return NUMPY_ARITHMETIC if arithmetic is None else arithmetic

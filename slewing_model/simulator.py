@@ -75,8 +75,8 @@ class SimulatorSettings:
         :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loops
         where numba is installed, numpy otherwise; the results are the same to round-off.
     contact_kernel : {"auto", "numpy", "compiled"}
-        The same for the load distribution's loops over the contacts (the springs of the
-        flexible model, the Hertz ellipses: ``kernel`` of :class:`slewing_model.bime.BimeSolver`).
+        The same for the load distribution's loops (its per-contact work and the reduced ring
+        operator's: ``kernel`` of :class:`slewing_model.bime.BimeSolver`).
     """
 
     ring_model: str = "flexible"

@@ -110,16 +110,31 @@ def test_compiled_contact_set_equals_the_numpy_one(case):
         assert want.shape == got.shape and np.array_equal(want, got)
     assert results[0][3][sets[False].inactive].tolist() == [0.31] * sets[False].inactive.size
     load = distribution.contact_load
-    loaded = tuple(np.argwhere(load > 0)[0])
-    for change, message in (({"contact_angle": np.where(load > 0, np.nan, distribution.contact_angle)},
-                             "contact_angle: must be finite"),
-                            ({"contact_load": load - 2.0 * (load > 0) * load.max()}, "contact_load: must be >= 0"),
-                            ({"semi_axis_b": np.where(np.arange(load.size).reshape(load.shape) == np.ravel_multi_index(
-                                loaded, load.shape), 0.0, distribution.semi_axis_b)}, "must be > 0 (m) where")):
+    ball, contact = np.argwhere(load > 0)[1]                   # the second loaded contact
+    first = np.arange(load.size).reshape(load.shape) == 4 * ball + contact
+    for change, message in (
+            ({"contact_angle": np.where(first, np.nan, distribution.contact_angle)},
+             f"distribution.contact_angle of ball {ball + 1}, contact {contact + 1} = nan: must be finite"),
+            ({"contact_load": np.where(first, -2.0, load)},
+             f"distribution.contact_load of ball {ball + 1}, contact {contact + 1} = -2.0 N: must be >= 0"),
+            ({"semi_axis_b": np.where(first, 0.0, distribution.semi_axis_b)},
+             f"distribution.semi_axis_a/b of ball {ball + 1}, contact {contact + 1} = ")):
         bad = dataclasses.replace(distribution, **change)
+        messages = []
         for compiled in (False, True):
-            with pytest.raises(ValueError, match=message.replace("(", "\\(").replace(")", "\\)")):
+            with pytest.raises(ValueError) as refused:
                 ContactSet(bearing, bad, 0.1, 0.7, 1e-3, compiled=compiled)
+            messages.append(str(refused.value))
+        assert messages[0] == messages[1] and messages[0].startswith(message), messages
+    # read-only arrays (a memory map, a view) are taken too, and a distribution without load
+    frozen = dataclasses.replace(distribution, **{k: np.broadcast_to(getattr(distribution, k), load.shape)
+                                                  for k in ("contact_load", "contact_angle")})
+    assert np.array_equal(ContactSet(bearing, frozen, 0.1, 0.7, 1e-3, compiled=True).owner, sets[True].owner)
+    idle = dataclasses.replace(distribution, contact_load=np.zeros_like(load))
+    for compiled in (False, True):
+        empty = ContactSet(bearing, idle, 0.1, 0.7, 1e-3, compiled=compiled)
+        assert empty.ball_index.size == empty.active.size == empty.force_scale.size == 0
+        assert empty.inactive.size == bearing.ball_count
 
 
 @needs_numba
