@@ -39,16 +39,21 @@ def _table3_with_measured_radii(table3):
                                                   ball_diameter_deviation=synthetic.ball_diameter_deviation))
 
 
+def _case(which: str, pitch, table3):
+    """The bearing, its superelement and a combined load of the two cases these tests run: the pitch
+    bearing, and table3 whose balls each see other grooves (every ball's and diagonal's stiffness
+    and natural length differ)."""
+    if which == "pitch":
+        return (*pitch, Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6))
+    bearing = _table3_with_measured_radii(table3)
+    superelement = build_superelement(table3, mesh="coarse", bc="free")
+    assert np.unique(BimeSolver(bearing, superelement).assembly.stiffness).size == bearing.ball_count * 2
+    return bearing, superelement, Loads(Fx=2e4, Fz=1e5, Mx=3e4, My=-2e4)
+
+
 @pytest.mark.parametrize("which", ["pitch", "table3 with errors"])
 def test_compiled_trial_points_equal_the_numpy_ones(pitch, table3, which):
-    if which == "pitch":
-        bearing, superelement = pitch
-        loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
-    else:
-        bearing = _table3_with_measured_radii(table3)
-        superelement = build_superelement(table3, mesh="coarse", bc="free")
-        loads = Loads(Fx=2e4, Fz=1e5, Mx=3e4, My=-2e4)
-        assert np.unique(BimeSolver(bearing, superelement).assembly.stiffness).size == bearing.ball_count * 2
+    bearing, superelement, loads = _case(which, pitch, table3)
     solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
     jacobian = solvers["numpy"].jacobian                                  # eq 23, set_rotation
     assert np.abs(solvers["compiled"].jacobian - jacobian).max() <= 1e-15 * np.abs(jacobian).max()
@@ -82,13 +87,7 @@ def test_compiled_contact_results_equal_the_numpy_ones(pitch, table3, which):
     edge loading) and its refusals of loads past the groove edge or the pressure limit, by the
     compiled loop and by numpy, at the same iterate: balls of other diameters and grooves of other
     measured radii too."""
-    if which == "pitch":
-        bearing, superelement = pitch
-        loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
-    else:
-        bearing = _table3_with_measured_radii(table3)
-        superelement = build_superelement(table3, mesh="coarse", bc="free")
-        loads = Loads(Fx=2e4, Fz=1e5, Mx=3e4, My=-2e4)
+    bearing, superelement, loads = _case(which, pitch, table3)
     solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
     state = solvers["numpy"].solve(loads).state
     f_scaled = solvers["numpy"]._scaled_load(loads)
