@@ -171,7 +171,9 @@ _TURN_SIGNATURE = "Tuple((b1, f8[:, :], f8[:, :]))(f8[:, :], f8[:, :], f8[:, :],
 
 def _solve_small(a, b):
     """``a^-1 b`` for a small square ``a`` (m, m) and ``b`` (m, k): Gaussian elimination with
-    partial pivoting (as LAPACK's ``gesv``); and False where ``a`` is singular."""
+    partial pivoting (as LAPACK's ``gesv``); and False where ``a`` is singular. The friction's
+    ``_solve3`` (:mod:`slewing_model.friction_kernel`) is the same elimination for 3 x 3, kept
+    apart: on this general one the balls' minimisation took 17 % longer (measured)."""
     m, k = b.shape
     work = np.empty((m, m + k))
     work[:, :m] = a

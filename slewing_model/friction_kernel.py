@@ -152,7 +152,8 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
 
 def _solve3(a, rhs, out):
     """``out = a^-1 rhs`` for a symmetric (3, 3) ``a``: Gaussian elimination with partial
-    pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same). A
+    pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same; the contacts'
+    general ``_solve_small`` is the same elimination, slower here by its sizes known late). A
     singular ``a`` (not met) is regularised as ``solve_per_ball`` does: ``a + 1e-13 mean(diag) I``;
     still singular, it raises ValueError (numpy's LinAlgError is one)."""
     m = np.empty((3, 4))
