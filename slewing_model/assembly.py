@@ -119,8 +119,8 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     n = bearing.ball_count
     cage = cage_ratio(bearing) * psi if cage_angle is None else cage_angle
     phi = bearing.ball_angles + cage
+    sign = 1.0 if bearing.moving_ring == "inner" else -1.0
     if previous is not None:
-        sign = 1.0 if bearing.moving_ring == "inner" else -1.0
         if previous.ball_diameter.shape != (n,) or previous.moving_sign != sign:
             raise ValueError(f"previous: an assembly of {previous.ball_diameter.shape[0]} balls, moving sign "
                              f"{previous.moving_sign:+g}: not of this bearing ({n} balls, "
@@ -157,21 +157,20 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     return Assembly(
         psi=float(psi), cage_angle=float(cage), ball_angle=phi, groove_centre=centre, groove_radius=radius, ball_diameter=dw,
         contact_stiffness=k, stiffness=k_tot, natural_length=natural,
-        moving_sign=1.0 if bearing.moving_ring == "inner" else -1.0,
+        moving_sign=sign,
     )
 
 
 def _errors_at(error_map, theta: np.ndarray, compiled: bool):
-    """:meth:`slewing_model.errors.RingErrorMap.at`, or the same by a compiled loop."""
+    """:meth:`slewing_model.errors.RingErrorMap.at`, its table interpolated by a compiled loop
+    where ``compiled``."""
     if not compiled:
         return error_map.at(theta)
     from .contact_kernel import periodic_interp
     from .friction_kernel import use_compiled
 
     use_compiled("compiled", "compiled")               # a clear ValueError where numba is not installed
-
-    values = periodic_interp(theta, *error_map.table)
-    return values[:, 0:2], values[:, 2:4], values[:, 4:6] if values.shape[1] > 4 else None
+    return error_map.at(theta, periodic_interp)
 
 
 def rings_have_errors(bearing: Bearing) -> bool:

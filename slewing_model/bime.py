@@ -54,8 +54,7 @@ import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
-from .contact_kernel import compiled_jacobian, compiled_trial_point, contact_results
-from .contact_kernel import COMPILED_ARITHMETIC
+from .contact_kernel import COMPILED_ARITHMETIC, compiled_jacobian, compiled_trial_point, contact_results
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )

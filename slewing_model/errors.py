@@ -56,22 +56,28 @@ class RingErrorMap:
     axial: np.ndarray
     groove_radius: np.ndarray | None = None
 
-    def at(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    def at(self, theta: np.ndarray, interpolate=None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """Periodic linear interpolation at ring angles ``theta`` (rad, shape (B,)).
 
+        ``interpolate(theta, angle, table)``: the columns of :attr:`table` at ``theta`` (B, K);
+        default numpy's ``interp`` of each at ``theta`` modulo ``2 pi``, which a compiled loop
+        may stand for (:func:`slewing_model.contact_kernel.periodic_interp`).
+
         Returns radial (B, 2), axial (B, 2) and groove radius (B, 2) or None."""
-        x = np.asarray(theta, dtype=float) % (2.0 * np.pi)
-        angle, columns = self._periodic_table
-        values = [np.interp(x, angle, column) for column in columns]
-        rc = None if self.groove_radius is None else np.stack(values[4:], axis=1)
-        return np.stack(values[:2], axis=1), np.stack(values[2:4], axis=1), rc
+        angle, table = self.table
+        if interpolate is None:
+            x = np.asarray(theta, dtype=float) % (2.0 * np.pi)
+            values = np.stack([np.interp(x, angle, column) for column in table], axis=1)
+        else:
+            values = interpolate(theta, angle, table)
+        return values[:, 0:2], values[:, 2:4], None if self.groove_radius is None else values[:, 4:6]
 
     @functools.cached_property
-    def _periodic_table(self):
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
         """The table sorted and closed over one period, as ``np.interp(..., period=2 pi)``
-        builds it on every call (the same arithmetic, so the same values): the angles, and
-        the columns radial 1, 2, axial 1, 2 (and groove radius 1, 2). Built once: the run
-        time calls :meth:`at` every step."""
+        builds it on every call (the same arithmetic, so the same values): the angles (N + 2,)
+        and the columns radial 1, 2, axial 1, 2 (and groove radius 1, 2), (4 or 6, N + 2).
+        Built once: the run time calls :meth:`at` every step."""
         period = 2.0 * np.pi
         xp = self.angle % period
         order = np.argsort(xp)
@@ -83,14 +89,6 @@ class RingErrorMap:
             for k in range(2):
                 fp = np.asarray(table[:, k], dtype=float)[order]
                 columns.append(np.concatenate((fp[-1:], fp, fp[0:1])))
-        return angle, columns
-
-    @functools.cached_property
-    def table(self) -> tuple[np.ndarray, np.ndarray]:
-        """The periodic table of :meth:`at` as the angles (N + 2,) and one array of its columns
-        (4 or 6, N + 2): what a compiled loop interpolates
-        (:func:`slewing_model.contact_kernel.periodic_interp`)."""
-        angle, columns = self._periodic_table
         return angle, np.array(columns)
 
     def to_dict(self) -> dict:
