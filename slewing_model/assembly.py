@@ -28,6 +28,8 @@ INNER_OF_DIAGONAL = np.array([c - 1 for _, c in DIAGONALS])   # contacts 3, 2
 #: for each diagonal, the index (0 or 1) of its contact within the ring's own pair
 OUTER_SLOT = np.array([RING_CONTACTS["outer"].index(c) for c, _ in DIAGONALS])  # 0, 1
 INNER_SLOT = np.array([RING_CONTACTS["inner"].index(c) for _, c in DIAGONALS])  # 1, 0
+#: the columns (contacts 1..4, 0-based) of each ring's two contacts
+_RING_COLUMNS = {ring: [c - 1 for c in contacts] for ring, contacts in RING_CONTACTS.items()}
 
 
 def cage_ratio(bearing: Bearing) -> float:
@@ -108,9 +110,9 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
         its own diameter), so only the angles change: the rest is taken from it;
         where no ring has measured groove radii, so are the radii and stiffnesses.
     compiled : bool
-        Interpolate the rings' error tables by a compiled loop
-        (:func:`slewing_model.contact_kernel.periodic_interp`, needs numba): numpy's
-        arithmetic, the same values.
+        Interpolate the rings' error tables and add them to the groove centres by a
+        compiled loop (:func:`slewing_model.contact_kernel.add_groove_errors`, needs
+        numba): numpy's arithmetic, the same values.
 
     Returns
     -------
@@ -139,10 +141,13 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
             if error_map is None:
                 continue
             theta = phi - psi if ring == bearing.moving_ring else phi
-            d_radial, d_axial, rc = _errors_at(error_map, theta, compiled)
-            cols = [c - 1 for c in RING_CONTACTS[ring]]
-            centre[:, cols, 0] += d_radial
-            centre[:, cols, 1] += d_axial
+            cols = _RING_COLUMNS[ring]
+            if compiled:                              # the same additions, one compiled loop
+                rc = _compiled_groove_errors(centre, theta, error_map, cols)
+            else:
+                d_radial, d_axial, rc = error_map.at(theta)
+                centre[:, cols, 0] += d_radial
+                centre[:, cols, 1] += d_axial
             if rc is not None:
                 radius[:, cols] = rc
                 measured_radius = True
@@ -161,16 +166,15 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     )
 
 
-def _errors_at(error_map, theta: np.ndarray, compiled: bool):
-    """:meth:`slewing_model.errors.RingErrorMap.at`, its table interpolated by a compiled loop
-    where ``compiled``."""
-    if not compiled:
-        return error_map.at(theta)
-    from .contact_kernel import periodic_interp
+def _compiled_groove_errors(centre: np.ndarray, theta: np.ndarray, error_map, cols: list) -> np.ndarray | None:
+    """A ring's errors at its angles ``theta`` added to the groove centres of its contacts ``cols``
+    by a compiled loop (:func:`slewing_model.contact_kernel.add_groove_errors`); its measured
+    groove radii, or None."""
+    from .contact_kernel import add_groove_errors
     from .friction_kernel import use_compiled
 
     use_compiled("compiled", "compiled")               # a clear ValueError where numba is not installed
-    return error_map.at(theta, periodic_interp)
+    return add_groove_errors(centre, theta, error_map, cols)
 
 
 def rings_have_errors(bearing: Bearing) -> bool:

@@ -8,7 +8,8 @@ these is some ten to fifty array operations on a few hundred entries, whose call
 their arithmetic, sets the time. The loops here are the same formulas, most in the same order
 of operations, one loop each:
 
-* a new rotation: the rings' error tables (:func:`_periodic_interp`), the Jacobian of eq 23
+* a new rotation: the rings' error tables interpolated and added to the grooves
+  (:func:`_add_groove_errors`), the Jacobian of eq 23
   (:func:`_jacobian`);
 * an iteration: the trial point, its springs (eqs 1, 7, 8) and stop-rule terms
   (:func:`_trial_point`), the modified Newton step (:func:`_newton_step`);
@@ -493,9 +494,6 @@ def _contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, p
     return contact_load, contact_angle, deflection, semi_a, semi_b, pressure, truncated, off
 
 
-_PERIODIC_SIGNATURE = "f8[:, :](f8[:], f8[:], f8[:, :])"
-
-
 def _periodic_interp(theta, angle, table):
     """The columns of ``table`` (K, N) at the angles ``theta`` (B,) taken modulo ``2 pi``:
     ``np.interp(theta % (2 pi), angle, column)`` of each column, in numpy's arithmetic
@@ -513,11 +511,29 @@ def _periodic_interp(theta, angle, table):
     return out
 
 
+_GROOVE_ERRORS_SIGNATURE = "f8[:, :](f8[:, :, :], f8[:], f8[:], f8[:, :], i8, i8)"
+
+
+def _add_groove_errors(centre, theta, angle, table, contact_a, contact_b):
+    """One ring's groove-centre deviations at its angles ``theta`` (B,) added to the groove centres
+    ``centre`` (B, 4, 2) of its contacts ``contact_a``, ``contact_b`` (0-based), in place: the
+    radial and axial columns of its periodic table (:attr:`slewing_model.errors.RingErrorMap.table`)
+    interpolated by :func:`_periodic_interp`, as :func:`slewing_model.assembly.assemble` adds
+    them with numpy. Returns the interpolated columns (B, K) (a measured groove's radii last)."""
+    values = _periodic_interp(theta, angle, table)
+    for b in range(theta.size):
+        centre[b, contact_a, 0] += values[b, 0]
+        centre[b, contact_b, 0] += values[b, 1]
+        centre[b, contact_a, 1] += values[b, 2]
+        centre[b, contact_b, 1] += values[b, 3]
+    return values
+
+
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
     return compile_loop(function, signature, ("_segment", "_interp", "_solve_small", "_hertz_contact",
-                                              "_symmetric_times"), error_model="numpy")
+                                              "_symmetric_times", "_periodic_interp"), error_model="numpy")
 
 
 #: (factory, Python function) of each compiled loop of the load distribution
@@ -530,7 +546,7 @@ compiled_bordered_inverse = loop_factory(KERNELS, _compile, _bordered_inverse, _
 compiled_operator_matrix = loop_factory(KERNELS, _compile, _operator_matrix, _MATRIX_SIGNATURE)
 compiled_operator_coupling = loop_factory(KERNELS, _compile, _operator_coupling, _COUPLING_SIGNATURE)
 compiled_contact_results = loop_factory(KERNELS, _compile, _contact_results, _RESULTS_SIGNATURE)
-compiled_periodic_interp = loop_factory(KERNELS, _compile, _periodic_interp, _PERIODIC_SIGNATURE)
+compiled_add_groove_errors = loop_factory(KERNELS, _compile, _add_groove_errors, _GROOVE_ERRORS_SIGNATURE)
 
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------
@@ -576,9 +592,14 @@ def operator_coupling(inverse, ja, mu):
     return coupling, schur_inverse
 
 
-def periodic_interp(theta, angle, table):
-    """:func:`_periodic_interp` by the compiled loop."""
-    return compiled_periodic_interp()(np.ascontiguousarray(theta, dtype=float), angle, table)
+def add_groove_errors(centre, theta, error_map, contacts):
+    """:func:`_add_groove_errors` by the compiled loop, for a ring's ``error_map``
+    (:class:`slewing_model.errors.RingErrorMap`) and its two ``contacts`` (0-based): in place on
+    ``centre``; returns the measured groove radii (B, 2), or None."""
+    angle, table = error_map.table
+    values = compiled_add_groove_errors()(centre, np.ascontiguousarray(theta, dtype=float), angle, table,
+                                          contacts[0], contacts[1])
+    return None if error_map.groove_radius is None else values[:, 4:6]
 
 
 def contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner, youngs_modulus,

@@ -56,20 +56,15 @@ class RingErrorMap:
     axial: np.ndarray
     groove_radius: np.ndarray | None = None
 
-    def at(self, theta: np.ndarray, interpolate=None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        """Periodic linear interpolation at ring angles ``theta`` (rad, shape (B,)).
-
-        ``interpolate(theta, angle, table)``: the columns of :attr:`table` at ``theta`` (B, K);
-        default numpy's ``interp`` of each at ``theta`` modulo ``2 pi``, which a compiled loop
-        may stand for (:func:`slewing_model.contact_kernel.periodic_interp`).
+    def at(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Periodic linear interpolation at ring angles ``theta`` (rad, shape (B,)): numpy's
+        ``interp`` of each column of :attr:`table` at ``theta`` modulo ``2 pi`` (a compiled loop
+        does the same, :func:`slewing_model.contact_kernel.add_groove_errors`).
 
         Returns radial (B, 2), axial (B, 2) and groove radius (B, 2) or None."""
         angle, table = self.table
-        if interpolate is None:
-            x = np.asarray(theta, dtype=float) % (2.0 * np.pi)
-            values = np.stack([np.interp(x, angle, column) for column in table], axis=1)
-        else:
-            values = interpolate(theta, angle, table)
+        x = np.asarray(theta, dtype=float) % (2.0 * np.pi)
+        values = np.stack([np.interp(x, angle, column) for column in table], axis=1)
         return values[:, 0:2], values[:, 2:4], None if self.groove_radius is None else values[:, 4:6]
 
     @functools.cached_property

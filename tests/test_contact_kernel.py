@@ -202,18 +202,23 @@ def test_compiled_column_turn_equals_the_numpy_turn(pitch, table3):
 
 def test_compiled_error_tables_equal_numpy_interp(table3):
     """The grooves under the balls at a new rotation, from the rings' error tables interpolated by
-    the compiled loop: numpy's values bit for bit, with measured groove radii and without, at
-    angles past a turn and negative."""
+    the compiled loop and added to the nominal grooves: numpy's values bit for bit, with measured
+    groove radii and without, at angles past a turn and negative, assembled anew and from the last
+    rotation (as a co-simulation step does)."""
     from slewing_model import synthetic_errors
     from slewing_model.assembly import assemble
 
     for bearing in (table3.with_errors(synthetic_errors(table3.ball_count, seed=3)),
                     _table3_with_measured_radii(table3)):
+        last = assemble(bearing, 0.2)
         for psi in (0.0, 0.37, -2.5, 7.1):
-            want, got = assemble(bearing, psi), assemble(bearing, psi, compiled=True)
-            assert np.array_equal(got.groove_centre, want.groove_centre)
-            assert np.array_equal(got.groove_radius, want.groove_radius)
-            assert np.array_equal(got.stiffness, want.stiffness)
+            for previous in (None, last):
+                want = assemble(bearing, psi, previous=previous)
+                got = assemble(bearing, psi, previous=previous, compiled=True)
+                assert np.array_equal(got.groove_centre, want.groove_centre)
+                assert np.array_equal(got.groove_radius, want.groove_radius)
+                assert np.array_equal(got.stiffness, want.stiffness)
+                assert not np.array_equal(want.groove_centre, last.groove_centre)    # other grooves under the balls
 
 
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
