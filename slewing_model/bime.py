@@ -167,6 +167,7 @@ class BimeSolver:
         if previous is None or a.groove_centre is not previous.groove_centre:   # other grooves under the balls
             self._moving_centre = a.moving_centre
             self._separation = a.separation                    # e before loading, (B, 2, 2)
+        if previous is None or a.stiffness is not previous.stiffness:           # other springs
             k_mean = float(a.stiffness.mean())
             self.reference_stiffness = a.stiffness.size * k_mean * math.sqrt(1e-4 * self.bearing.ball_diameter)
         if self._compiled:                     # the same formulas, one compiled loop (contact_kernel)
