@@ -54,7 +54,9 @@ import numpy as np
 
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
-from .contact_kernel import COMPILED_ARITHMETIC, compiled_jacobian, compiled_trial_point, contact_results
+from .contact_kernel import (
+    COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_trial_point, contact_results,
+)
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
@@ -64,7 +66,7 @@ from .reduced_operator import (
     NUMPY_ARITHMETIC, PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator,
     start_operator, turned_operator, update_operator,
 )
-from .ring_compliance import contact_compliance, ring_compliances, ring_selector  # noqa: F401
+from .ring_compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
 #: residual by less than this factor (0.25 until a new operator was spread over two steps;
@@ -135,6 +137,8 @@ class BimeSolver:
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
         self.ring_compliance = None if superelement is None else ring_compliances(superelement)
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
+        # M's product in the compiled iterations (contact_kernel._kept_iterations)
+        self._product_operands = product_operands(self.compliance) if self._compiled and superelement is not None else None
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._loaded_from = 1e-15 * bearing.ball_diameter     # a spring stretched more than this is loaded
@@ -336,6 +340,19 @@ class BimeSolver:
                 raise NoEquilibriumError(
                     f"no convergence after {iterations} Newton iterations (relative residual {residual:.2e}) "
                     f"for loads {loads}")
+            if self._product_operands is not None and last_residual is not None:
+                if self._reduced is not None and self._reduced_jacobian is not self._jacobian_rows:
+                    # the ring turned since (set_rotation): the coupling follows, as in _flexible_direction
+                    self._reduced = turned_operator(self._reduced, self.jacobian, mu, may_turn=self._rigid_turn,
+                                                    arithmetic=self._arithmetic)
+                    self._reduced_jacobian = self._jacobian_rows
+            if self._product_operands is not None and last_residual is not None and self._kept_operator_serves():
+                # the iterations that keep the operator, in one compiled loop, as far as they go
+                done, point, last_residual = self._kept_iterations(point, f_scaled, load_scale, trust, last_residual,
+                                                                   iterations)
+                if done:
+                    iterations += done
+                    continue
             iterations += 1
 
             if flexible:
@@ -378,6 +395,34 @@ class BimeSolver:
                     f"no contact resists this load")
 
         return self._result(loads, point, iterations, residual)
+
+    def _kept_operator_serves(self) -> bool:
+        """Whether the next iteration may keep the reduced operator as it is, all else equal: its
+        coupling is that of this Jacobian and no stage of a pending one is due (``_flexible_direction``)."""
+        return (self._reduced is not None and self._reduced_jacobian is self._jacobian_rows
+                and not (self.pending_operator is not None and self._stage_due))
+
+    def _kept_iterations(self, p: "_Point", f_scaled: np.ndarray, load_scale: float, trust: float,
+                         last_residual: float, iterations: int):
+        """The iterations with the kept operator from ``p`` in one compiled loop
+        (:func:`slewing_model.contact_kernel._kept_iterations`: the steps of :meth:`solve`, up
+        to the first that needs more than the operator's product): the iterations done, the point
+        reached and the last residual."""
+        a, op = self.assembly, self._reduced
+        dw = self.bearing.ball_diameter
+        rules = np.array([self.rtol, load_scale, trust, dw * dw, REFRESH, FINISH_ITERATIONS, last_residual])
+        terms = np.array([p.total, p.energy_scale, p.peak_force, p.peak_residual, float(p.any_loaded)])
+        (done, last_residual, qs, y, my, e, delta, q, force, n, length, gradient, mismatch, loaded,
+         terms) = compiled_kept_iterations()(
+            self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
+            np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
+            op.schur_inverse, op.active, *self._product_operands, p.qs, p.y, p.ring_motion, p.e, p.delta, p.q,
+            p.force, p.n, p.length, p.gradient, p.mismatch, p.loaded, terms, rules, iterations, self.max_iterations)
+        if not done:
+            return 0, p, last_residual
+        total, energy_scale, peak_force, peak_residual, n_loaded = terms
+        return done, _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch,
+                            peak_force, peak_residual, loaded, n_loaded > 0, my), last_residual
 
     def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray, my: np.ndarray | None = None,
                   direction: tuple | None = None, t: float = 0.0) -> "_Point":

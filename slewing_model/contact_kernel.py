@@ -12,7 +12,10 @@ of operations, one loop each:
   (:func:`_add_groove_errors`), the Jacobian of eq 23
   (:func:`_jacobian`);
 * an iteration: the trial point, its springs (eqs 1, 7, 8) and stop-rule terms
-  (:func:`_trial_point`), the modified Newton step (:func:`_newton_step`);
+  (:func:`_trial_point`), the modified Newton step (:func:`_newton_step`); and the iterations
+  that keep the reduced operator as they are, one after the other in one loop
+  (:func:`_kept_iterations`, with the ring compliance's product :func:`_ring_times`: numba has
+  no FFT, so by a real DFT with tables);
 * the operator (:data:`COMPILED_ARITHMETIC`, numpy's :data:`slewing_model.reduced_operator.NUMPY_ARITHMETIC`):
   formed (:func:`_operator_matrix`), coupled to the ring's motions (:func:`_operator_coupling`),
   turned with the ring (:func:`_column_turn`), bordered by contacts that close
@@ -529,11 +532,155 @@ def _add_groove_errors(centre, theta, angle, table, contact_a, contact_b):
     return values
 
 
+_RING_TIMES_SIGNATURE = "f8[::1](b1, f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[::1])"
+
+
+def _ring_times(by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag,
+                v):
+    """The ring compliance's product ``M v`` (:class:`slewing_model.ring_compliance.BlockCirculant`,
+    blocks of ``m``): with its dense matrix (``by_harmonics`` False; ``M`` symmetric, summed column
+    by column as :func:`_symmetric_times`), or through its harmonics as numpy's FFT product does,
+    ``R_j = conj(C^_j) V_j``: the real DFT ``V_j = sum_b v_b exp(-2 pi i j b / B)`` and its
+    inverse by the tables ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` (and their transposes), the
+    harmonics ``conj(C^_j)`` (K, m, m) by their real and imaginary parts. Differs from the FFT by
+    round-off (the sums run in another order)."""
+    if not by_harmonics:
+        return _symmetric_times(dense, v.reshape(1, v.size))[0]
+    n_harmonics, n_balls = cos_table.shape
+    m = harmonic_real.shape[1]
+    v_real = np.zeros((m, n_harmonics))
+    v_imag = np.zeros((m, n_harmonics))
+    for b in range(n_balls):                       # V_j, each ball's block added to every harmonic
+        for a in range(m):
+            value = v[b * m + a]
+            if value == 0.0:                       # (the rows off the reduced operator's)
+                continue
+            for j in range(n_harmonics):
+                v_real[a, j] += cos_by_ball[b, j] * value
+                v_imag[a, j] -= sin_by_ball[b, j] * value
+    p_real = np.empty((m, n_harmonics))
+    p_imag = np.empty((m, n_harmonics))
+    for j in range(n_harmonics):                   # R_j; the inverse's weights (numpy's irfft: the
+        weight = 1.0 if j == 0 or 2 * j == n_balls else 2.0      # imaginary part of j = 0 and B/2 drops)
+        weight /= n_balls
+        for a in range(m):
+            real = imag = 0.0
+            for c in range(m):
+                real += harmonic_real[j, a, c] * v_real[c, j] - harmonic_imag[j, a, c] * v_imag[c, j]
+                imag += harmonic_real[j, a, c] * v_imag[c, j] + harmonic_imag[j, a, c] * v_real[c, j]
+            p_real[a, j] = weight * real
+            p_imag[a, j] = weight * imag
+    out_t = np.zeros((m, n_balls))
+    for a in range(m):                             # the inverse DFT, each harmonic added to every ball
+        for j in range(n_harmonics):
+            real, imag = p_real[a, j], p_imag[a, j]
+            for b in range(n_balls):
+                out_t[a, b] += real * cos_table[j, b] - imag * sin_table[j, b]
+    out = np.empty(v.size)
+    for b in range(n_balls):
+        for a in range(m):
+            out[b * m + a] = out_t[a, b]
+    return out
+
+
+_KEPT_SIGNATURE = (
+    "Tuple((i8, f8, f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
+    "f8[:, ::1], f8[::1], f8[::1], b1[::1], f8[::1]))("
+    "f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
+    "f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
+    "b1, f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
+    "f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], "
+    "f8[::1], f8[::1], b1[::1], f8[:], f8[:], i8, i8)")
+
+
+def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_scaled, loaded_from,
+                     inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse, op_active,
+                     by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag,
+                     qs, y, ring_motion, e, delta, q, force, n, length, gradient, mismatch, loaded, terms, rules,
+                     iterations, max_iterations):
+    """The flexible solver's iterations with a kept reduced operator, as ``BimeSolver.solve``
+    (:mod:`slewing_model.bime`) runs them, one after the other in one loop, for as long as nothing
+    but the operator's product is asked: each the modified Newton step (:func:`_newton_step`), the
+    ring compliance's product with its ``dy`` (:func:`_ring_times`), the step limited to the trust
+    length and the backtracking line search on the total energy (:func:`_trial_point`).
+
+    The loop stops before an iteration that the solver must run itself: the stop rule met (or its
+    residual not finite), ``max_iterations`` reached, a new operator asked for by the refresh rule,
+    a diagonal loaded outside the operator's ``op_active`` (it borders them in), none loaded, a
+    line search that fails or a moving ring beyond the ball diameter (it raises).
+
+    ``qs`` ... ``loaded`` are the last point's (``BimeSolver``'s ``_Point``), ``terms`` its total
+    energy, energy scale, largest force, largest residual and loaded diagonals; ``rules`` the stop
+    rule's tolerance, the load scale, the trust length, the squared ball diameter, the refresh
+    threshold, the finish iterations and the last iteration's residual. Returns the iterations
+    done here, the last residual and the point reached, in the order given (the one given when
+    none was done)."""
+    rtol, load_scale, trust, dw2, refresh, finish = rules[0], rules[1], rules[2], rules[3], rules[4], rules[5]
+    last_residual = rules[6]
+    total, energy_scale, peak_force, peak_residual, n_loaded = terms[0], terms[1], terms[2], terms[3], terms[4]
+    done = 0
+    while True:
+        scale = max(load_scale, peak_force, 1e-300)
+        residual = peak_residual / scale
+        if not math.isfinite(residual) or residual <= rtol or scale == 1e-300 or iterations >= max_iterations:
+            break
+        fresh = residual > refresh * last_residual
+        if fresh and residual < last_residual:
+            fresh = math.log(rtol / residual) < finish * math.log(residual / last_residual)
+        if fresh or n_loaded == 0:
+            break
+        closed = False
+        for i in range(loaded.size):
+            if loaded[i] and not op_active[i]:
+                closed = True
+                break
+        if closed:
+            break
+        dq, y_new = _newton_step(inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse,
+                                 force.reshape(-1), ring_motion, f_scaled, y.size)
+        dy = y_new - y
+        m_dy = _ring_times(by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real,
+                           harmonic_imag, dy)
+        slope = 0.0
+        for k in range(5):
+            slope += gradient[k] * dq[k]
+        for i in range(dy.size):
+            slope -= mismatch[i] * m_dy[i]
+        norm = math.sqrt(dq[0] ** 2 + dq[1] ** 2 + dq[2] ** 2 + dq[3] ** 2 + dq[4] ** 2)
+        if norm > trust:
+            shrink = trust / norm
+            dq, dy, m_dy, slope = dq * shrink, dy * shrink, m_dy * shrink, slope * shrink
+        t = 1.0
+        accepted = False
+        for _ in range(60):
+            (qs_t, y_t, motion_t, e_t, delta_t, q_t, force_t, n_t, length_t, gradient_t, mismatch_t, loaded_t,
+             trial_terms) = _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, m_dy, t,
+                                         natural_length, stiffness, f_scaled, loaded_from)
+            total_t = trial_terms[0] + trial_terms[1] - trial_terms[2]
+            scale_t = trial_terms[0] + trial_terms[1] + abs(trial_terms[2])
+            if total_t <= total + 1e-4 * t * min(slope, 0.0) + 1e-12 * max(energy_scale, scale_t):
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted or qs_t[0] ** 2 + qs_t[1] ** 2 + qs_t[2] ** 2 + qs_t[3] ** 2 + qs_t[4] ** 2 > dw2:
+            break
+        qs, y, ring_motion, e, delta, q, force, n, length = qs_t, y_t, motion_t, e_t, delta_t, q_t, force_t, n_t, length_t
+        gradient, mismatch, loaded = gradient_t, mismatch_t, loaded_t
+        total, energy_scale = total_t, scale_t
+        peak_force, peak_residual, n_loaded = trial_terms[3], trial_terms[4], trial_terms[5]
+        iterations += 1
+        last_residual = residual
+        done += 1
+    return (done, last_residual, qs, y, ring_motion, e, delta, q, force, n, length, gradient, mismatch, loaded,
+            np.array([total, energy_scale, peak_force, peak_residual, n_loaded]))
+
+
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
     return compile_loop(function, signature, ("_segment", "_interp", "_solve_small", "_hertz_contact",
-                                              "_symmetric_times", "_periodic_interp"), error_model="numpy")
+                                              "_symmetric_times", "_periodic_interp", "_trial_point",
+                                              "_newton_step", "_ring_times"), error_model="numpy")
 
 
 #: (factory, Python function) of each compiled loop of the load distribution
@@ -547,6 +694,8 @@ compiled_operator_matrix = loop_factory(KERNELS, _compile, _operator_matrix, _MA
 compiled_operator_coupling = loop_factory(KERNELS, _compile, _operator_coupling, _COUPLING_SIGNATURE)
 compiled_contact_results = loop_factory(KERNELS, _compile, _contact_results, _RESULTS_SIGNATURE)
 compiled_add_groove_errors = loop_factory(KERNELS, _compile, _add_groove_errors, _GROOVE_ERRORS_SIGNATURE)
+compiled_ring_times = loop_factory(KERNELS, _compile, _ring_times, _RING_TIMES_SIGNATURE)
+compiled_kept_iterations = loop_factory(KERNELS, _compile, _kept_iterations, _KEPT_SIGNATURE)
 
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------

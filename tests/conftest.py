@@ -1,6 +1,7 @@
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -57,3 +58,13 @@ def simulators_per_kernel(name: str, steps: int, setting: str):
     frame = "rotating" if case.parameters["load_frame"] == 2 else "fixed"
     return case, {k: BearingSimulator(bearing, superelement, SimulatorSettings(
         ring_model="flexible", load_frame=frame, **{setting: k})) for k in ("numpy", "compiled")}
+
+
+def symmetric_block_circulant(balls: int, seed: int = 0) -> np.ndarray:
+    """A random symmetric block-circulant matrix (4 balls x 4 balls) as the rings' compliance is:
+    block (b, c) = C_(c-b mod B), C_(-k) = C_k^T."""
+    rng = np.random.default_rng(seed)
+    blocks = rng.standard_normal((balls, 4, 4))
+    blocks = 0.5 * (blocks + blocks[(-np.arange(balls)) % balls].transpose(0, 2, 1))
+    k = (np.arange(balls)[None, :] - np.arange(balls)[:, None]) % balls
+    return blocks[k].transpose(0, 2, 1, 3).reshape(4 * balls, 4 * balls)

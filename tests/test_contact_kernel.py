@@ -1,11 +1,14 @@
 """The load distribution's compiled loops (:mod:`slewing_model.contact_kernel`) against its numpy code.
 
 Each compiled loop (a new rotation's grooves and Jacobian, a trial point and its springs, the
-modified Newton step, the reduced operator formed, coupled, turned and bordered, a result's
-contacts and refusals) against the numpy code it stands for, at a solver's iterates and off them:
-equal to round-off, most bit for bit; and a co-simulation stepped with either gives the same
-outputs to the solver's tolerance.
+modified Newton step, the ring compliance's product, the reduced operator formed, coupled, turned
+and bordered, a result's contacts and refusals) against the numpy code it stands for, at a
+solver's iterates and off them: equal to round-off, most bit for bit; and a co-simulation stepped
+with either (with the compiled loops, most iterations in one loop) takes the same iterations to
+the same outputs, to round-off.
 """
+import math
+
 import numpy as np
 import pytest
 
@@ -14,7 +17,7 @@ from slewing_model.distribution import LoadCapacityError
 from slewing_model.friction_kernel import AVAILABLE
 from slewing_model.superelement import build_superelement
 
-from conftest import BEARINGS, simulators_per_kernel
+from conftest import BEARINGS, simulators_per_kernel, symmetric_block_circulant
 
 pytestmark = pytest.mark.skipif(not AVAILABLE, reason="numba is not installed: only the numpy path exists here")
 
@@ -221,14 +224,49 @@ def test_compiled_error_tables_equal_numpy_interp(table3):
                 assert not np.array_equal(want.groove_centre, last.groove_centre)    # other grooves under the balls
 
 
+@pytest.mark.parametrize("balls", [67, 150, 151, 180])
+def test_compiled_ring_product_equals_the_dense_product(balls):
+    """The ring compliance's product in the compiled iterations (``contact_kernel._ring_times``):
+    column sums of the dense matrix below FFT_FROM_BALLS balls, a real DFT by tables above (an
+    even and an odd number of balls: the harmonic B/2 is real or absent), against the dense
+    product, also for a vector with the zero rows of those off the reduced operator."""
+    from slewing_model.contact_kernel import compiled_ring_times
+    from slewing_model.ring_compliance import BlockCirculant, product_operands
+
+    dense = symmetric_block_circulant(balls, seed=balls)
+    operands = product_operands(BlockCirculant(dense, 4))
+    rng = np.random.default_rng(balls + 1)
+    for y in (rng.standard_normal(4 * balls), np.where(rng.random(4 * balls) < 0.4, 0.0, 1.0)):
+        expected = np.array([math.fsum(dense[r] * y) for r in range(4 * balls)])
+        got = compiled_ring_times()(*operands, y)
+        assert np.abs(got - expected).max() <= 1e-13 * np.abs(expected).max()
+
+
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
-def test_steps_with_compiled_contacts_equal_the_numpy_steps(name):
+def test_steps_with_compiled_contacts_equal_the_numpy_steps(name, monkeypatch):
+    """Whole steps with the compiled loops (most iterations in one loop with the kept operator,
+    ``contact_kernel._kept_iterations``) against the numpy path: the same iterations, loads and
+    torques to round-off."""
+    from slewing_model.bime import BimeSolver
+
+    kept = []
+    run_kept = BimeSolver._kept_iterations
+
+    def counted(self, *args):
+        done, point, last = run_kept(self, *args)
+        kept.append(done)
+        return done, point, last
+
+    monkeypatch.setattr(BimeSolver, "_kept_iterations", counted)
     case, sims = simulators_per_kernel(name, 25, "contact_kernel")
-    worst = 0.0
+    worst, total = 0.0, 0
     for k in range(case.steps):
         out = {kernel: sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for kernel, sim in sims.items()}
         ref, got = out["numpy"].distribution, out["compiled"].distribution
+        assert got.iterations == ref.iterations
+        total += ref.iterations
         worst = max(worst, np.abs(got.contact_load - ref.contact_load).max() / ref.max_ball_load,
                     abs(out["compiled"].friction_torque - out["numpy"].friction_torque) / abs(out["numpy"].friction_torque))
     assert worst <= 1e-9, worst
+    assert sum(kept) >= total // 2, (sum(kept), total)     # most iterations ran in the compiled loop
 

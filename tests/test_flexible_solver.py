@@ -7,6 +7,7 @@ import pytest
 
 from slewing_model import BimeSolver, Loads, solve
 from slewing_model.bime import solve_dense_newton
+from conftest import symmetric_block_circulant
 from synthetic_rings import synthetic_superelement
 
 LOADS = [Loads(), Loads(Fx=2e4, Fz=5e4, My=1e4), Loads(Fy=-3e4, Mx=-2e4, My=1.5e4)]
@@ -152,15 +153,11 @@ def test_block_circulant_product_by_harmonics_equals_the_dense_product(balls):
     (b, c) = C_(c-b mod B), C_(-k) = C_k^T."""
     from slewing_model.ring_compliance import FFT_FROM_BALLS, BlockCirculant
 
-    rng = np.random.default_rng(balls)
-    blocks = rng.standard_normal((balls, 4, 4))
-    blocks = 0.5 * (blocks + blocks[(-np.arange(balls)) % balls].transpose(0, 2, 1))
-    k = (np.arange(balls)[None, :] - np.arange(balls)[:, None]) % balls
-    dense = blocks[k].transpose(0, 2, 1, 3).reshape(4 * balls, 4 * balls)
+    dense = symmetric_block_circulant(balls, seed=balls)
     assert np.array_equal(dense, dense.T)
     matrix = BlockCirculant(dense, 4)
     assert matrix.by_harmonics == (balls >= FFT_FROM_BALLS)
-    y = rng.standard_normal(4 * balls)
+    y = np.random.default_rng(balls + 1).standard_normal(4 * balls)
     expected = np.array([sum(dense[r, c] * y[c] for c in range(4 * balls)) for r in range(4 * balls)])
     assert np.abs(matrix @ y - expected).max() <= 1e-13 * np.abs(expected).max()
     assert np.array_equal(matrix[np.ix_([0, 5], [3, 7])], dense[np.ix_([0, 5], [3, 7])])
