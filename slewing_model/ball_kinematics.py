@@ -24,10 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contact_friction import conformity_radius
-from .ellipse_quadrature import EllipseQuadrature
+from .ellipse_quadrature import EllipseQuadrature, ellipse_quadrature
 from .friction_kernel import (
-    NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
-    compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
+    GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
+    compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
 )
 from .geometry import RING_CONTACTS, Bearing
 
@@ -110,26 +110,39 @@ def _first(mask: np.ndarray) -> int:
     return int(np.flatnonzero(mask)[0])
 
 
+def distribution_arrays(bearing: Bearing, distribution, writable: bool = False) -> dict:
+    """The contact loads, angles and semi-axes (B, 4) of a load distribution for this bearing (a
+    ValueError naming a field of another shape); ``writable`` copies where read-only (the compiled
+    loops take writable arrays)."""
+    n_balls = bearing.ball_count
+    arrays = {}
+    for name in _DISTRIBUTION_FIELDS:
+        value = np.asarray(getattr(distribution, name), dtype=float)
+        if writable and not value.flags.writeable:
+            value = value.copy()
+        if value.shape != (n_balls, 4):
+            raise ValueError(f"distribution.{name} has shape {value.shape}, expected ({n_balls}, 4) "
+                             f"for this bearing ({bearing.name})")
+        arrays[name] = value
+    return arrays
+
+
+def ball_radii(bearing: Bearing) -> np.ndarray:
+    """Radius of every ball (B,), m: the diameter with the preload and each ball's deviation."""
+    dw = np.full(bearing.ball_count, bearing.ball_diameter + bearing.preload)
+    if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
+        dw = dw + bearing.errors.ball_diameter_deviation
+    return 0.5 * dw
+
+
 class ContactSet:
     """The loaded contacts of a load distribution, and what does not depend on
     the quadrature rule: ball of each contact, normal, ellipse, ring speed."""
 
     def __init__(self, bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float,
                  compiled: bool = False):
-        n_balls = bearing.ball_count
-        arrays = {}
-        for name in _DISTRIBUTION_FIELDS:
-            value = np.asarray(getattr(distribution, name), dtype=float)
-            if compiled and not value.flags.writeable:       # the compiled loop takes writable arrays
-                value = value.copy()
-            if value.shape != (n_balls, 4):
-                raise ValueError(f"distribution.{name} has shape {value.shape}, expected ({n_balls}, 4) "
-                                 f"for this bearing ({bearing.name})")
-            arrays[name] = value
-        dw = np.full(n_balls, bearing.ball_diameter + bearing.preload)
-        if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
-            dw = dw + bearing.errors.ball_diameter_deviation
-        self.ball_radius = 0.5 * dw
+        arrays = distribution_arrays(bearing, distribution, writable=compiled)
+        self.ball_radius = ball_radii(bearing)
         self.pitch_radius = 0.5 * bearing.pitch_diameter
         self.length_scale = 0.5 * bearing.ball_diameter
         self.speed = speed
@@ -165,7 +178,7 @@ class ContactSet:
         active_mask = loaded.any(axis=1)
         self.active = active = np.flatnonzero(active_mask)
         self.inactive = np.flatnonzero(~active_mask)
-        position = np.full(n_balls, -1)
+        position = np.full(bearing.ball_count, -1)
         position[active] = np.arange(active.size)
         self.owner = position[self.ball_index]                # active-ball row of every contact
         b_i, c_i = self.ball_index, self.contact_index
@@ -673,6 +686,43 @@ def ball_results(geometry: ContactSet, u: np.ndarray, contact_power: np.ndarray,
     orbital[geo.inactive] = cage_speed          # unloaded balls: nominal rolling, for the record
     return (power, per_ball, omega_ball, orbital, state, spin_roll_ratio(geo, u, n_balls),
             np.count_nonzero(geo.loaded, axis=1))
+
+
+def _rule_arrays(quad: EllipseQuadrature) -> tuple:
+    """A rule's across nodes, folded ``t^2`` and folded weights as writable arrays (the compiled
+    loop takes no read-only ones), made once for each of the library's rules."""
+    if quad is ellipse_quadrature(quad.n_across, quad.n_along):
+        return _library_rule_arrays(quad.n_across, quad.n_along)
+    return (np.array(quad.across_nodes, dtype=float), np.array(quad.along_squared, dtype=float),
+            np.array(quad.folded_weight, dtype=float))
+
+
+@functools.lru_cache(maxsize=8)
+def _library_rule_arrays(n_across: int, n_along: int) -> tuple:
+    quad = ellipse_quadrature(n_across, n_along)
+    return (np.array(quad.across_nodes, dtype=float), np.array(quad.along_squared, dtype=float),
+            np.array(quad.folded_weight, dtype=float))
+
+
+def warm_friction_step(bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float,
+                       quad: EllipseQuadrature, solve_quad: EllipseQuadrature, warm: np.ndarray, tol: float,
+                       max_iterations: int, cage_speed: float):
+    """A warm-started friction torque's loops in one compiled call
+    (:func:`slewing_model.friction_kernel.compiled_friction_step`): the same loops, with the same
+    arguments, as the steps of :func:`slewing_model.friction.friction_torque` (the same numbers
+    bit for bit). ``warm``: the last state (B, 4). None where the general path must run (a
+    distribution to refuse, no loaded contact, a ball without a warm start); else the
+    iterations, largest residual, whether converged, the contacts' powers and torques (C,) and
+    :func:`ball_results`'s arrays."""
+    arrays = distribution_arrays(bearing, distribution, writable=True)
+    same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
+    out = compiled_friction_step()(
+        arrays["contact_load"], arrays["contact_angle"], arrays["semi_axis_a"], arrays["semi_axis_b"],
+        ball_radii(bearing), np.asarray(bearing.groove_radius, dtype=float), _IS_MOVING[bearing.moving_ring],
+        _NORMAL_SIGN_R, _NORMAL_SIGN_Z, mu, speed, sliding_regularisation, 0.5 * bearing.ball_diameter,
+        0.5 * bearing.pitch_diameter, *_rule_arrays(quad), *_rule_arrays(solve_quad), same,
+        np.array(warm, dtype=float), tol, max_iterations, _THETA_DOWN, _THETA_UP, _THETA_MIN_UP, cage_speed)
+    return None if out[0] == GENERAL_PATH else out[1:]
 
 
 def spin_roll_ratio(geometry: ContactSet, u: np.ndarray, n_balls: int) -> np.ndarray:

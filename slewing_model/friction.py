@@ -54,7 +54,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .assembly import cage_ratio
-from .ball_kinematics import SOLVED, ContactPoints, ContactSet, ball_results, cold_start, minimise_power
+from .ball_kinematics import (
+    SOLVED, ContactPoints, ContactSet, ball_results, cold_start, minimise_power, warm_friction_step,
+)
 from .catalogue import CATALOGUE_MU, catalogue_torque  # noqa: F401  (part of this module's interface)
 from .contact_friction import (  # noqa: F401
     DEFAULT_MU, DEFAULT_SLIDING_REGULARISATION, EllipseFriction, check_number, conformity_radius, ellipse_friction,
@@ -310,35 +312,44 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     solve_quad = quad if solve_quadrature is None else as_quadrature(solve_quadrature)
     seal = seal_torque_of(bearing, seal_torque, seal_torque_per_length, seal_length)
     speed = omega if omega != 0.0 else 1.0
-    geometry = ContactSet(bearing, distribution, mu, speed, sliding_regularisation, compiled=compiled)
     n_balls = bearing.ball_count
-    ls, big_r = geometry.length_scale, geometry.pitch_radius
-    scale_u = np.array([ls, ls, big_r])                # solved: r w_r, r w_z, R w_c (w_t = 0)
-    active = geometry.active
-
-    iterations, residual, converged = 0, 0.0, True
-    u = np.zeros((active.size, 3))
-    if active.size and mu > 0.0:
-        contacts = ContactPoints(geometry, quad, compiled=compiled)
-        same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
-        solver = contacts if same else ContactPoints(geometry, solve_quad, workspace="solve", compiled=compiled)
-        cold = np.ones(active.size, dtype=bool)
-        if initial is not None:
-            state = initial.state if isinstance(initial, FrictionTorque) else np.asarray(initial, dtype=float)
-            if state.shape != (n_balls, 4):
-                raise ValueError(f"initial: state of shape {state.shape}, expected ({n_balls}, 4) for this bearing")
-            u = state[active][:, SOLVED] * speed * scale_u
-            cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
-        if np.any(cold):
-            u = cold_start(geometry, solver, u, cold)
-        u, iterations, residual, converged = minimise_power(solver, u, tol, max_iterations)
-        power_c, torque_c = contacts.tractions(u)
+    cage = cage_ratio(bearing) * speed
+    warm = None
+    if initial is not None:
+        warm = initial.state if isinstance(initial, FrictionTorque) else np.asarray(initial, dtype=float)
+    step = None
+    if compiled and warm is not None and warm.shape == (n_balls, 4) and mu > 0.0:
+        # the usual co-simulation step: the loops below in one compiled call, the same numbers
+        step = warm_friction_step(bearing, distribution, mu, speed, sliding_regularisation, quad, solve_quad, warm,
+                                  tol, max_iterations, cage)
+    if step is not None:
+        (iterations, residual, converged, power_c, torque_c, contact_power, per_ball, omega_ball, orbital, state,
+         spin_roll, contact_count) = step
     else:
-        power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0
-
-    cage_speed = cage_ratio(bearing) * speed if geometry.inactive.size else 0.0
-    contact_power, per_ball, omega_ball, orbital, state, spin_roll, contact_count = ball_results(
-        geometry, u, power_c, n_balls, cage_speed, compiled)
+        geometry = ContactSet(bearing, distribution, mu, speed, sliding_regularisation, compiled=compiled)
+        ls, big_r = geometry.length_scale, geometry.pitch_radius
+        scale_u = np.array([ls, ls, big_r])                # solved: r w_r, r w_z, R w_c (w_t = 0)
+        active = geometry.active
+        iterations, residual, converged = 0, 0.0, True
+        u = np.zeros((active.size, 3))
+        if active.size and mu > 0.0:
+            contacts = ContactPoints(geometry, quad, compiled=compiled)
+            same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
+            solver = contacts if same else ContactPoints(geometry, solve_quad, workspace="solve", compiled=compiled)
+            cold = np.ones(active.size, dtype=bool)
+            if warm is not None:
+                if warm.shape != (n_balls, 4):
+                    raise ValueError(f"initial: state of shape {warm.shape}, expected ({n_balls}, 4) for this bearing")
+                u = warm[active][:, SOLVED] * speed * scale_u
+                cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
+            if np.any(cold):
+                u = cold_start(geometry, solver, u, cold)
+            u, iterations, residual, converged = minimise_power(solver, u, tol, max_iterations)
+            power_c, torque_c = contacts.tractions(u)
+        else:
+            power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0
+        contact_power, per_ball, omega_ball, orbital, state, spin_roll, contact_count = ball_results(
+            geometry, u, power_c, n_balls, cage if geometry.inactive.size else 0.0, compiled)
     contact_part = float(per_ball.sum())
     contact_part_moments = -math.copysign(1.0, speed) * float(np.sum(torque_c))
     magnitude = contact_part + seal

@@ -11,7 +11,8 @@ is likewise compiled: the loaded contacts of the distribution (:func:`_contact_s
 of the points' velocity coefficients, twice a step (:func:`_point_coefficients`, for the rule the
 balls are solved on and the torque's), the balls' equilibrium ball by ball
 (:func:`_minimise_balls`), the contacts' powers and torques (:func:`_tractions`) and what is
-reported per ball (:func:`_ball_results`).
+reported per ball (:func:`_ball_results`); a warm-started torque, each co-simulation step's,
+runs them all in one call (:func:`_friction_step`).
 
 numba is optional (it is not part of the FMU's run-time requirements): without it
 :data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
@@ -349,6 +350,97 @@ _MINIMISE_SIGNATURE = ("Tuple((f8[:, :], i8[:], f8[:], b1[:]))("
                        "f8[:], f8[:], f8[:], f8, f8, i8, f8, f8, f8)")
 
 
+_FRICTION_STEP_SIGNATURE = (
+    "Tuple((i8, i8, f8, b1, f8[:], f8[:], f8[:, :], f8[:], f8[:, :], f8[:], f8[:, :], f8[:, :], i8[:]))("
+    "f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:], f8, f8, f8, f8, f8, "
+    "f8[:], f8[:], f8[:, :], f8[:], f8[:], f8[:, :], b1, f8[:, :], f8, i8, f8, f8, f8, f8)")
+
+#: what :func:`_friction_step` answers where the friction torque must take its general path
+GENERAL_PATH = -1
+
+
+def _rule_weight(folded_weight, mu_load):
+    """The points' weights (K, C, I) of a rule's folded weights (K, I) for the contacts' ``mu Q``
+    (C,), as ``ContactPoints`` multiplies them."""
+    n_fold, n_across = folded_weight.shape
+    weight = np.empty((n_fold, mu_load.size, n_across))
+    for k in range(n_fold):
+        for c in range(mu_load.size):
+            for i in range(n_across):
+                weight[k, c, i] = folded_weight[k, i] * mu_load[c]
+    return weight
+
+
+def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
+                   sliding_regularisation, length_scale, pitch_radius, fine_nodes, fine_t2, fine_weight,
+                   solve_nodes, solve_t2, solve_weight, same_rule, warm, tol, max_iterations, theta_down, theta_up,
+                   theta_min_up, cage_speed):
+    """A warm-started friction torque (:func:`slewing_model.friction.friction_torque`) in one call: the
+    loaded contacts (:func:`_contact_set`), the points of the rule the balls are solved on and of
+    the torque's (:func:`_point_coefficients`), the balls' equilibrium from ``warm`` (the last
+    state, (B, 4); :func:`_minimise_balls`), the contacts' powers and torques (:func:`_tractions`)
+    and what is reported per ball (:func:`_ball_results`): the loops ``friction_torque`` calls one
+    by one, with the same arguments, so the same numbers bit for bit.
+
+    Returns a status (0; :data:`GENERAL_PATH` where the general path must run: a refused
+    distribution, whose refusal it words, no loaded contact, or a ball without a warm start),
+    the iterations (as ``minimise_power`` counts them), the largest force residual, whether every
+    ball converged, the contacts' powers and torques (C,), and :func:`_ball_results`'s."""
+    n_balls = load.shape[0]
+    (status, _, ball_index, contact_index, owner, active, inactive, rows, moving_c, force_scale) = _contact_set(
+        load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
+        sliding_regularisation)
+    empty_i = np.zeros(0, np.int64)
+    empty_2 = np.zeros((0, 0))
+    empty_1 = np.zeros(0)
+    refused = (GENERAL_PATH, 0, 0.0, False, empty_1, empty_1, empty_2, empty_1, empty_2, empty_1, empty_2, empty_2,
+               empty_i)
+    if status != 0 or active.size == 0 or mu <= 0.0:
+        return refused
+    scale = (length_scale, length_scale, pitch_radius)
+    u = np.empty((active.size, 3))
+    for row in range(active.size):                  # the warm start (friction_torque's), or the general path
+        finite, moves = True, False
+        for k, column in enumerate((0, 2, 3)):      # SOLVED
+            value = warm[active[row], column] * speed * scale[k]
+            u[row, k] = value
+            finite = finite and math.isfinite(value)
+            moves = moves or value != 0.0
+        if not (finite and moves):
+            return refused
+    a, b, rb, rd, n_r, n_z, ring_speed = rows[4], rows[5], rows[0], rows[1], rows[2], rows[3], rows[6]
+    mu_load, eps2 = rows[7], rows[8]
+    g10, g12, h1, s0, s1, hs, arm1, arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
+                                                               fine_nodes, length_scale, pitch_radius)
+    weight = _rule_weight(fine_weight, mu_load)
+    first = np.zeros(active.size + 1, np.int64)     # the contacts of each active ball (ordered by ball)
+    for j in range(owner.size):
+        first[owner[j] + 1] = j + 1
+    for row in range(active.size):
+        first[row + 1] = max(first[row + 1], first[row])
+    if same_rule:
+        u, iterations, residual, converged = _minimise_balls(
+            u, first, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, force_scale, tol, -1.0, max_iterations,
+            theta_down, theta_up, theta_min_up)
+    else:
+        c10, c12, c1, c0, c1s, chs, _, _ = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
+                                                               solve_nodes, length_scale, pitch_radius)
+        u, iterations, residual, converged = _minimise_balls(
+            u, first, c10, c12, c1, c0, c1s, chs, _rule_weight(solve_weight, mu_load), solve_t2, eps2, force_scale,
+            tol, -1.0, max_iterations, theta_down, theta_up, theta_min_up)
+    power_c, torque_c = _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, arm1, arm2)
+    all_converged = True
+    most, largest = 0, 0.0
+    for row in range(active.size):
+        all_converged = all_converged and converged[row]
+        most = max(most, iterations[row])
+        largest = max(largest, residual[row])
+    results = _ball_results(ball_index, contact_index, owner, active, inactive, power_c, u, n_r, n_z, ring_speed,
+                            length_scale, pitch_radius, speed, cage_speed if inactive.size else 0.0, n_balls)
+    return (0, most if all_converged else max_iterations, largest, all_converged, power_c, torque_c, results[0],
+            results[1], results[2], results[3], results[4], results[5], results[6])
+
+
 def compile_loop(function, signature: str, helpers: tuple = (), error_model: str = "python"):
     """``function`` compiled by numba for ``signature`` (eager, numba's on-disk cache), after the
     ``helpers`` it calls (names in its module).
@@ -368,7 +460,8 @@ def compile_loop(function, signature: str, helpers: tuple = (), error_model: str
 
 
 #: the helpers the friction's loops call
-_HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step")
+_HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
+            "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results")
 
 
 def _compile(function, signature):
@@ -573,6 +666,7 @@ compiled_minimise_balls = loop_factory(KERNELS, _compile, _minimise_balls, _MINI
 compiled_point_coefficients = loop_factory(KERNELS, _compile, _point_coefficients, _COEFFICIENT_SIGNATURE)
 compiled_contact_set = loop_factory(KERNELS, _compile, _contact_set, _CONTACT_SET_SIGNATURE)
 compiled_ball_results = loop_factory(KERNELS, _compile, _ball_results, _BALL_RESULTS_SIGNATURE)
+compiled_friction_step = loop_factory(KERNELS, _compile, _friction_step, _FRICTION_STEP_SIGNATURE)
 
 
 def all_kernels(friction: bool = True, contact: bool = True) -> tuple:

@@ -11,6 +11,7 @@ FMU loads its compiled loops from the cache it carries instead of compiling them
 import json
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -161,6 +162,46 @@ def test_compiled_steps_equal_the_numpy_steps(name):
         out = {kernel: sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for kernel, sim in sims.items()}
         assert out["compiled"].friction_torque == pytest.approx(out["numpy"].friction_torque, rel=1e-10), k
         assert np.allclose(sims["compiled"]._friction_warm, sims["numpy"]._friction_warm, rtol=1e-8, atol=1e-12), k
+
+
+@needs_numba
+@pytest.mark.parametrize("case", range(3))
+@pytest.mark.parametrize("solve_quadrature", [(12, 2), None])
+def test_warm_torque_in_one_call_equals_the_loops_one_by_one(case, solve_quadrature, monkeypatch):
+    """A warm-started torque (each co-simulation step's) runs its compiled loops in one call
+    (``friction_kernel._friction_step``): bit for bit what the loops give called one by one from
+    Python; a ball without a warm start (a cold start) and no loaded contact take the general path."""
+    import slewing_model.friction as friction
+
+    bearing, distribution = _distributions()[case]
+    start = friction_torque(bearing, distribution).state * 1.01
+    calls = []
+    one_call = friction.warm_friction_step
+
+    def counted(*args):
+        calls.append(one_call(*args))
+        return calls[-1]
+
+    def one_by_one(*args):
+        return None
+
+    monkeypatch.setattr(friction, "warm_friction_step", counted)
+    fused = friction_torque(bearing, distribution, initial=start, solve_quadrature=solve_quadrature)
+    assert calls[-1] is not None
+    monkeypatch.setattr(friction, "warm_friction_step", one_by_one)
+    loops = friction_torque(bearing, distribution, initial=start, solve_quadrature=solve_quadrature)
+    for name in ("torque", "magnitude", "contact_part_moments", "power", "iterations", "residual", "converged"):
+        assert getattr(fused, name) == getattr(loops, name), name
+    for name in ("per_ball", "contact_power", "state", "ball_angular_velocity", "orbital_speed",
+                 "spin_roll_ratio", "contact_count"):
+        assert np.array_equal(getattr(fused, name), getattr(loops, name)), name
+    cold = start.copy()
+    cold[np.flatnonzero(distribution.contact_load.max(axis=1) > 0)[0]] = 0.0      # a loaded ball, no warm start
+    assert one_call(bearing, distribution, 0.1, 1.0, 1e-3, ellipse_quadrature(20, 4), ellipse_quadrature(12, 2),
+                    cold, 1e-5, 60, 0.5) is None
+    idle = replace(distribution, contact_load=np.zeros_like(distribution.contact_load))
+    assert one_call(bearing, idle, 0.1, 1.0, 1e-3, ellipse_quadrature(20, 4), ellipse_quadrature(12, 2), start,
+                    1e-5, 60, 0.5) is None
 
 
 @needs_numba
