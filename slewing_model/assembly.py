@@ -130,11 +130,9 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
         if not rings_have_errors(bearing):
             return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi)
     centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()
-    radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
-    dw = np.full(n, bearing.ball_diameter + bearing.preload)
+    measured = []                                         # (contacts, groove radii) a ring measured
 
     errors = bearing.errors
-    measured_radius = False
     if errors is not None:
         for ring in ("outer", "inner"):
             error_map = getattr(errors, ring)
@@ -149,13 +147,16 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
                 centre[:, cols, 0] += d_radial
                 centre[:, cols, 1] += d_axial
             if rc is not None:
-                radius[:, cols] = rc
-                measured_radius = True
-        if errors.ball_diameter_deviation is not None:
-            dw = dw + errors.ball_diameter_deviation
+                measured.append((cols, rc))
 
-    if previous is not None and not measured_radius:      # the same grooves' radii under every ball
+    if previous is not None and not measured:             # the same grooves' radii under every ball
         return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi, groove_centre=centre)
+    radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
+    for cols, rc in measured:
+        radius[:, cols] = rc
+    dw = np.full(n, bearing.ball_diameter + bearing.preload)
+    if errors is not None and errors.ball_diameter_deviation is not None:
+        dw = dw + errors.ball_diameter_deviation
     k = houpert_stiffness(dw[:, None], dw[:, None] / (2.0 * radius), bearing.youngs_modulus, bearing.poisson_ratio)
     k_tot = diagonal_stiffness(k[:, OUTER_OF_DIAGONAL], k[:, INNER_OF_DIAGONAL])
     natural = radius[:, OUTER_OF_DIAGONAL] + radius[:, INNER_OF_DIAGONAL] - dw[:, None]

@@ -17,6 +17,7 @@ Conventions (``DESIGN.md``):
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 from dataclasses import dataclass, field, asdict
@@ -30,6 +31,11 @@ CONTACTS = (1, 2, 3, 4)
 DIAGONALS = ((1, 3), (4, 2))
 #: contacts owned by each ring, in the order of the ring's superelement DOFs
 RING_CONTACTS = {"outer": (1, 4), "inner": (2, 3)}
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    array.setflags(write=False)
+    return array
 
 
 class BearingDefinitionError(ValueError):
@@ -115,11 +121,12 @@ class Bearing:
         """Osculation ratio ``s = Dw / (2 Rc)`` of contacts 1..4 (paper eq 10)."""
         return self.ball_diameter / (2.0 * self.groove_radius)
 
-    @property
+    @functools.cached_property
     def ball_angles(self) -> np.ndarray:
-        """Angular position ``phi_b`` of every ball, rad, shape (B,)."""
+        """Angular position ``phi_b`` of every ball, rad, shape (B,) (read-only: formed once, the
+        assembly asks at every new rotation)."""
         b = np.arange(self.ball_count)
-        return self.first_ball_angle + 2.0 * np.pi * b / self.ball_count
+        return _read_only(self.first_ball_angle + 2.0 * np.pi * b / self.ball_count)
 
     @property
     def contact_normals(self) -> np.ndarray:
@@ -127,15 +134,16 @@ class Bearing:
         c, s = math.cos(self.contact_angle), math.sin(self.contact_angle)
         return np.array([[c, s], [-c, s], [-c, -s], [c, -s]])
 
-    @property
+    @functools.cached_property
     def groove_centres(self) -> np.ndarray:
-        """Nominal groove-centre positions (R, z) of contacts 1..4, m, shape (4, 2).
+        """Nominal groove-centre positions (R, z) of contacts 1..4, m, shape (4, 2) (read-only:
+        formed once).
 
         On the contact line, on the far side of the ball centre, at
         ``Rc - Dw/2`` from the ball centre ``(dm/2, 0)`` (paper Fig. 2)."""
         offset = self.groove_radius - self.ball_diameter / 2.0
         centre = np.array([self.pitch_diameter / 2.0, 0.0])
-        return centre - offset[:, None] * self.contact_normals
+        return _read_only(centre - offset[:, None] * self.contact_normals)
 
     def groove_edge_angle(self, contact: int) -> float:
         """Angle, seen from the groove centre, at which the raceway arc of
