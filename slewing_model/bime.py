@@ -55,7 +55,8 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from .contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .contact_kernel import (
-    COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_trial_point, contact_results,
+    COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_ring_times, compiled_trial_point,
+    contact_results,
 )
 from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -364,7 +365,7 @@ class BimeSolver:
                     fresh = math.log(self.rtol / residual) < FINISH_ITERATIONS * math.log(residual / last_residual)
                 last_residual = residual
                 dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
-                m_dy = self.compliance @ dy       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
+                m_dy = self._ring_times(dy)       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
                 slope = float(grad_q @ dq) - float(mismatch @ m_dy)
             else:
                 dq, dy = self._rigid_direction(point, grad_q, mu), point.y
@@ -395,6 +396,12 @@ class BimeSolver:
                     f"no contact resists this load")
 
         return self._result(loads, point, iterations, residual)
+
+    def _ring_times(self, v: np.ndarray) -> np.ndarray:
+        """``M v``: the ring compliance's product (numpy's FFT, or the compiled loop's DFT)."""
+        if self._product_operands is None:
+            return self.compliance @ v
+        return compiled_ring_times()(*self._product_operands, np.ascontiguousarray(v, dtype=float))
 
     def _kept_operator_serves(self) -> bool:
         """Whether the next iteration may keep the reduced operator as it is, all else equal: its
@@ -432,7 +439,7 @@ class BimeSolver:
         ring = 0.0
         flexible = self.compliance is not None
         if flexible and my is None:
-            my = self.compliance @ y
+            my = self._ring_times(y)
         if flexible and self._compiled:      # the same formulas, one compiled loop
             a = self.assembly
             dq, dy, m_dy = (np.zeros(5), np.zeros(y.size), np.zeros(y.size)) if direction is None else direction
