@@ -542,22 +542,30 @@ def _ring_times(by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_b
     by column as :func:`_symmetric_times`), or through its harmonics as numpy's FFT product does,
     ``R_j = conj(C^_j) V_j``: the real DFT ``V_j = sum_b v_b exp(-2 pi i j b / B)`` and its
     inverse by the tables ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` (and their transposes), the
-    harmonics ``conj(C^_j)`` (K, m, m) by their real and imaginary parts. Differs from the FFT by
-    round-off (the sums run in another order)."""
+    harmonics ``conj(C^_j)`` (K, m, m) by their real and imaginary parts. The balls ``b`` and
+    ``B - b`` share their cosines and have opposite sines, so each sum runs over half the balls.
+    Differs from the FFT by round-off (the sums run in another order)."""
     if not by_harmonics:
         return _symmetric_times(dense, v.reshape(1, v.size))[0]
     n_harmonics, n_balls = cos_table.shape
     m = harmonic_real.shape[1]
+    pairs = (n_balls - 1) // 2                     # b and B - b for b = 1 .. pairs; b = 0 (and B/2) alone
     v_real = np.zeros((m, n_harmonics))
     v_imag = np.zeros((m, n_harmonics))
-    for b in range(n_balls):                       # V_j, each ball's block added to every harmonic
+    for single in range(2 if n_balls % 2 == 0 else 1):     # b = 0 and, for an even B, B/2: no sine, no pair
+        b = single * (n_balls // 2)
         for a in range(m):
             value = v[b * m + a]
-            if value == 0.0:                       # (the rows off the reduced operator's)
-                continue
             for j in range(n_harmonics):
                 v_real[a, j] += cos_by_ball[b, j] * value
-                v_imag[a, j] -= sin_by_ball[b, j] * value
+    for b in range(1, pairs + 1):                  # V_j, the two balls' blocks added to every harmonic
+        for a in range(m):
+            both, apart = v[b * m + a] + v[(n_balls - b) * m + a], v[b * m + a] - v[(n_balls - b) * m + a]
+            if both == 0.0 and apart == 0.0:       # (the rows off the reduced operator's)
+                continue
+            for j in range(n_harmonics):
+                v_real[a, j] += cos_by_ball[b, j] * both
+                v_imag[a, j] -= sin_by_ball[b, j] * apart
     p_real = np.empty((m, n_harmonics))
     p_imag = np.empty((m, n_harmonics))
     for j in range(n_harmonics):                   # R_j; the inverse's weights (numpy's irfft: the
@@ -570,16 +578,21 @@ def _ring_times(by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_b
                 imag += harmonic_real[j, a, c] * v_imag[c, j] + harmonic_imag[j, a, c] * v_real[c, j]
             p_real[a, j] = weight * real
             p_imag[a, j] = weight * imag
-    out_t = np.zeros((m, n_balls))
-    for a in range(m):                             # the inverse DFT, each harmonic added to every ball
+    half = n_balls // 2 + 1
+    cos_part = np.zeros((m, half))
+    sin_part = np.zeros((m, half))
+    for a in range(m):                             # the inverse DFT, each harmonic added to half the balls
         for j in range(n_harmonics):
             real, imag = p_real[a, j], p_imag[a, j]
-            for b in range(n_balls):
-                out_t[a, b] += real * cos_table[j, b] - imag * sin_table[j, b]
+            for b in range(half):
+                cos_part[a, b] += real * cos_table[j, b]
+                sin_part[a, b] += imag * sin_table[j, b]
     out = np.empty(v.size)
-    for b in range(n_balls):
+    for b in range(half):                          # ball b: cos - sin; ball B - b: cos + sin
         for a in range(m):
-            out[b * m + a] = out_t[a, b]
+            out[b * m + a] = cos_part[a, b] - sin_part[a, b]
+            if 0 < b < n_balls - b:
+                out[(n_balls - b) * m + a] = cos_part[a, b] + sin_part[a, b]
     return out
 
 
