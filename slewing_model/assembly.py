@@ -83,13 +83,14 @@ class Assembly:
     def separation(self) -> np.ndarray:
         """Vector from the outer to the inner groove centre of each diagonal,
         (B, 2, 2) as (ball, diagonal, (r, z)), before loading."""
-        return self.groove_centre[:, INNER_OF_DIAGONAL] - self.groove_centre[:, OUTER_OF_DIAGONAL]
+        return np.take(self.groove_centre, INNER_OF_DIAGONAL, axis=1) - np.take(self.groove_centre, OUTER_OF_DIAGONAL,
+                                                                               axis=1)
 
     @property
     def moving_centre(self) -> np.ndarray:
         """(R, z) of the moving ring's groove centre of each diagonal, (B, 2, 2)."""
         cols = INNER_OF_DIAGONAL if self.moving_sign > 0 else OUTER_OF_DIAGONAL
-        return self.groove_centre[:, cols]
+        return np.take(self.groove_centre, cols, axis=1)
 
 
 def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None,
@@ -129,7 +130,8 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
                              f"{bearing.moving_ring} ring moving)")
         if not rings_have_errors(bearing):
             return replace(previous, psi=float(psi), cage_angle=float(cage), ball_angle=phi)
-    centre = np.broadcast_to(bearing.groove_centres, (n, 4, 2)).copy()
+    centre = np.empty((n, 4, 2))
+    centre[:] = bearing.groove_centres
     measured = []                                         # (contacts, groove radii) a ring measured
 
     errors = bearing.errors

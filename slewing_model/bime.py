@@ -327,7 +327,7 @@ class BimeSolver:
         if initial is None:
             self.pending_operator = None                  # a cold solve depends on nothing before it
         point = self._evaluate(qs, y, f_scaled)
-        load_scale = float(np.abs(f_scaled).max())
+        load_scale = max(map(abs, f_scaled.tolist()))
         while True:
             grad_q, mismatch = point.gradient, point.mismatch
             scale = max(load_scale, point.peak_force, 1e-300)
