@@ -20,6 +20,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .contact import diagonal_stiffness, houpert_stiffness
+from .contact_kernel import add_groove_errors
+from .friction_kernel import use_compiled
 from .geometry import DIAGONALS, RING_CONTACTS, Bearing
 
 #: for each diagonal (1, 2) the column of its outer and inner contact in (B, 4) arrays
@@ -173,9 +175,6 @@ def _compiled_groove_errors(centre: np.ndarray, theta: np.ndarray, error_map, co
     """A ring's errors at its angles ``theta`` added to the groove centres of its contacts ``cols``
     by a compiled loop (:func:`slewing_model.contact_kernel.add_groove_errors`); its measured
     groove radii, or None."""
-    from .contact_kernel import add_groove_errors
-    from .friction_kernel import use_compiled
-
     use_compiled("compiled", "compiled")               # a clear ValueError where numba is not installed
     return add_groove_errors(centre, theta, error_map, cols)
 

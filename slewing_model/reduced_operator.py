@@ -110,7 +110,7 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: boo
     where the caller knows it (``may_turn`` False). The operator itself when the Jacobian did
     not change."""
     ja = jacobian.reshape(-1, 5)[op.rows]
-    if np.array_equal(op.jacobian, ja):
+    if op.jacobian.shape == ja.shape and (op.jacobian == ja).all():
         return op
     arithmetic = _arithmetic(arithmetic)
     turned = None
