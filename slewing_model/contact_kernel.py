@@ -532,21 +532,18 @@ def _add_groove_errors(centre, theta, angle, table, contact_a, contact_b):
     return values
 
 
-_RING_TIMES_SIGNATURE = "f8[::1](b1, f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[::1])"
+_RING_TIMES_SIGNATURE = "f8[::1](f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[::1])"
 
 
-def _ring_times(by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag,
-                v):
+def _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, v):
     """The ring compliance's product ``M v`` (:class:`slewing_model.ring_compliance.BlockCirculant`,
-    blocks of ``m``): with its dense matrix (``by_harmonics`` False; ``M`` symmetric, summed column
-    by column as :func:`_symmetric_times`), or through its harmonics as numpy's FFT product does,
-    ``R_j = conj(C^_j) V_j``: the real DFT ``V_j = sum_b v_b exp(-2 pi i j b / B)`` and its
-    inverse by the tables ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` (and their transposes), the
-    harmonics ``conj(C^_j)`` (K, m, m) by their real and imaginary parts. The balls ``b`` and
-    ``B - b`` share their cosines and have opposite sines, so each sum runs over half the balls.
-    Differs from the FFT by round-off (the sums run in another order)."""
-    if not by_harmonics:
-        return _symmetric_times(dense, v.reshape(1, v.size))[0]
+    blocks of ``m``) through its harmonics, as numpy's FFT product does, ``R_j = conj(C^_j) V_j``:
+    the real DFT ``V_j = sum_b v_b exp(-2 pi i j b / B)`` and its inverse by the tables ``cos``,
+    ``sin`` (K, B) of ``2 pi j b / B`` (and their transposes), the harmonics ``conj(C^_j)``
+    (K, m, m) by their real and imaginary parts. The balls ``b`` and ``B - b`` share their
+    cosines and have opposite sines, so each sum runs over half the balls. Differs from the FFT
+    (and the dense product) by round-off; faster than the dense product from a few balls on
+    (67 balls: 4.6 against 7.6 us)."""
     n_harmonics, n_balls = cos_table.shape
     m = harmonic_real.shape[1]
     pairs = (n_balls - 1) // 2                     # b and B - b for b = 1 .. pairs; b = 0 (and B/2) alone
@@ -601,14 +598,14 @@ _KEPT_SIGNATURE = (
     "f8[:, ::1], f8[::1], f8[::1], b1[::1], f8[::1]))("
     "f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
     "f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
-    "b1, f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
+    "f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
     "f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], "
     "f8[::1], f8[::1], b1[::1], f8[:], f8[:], i8, i8)")
 
 
 def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_scaled, loaded_from,
                      inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse, op_active,
-                     by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag,
+                     cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag,
                      qs, y, ring_motion, e, delta, q, force, n, length, gradient, mismatch, loaded, terms, rules,
                      iterations, max_iterations):
     """The flexible solver's iterations with a kept reduced operator, as ``BimeSolver.solve``
@@ -652,8 +649,7 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
         dq, y_new = _newton_step(inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse,
                                  force.reshape(-1), ring_motion, f_scaled, y.size)
         dy = y_new - y
-        m_dy = _ring_times(by_harmonics, dense, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real,
-                           harmonic_imag, dy)
+        m_dy = _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, dy)
         slope = 0.0
         for k in range(5):
             slope += gradient[k] * dq[k]

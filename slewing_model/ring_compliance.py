@@ -67,20 +67,15 @@ class BlockCirculant:
 
 def product_operands(matrix: BlockCirculant) -> tuple:
     """What the compiled product ``M v`` (:func:`slewing_model.contact_kernel._ring_times`) takes of a
-    :class:`BlockCirculant`: whether it goes through the harmonics, the dense matrix, the tables
-    ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` for the harmonics ``j < K = B // 2 + 1`` and their
-    transposes (B, K), and the real and imaginary parts of its harmonics (K, m, m); empty tables
-    for a dense product."""
-    if not matrix.by_harmonics:
-        empty = np.zeros((0, 0))
-        return (False, np.ascontiguousarray(matrix.dense), empty, empty, empty, empty,
-                np.zeros((0, matrix.block, matrix.block)), np.zeros((0, matrix.block, matrix.block)))
+    :class:`BlockCirculant`, always through its harmonics (compiled, that is faster than the dense
+    product from a few balls on): the tables ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` for the
+    harmonics ``j < K = B // 2 + 1`` and their transposes (B, K), and the real and imaginary parts
+    of its harmonics (K, m, m)."""
     n_harmonics = matrix.harmonics.shape[0]
     angle = 2.0 * np.pi * np.outer(np.arange(n_harmonics), np.arange(matrix.balls)) / matrix.balls
     cos_table, sin_table = np.cos(angle), np.sin(angle)
-    return (True, np.ascontiguousarray(matrix.dense), cos_table, sin_table, np.ascontiguousarray(cos_table.T),
-            np.ascontiguousarray(sin_table.T), np.ascontiguousarray(matrix.harmonics.real),
-            np.ascontiguousarray(matrix.harmonics.imag))
+    return (cos_table, sin_table, np.ascontiguousarray(cos_table.T), np.ascontiguousarray(sin_table.T),
+            np.ascontiguousarray(matrix.harmonics.real), np.ascontiguousarray(matrix.harmonics.imag))
 
 
 def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:

@@ -226,12 +226,11 @@ def test_compiled_error_tables_equal_numpy_interp(table3):
                 assert not np.array_equal(want.groove_centre, last.groove_centre)    # other grooves under the balls
 
 
-@pytest.mark.parametrize("balls", [67, 150, 151, 180])
+@pytest.mark.parametrize("balls", [2, 5, 67, 150, 151, 180])
 def test_compiled_ring_product_equals_the_dense_product(balls):
-    """The ring compliance's product in the compiled iterations (``contact_kernel._ring_times``):
-    column sums of the dense matrix below FFT_FROM_BALLS balls, a real DFT by tables above (an
-    even and an odd number of balls: the harmonic B/2 is real or absent), against the dense
-    product, also for a vector with the zero rows of those off the reduced operator."""
+    """The ring compliance's product in the compiled iterations (``contact_kernel._ring_times``), a
+    real DFT by tables (even and odd numbers of balls: the harmonic B/2 is real or absent), against
+    the dense product, also for a vector with the zero rows of those off the reduced operator."""
     from slewing_model.contact_kernel import compiled_ring_times
     from slewing_model.ring_compliance import BlockCirculant, product_operands
 
