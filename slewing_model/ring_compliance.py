@@ -9,7 +9,8 @@ the flexible solver (:mod:`slewing_model.bime`, :mod:`slewing_model.reduced_oper
 eliminates the ring displacements.
 
 Both are kept as :class:`BlockCirculant`: dense for their entries (the reduced operator takes
-rows and columns of ``M``), multiplied harmonic by harmonic (FFT) on large bearings.
+rows and columns of ``M``), multiplied harmonic by harmonic (numpy's FFT) on large bearings, or
+by a compiled real DFT (:func:`product_operands`, :mod:`slewing_model.contact_kernel`) at any size.
 
 Run-time module: numpy.
 """
@@ -69,11 +70,14 @@ def product_operands(matrix: BlockCirculant) -> tuple:
     """What the compiled product ``M v`` (:func:`slewing_model.contact_kernel._ring_times`) takes of a
     :class:`BlockCirculant`, always through its harmonics (compiled, that is faster than the dense
     product from a few balls on): the tables ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` for the
-    harmonics ``j < K = B // 2 + 1`` and their transposes (B, K), and the real and imaginary parts
-    of its harmonics (K, m, m)."""
-    n_harmonics = matrix.harmonics.shape[0]
-    angle = 2.0 * np.pi * np.outer(np.arange(n_harmonics), np.arange(matrix.balls)) / matrix.balls
+    harmonics ``j < K = B // 2 + 1`` and their transposes (B, K), with ``j b`` taken modulo ``B``
+    (the tables then as exact as numpy's FFT's twiddles: 6e-16, not 1e-13 at 180 balls), and the
+    real and imaginary parts of its harmonics (K, m, m)."""
+    n_harmonics, n_balls = matrix.harmonics.shape[0], matrix.balls
+    turns = np.outer(np.arange(n_harmonics), np.arange(n_balls)) % n_balls      # j b mod B: angles below 2 pi
+    angle = 2.0 * np.pi * turns / n_balls
     cos_table, sin_table = np.cos(angle), np.sin(angle)
+    sin_table[2 * turns == n_balls] = 0.0                # the angle pi exactly (the harmonic B/2)
     return (cos_table, sin_table, np.ascontiguousarray(cos_table.T), np.ascontiguousarray(sin_table.T),
             np.ascontiguousarray(matrix.harmonics.real), np.ascontiguousarray(matrix.harmonics.imag))
 
