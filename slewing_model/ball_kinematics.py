@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contact_friction import conformity_radius
-from .ellipse_quadrature import EllipseQuadrature, ellipse_quadrature
+from .ellipse_quadrature import EllipseQuadrature
 from .friction_kernel import (
     GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
     compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
@@ -688,22 +688,6 @@ def ball_results(geometry: ContactSet, u: np.ndarray, contact_power: np.ndarray,
             np.count_nonzero(geo.loaded, axis=1))
 
 
-def _rule_arrays(quad: EllipseQuadrature) -> tuple:
-    """A rule's across nodes, folded ``t^2`` and folded weights as writable arrays (the compiled
-    loop takes no read-only ones), made once for each of the library's rules."""
-    if quad is ellipse_quadrature(quad.n_across, quad.n_along):
-        return _library_rule_arrays(quad.n_across, quad.n_along)
-    return (np.array(quad.across_nodes, dtype=float), np.array(quad.along_squared, dtype=float),
-            np.array(quad.folded_weight, dtype=float))
-
-
-@functools.lru_cache(maxsize=8)
-def _library_rule_arrays(n_across: int, n_along: int) -> tuple:
-    quad = ellipse_quadrature(n_across, n_along)
-    return (np.array(quad.across_nodes, dtype=float), np.array(quad.along_squared, dtype=float),
-            np.array(quad.folded_weight, dtype=float))
-
-
 def warm_friction_step(bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float,
                        quad: EllipseQuadrature, solve_quad: EllipseQuadrature, warm: np.ndarray, tol: float,
                        max_iterations: int, cage_speed: float):
@@ -720,7 +704,7 @@ def warm_friction_step(bearing: Bearing, distribution, mu: float, speed: float, 
         arrays["contact_load"], arrays["contact_angle"], arrays["semi_axis_a"], arrays["semi_axis_b"],
         ball_radii(bearing), np.asarray(bearing.groove_radius, dtype=float), _IS_MOVING[bearing.moving_ring],
         _NORMAL_SIGN_R, _NORMAL_SIGN_Z, mu, speed, sliding_regularisation, 0.5 * bearing.ball_diameter,
-        0.5 * bearing.pitch_diameter, *_rule_arrays(quad), *_rule_arrays(solve_quad), same,
+        0.5 * bearing.pitch_diameter, *quad.writable_arrays, *solve_quad.writable_arrays, same,
         np.array(warm, dtype=float), tol, max_iterations, _THETA_DOWN, _THETA_UP, _THETA_MIN_UP, cage_speed)
     return None if out[0] == GENERAL_PATH else out[1:]
 

@@ -114,8 +114,10 @@ class BimeSolver:
         How the solver's per-contact work is done (a new rotation's grooves and Jacobian, the
         trial points, the reduced operator's steps, forming, turning and bordering, the
         result's contacts): numpy array operations, or compiled loops
-        (:mod:`slewing_model.contact_kernel`, needs numba); "auto" takes the compiled
-        loops where numba is installed. The same results to round-off. Default numpy: a
+        (:mod:`slewing_model.contact_kernel`, needs numba), which also run the iterations that
+        keep the reduced operator one after the other in one loop, with the ring compliance's
+        product by a real DFT; "auto" takes the compiled loops where numba is installed. The
+        same iterations, and results to round-off. Default numpy: a
         few solves do not repay numba's import (0.5 s); the co-simulation's simulator
         takes "auto" (``SimulatorSettings.contact_kernel``).
     """
@@ -327,6 +329,7 @@ class BimeSolver:
         if initial is None:
             self.pending_operator = None                  # a cold solve depends on nothing before it
         point = self._evaluate(qs, y, f_scaled)
+        handed_back = False                               # the compiled loop stopped before this iteration
         load_scale = max(map(abs, f_scaled.tolist()))
         while True:
             grad_q, mismatch = point.gradient, point.mismatch
@@ -341,28 +344,27 @@ class BimeSolver:
                 raise NoEquilibriumError(
                     f"no convergence after {iterations} Newton iterations (relative residual {residual:.2e}) "
                     f"for loads {loads}")
-            if self._product_operands is not None and last_residual is not None:
+            if (self._product_operands is not None and not handed_back
+                    and not _refresh_due(residual, last_residual, self.rtol)):
                 if self._reduced is not None and self._reduced_jacobian is not self._jacobian_rows:
                     # the ring turned since (set_rotation): the coupling follows, as in _flexible_direction
                     self._reduced = turned_operator(self._reduced, self.jacobian, mu, may_turn=self._rigid_turn,
                                                     arithmetic=self._arithmetic)
                     self._reduced_jacobian = self._jacobian_rows
-            if self._product_operands is not None and last_residual is not None and self._kept_operator_serves():
-                # the iterations that keep the operator, in one compiled loop, as far as they go
-                done, point, last_residual = self._kept_iterations(point, f_scaled, load_scale, trust, last_residual,
-                                                                   iterations)
-                if done:
-                    iterations += done
-                    continue
+                if self._kept_operator_serves():
+                    # the iterations that keep the operator, in one compiled loop, as far as they go; the
+                    # one it stopped before is this loop's (handed_back)
+                    done, point, last_residual = self._kept_iterations(point, f_scaled, load_scale, trust,
+                                                                       last_residual, iterations)
+                    handed_back = True
+                    if done:
+                        iterations += done
+                        continue
+            handed_back = False
             iterations += 1
 
             if flexible:
-                # a fresh reduced operator on the first iteration of a cold solve and whenever
-                # the residual fell by less than a factor 1 / REFRESH in the last iteration
-                fresh = last_residual is None or residual > REFRESH * last_residual
-                if fresh and last_residual is not None and residual < last_residual:
-                    # slow, but the iterations this rate still needs are few: they cost less than a new operator
-                    fresh = math.log(self.rtol / residual) < FINISH_ITERATIONS * math.log(residual / last_residual)
+                fresh = _refresh_due(residual, last_residual, self.rtol)
                 last_residual = residual
                 dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
                 m_dy = self._ring_times(dy)       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
@@ -398,7 +400,8 @@ class BimeSolver:
         return self._result(loads, point, iterations, residual)
 
     def _ring_times(self, v: np.ndarray) -> np.ndarray:
-        """``M v``: the ring compliance's product (numpy's FFT, or the compiled loop's DFT)."""
+        """``M v``: the ring compliance's product (numpy's, :class:`~slewing_model.ring_compliance.BlockCirculant`;
+        or, with the compiled loops, their DFT)."""
         if self._product_operands is None:
             return self.compliance @ v
         return compiled_ring_times()(*self._product_operands, np.ascontiguousarray(v, dtype=float))
@@ -588,6 +591,19 @@ class BimeSolver:
             contact_pressure=pressure, truncated=truncated, energy=p.total, iterations=iterations, residual=residual,
             state=np.concatenate([qs, y]), rings=self.ring_compliance,
         )
+
+
+def _refresh_due(residual: float, last_residual: float | None, rtol: float) -> bool:
+    """Whether the flexible solver's next iteration forms a fresh reduced operator: on the first
+    iteration of a cold solve (no last residual) and whenever the residual fell by less than a
+    factor ``1 / REFRESH`` in the last iteration, unless at that rate the iterations still needed
+    are few (:data:`FINISH_ITERATIONS`): they cost less than a new operator."""
+    if last_residual is None:
+        return True
+    fresh = residual > REFRESH * last_residual
+    if fresh and residual < last_residual:
+        fresh = math.log(rtol / residual) < FINISH_ITERATIONS * math.log(residual / last_residual)
+    return fresh
 
 
 @dataclass

@@ -617,7 +617,9 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
     The loop stops before an iteration that the solver must run itself: the stop rule met (or its
     residual not finite), ``max_iterations`` reached, a new operator asked for by the refresh rule,
     a diagonal loaded outside the operator's ``op_active`` (it borders them in), none loaded, a
-    line search that fails or a moving ring beyond the ball diameter (it raises).
+    line search that fails or a moving ring beyond the ball diameter (it raises). Its decisions
+    are the solver's; its sums (the slope, the step's length) run in another order than numpy's
+    dot products, so a tie at round-off could fall the other way.
 
     ``qs`` ... ``loaded`` are the last point's (``BimeSolver``'s ``_Point``), ``terms`` its total
     energy, energy scale, largest force, largest residual and loaded diagonals; ``rules`` the stop
@@ -650,11 +652,12 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
                                  force.reshape(-1), ring_motion, f_scaled, y.size)
         dy = y_new - y
         m_dy = _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, dy)
-        slope = 0.0
+        slope_q = slope_y = 0.0                    # g . dq - (f - y) . M dy, as two dot products
         for k in range(5):
-            slope += gradient[k] * dq[k]
+            slope_q += gradient[k] * dq[k]
         for i in range(dy.size):
-            slope -= mismatch[i] * m_dy[i]
+            slope_y += mismatch[i] * m_dy[i]
+        slope = slope_q - slope_y
         norm = math.sqrt(dq[0] ** 2 + dq[1] ** 2 + dq[2] ** 2 + dq[3] ** 2 + dq[4] ** 2)
         if norm > trust:
             shrink = trust / norm

@@ -69,6 +69,13 @@ class EllipseQuadrature:
     def size(self) -> int:
         return self.across.size
 
+    @functools.cached_property
+    def writable_arrays(self) -> tuple:
+        """``across_nodes``, ``along_squared`` and ``folded_weight`` as writable copies, made once
+        (the compiled friction loop takes no read-only arrays; it does not write them)."""
+        return (np.array(self.across_nodes, dtype=float), np.array(self.along_squared, dtype=float),
+                np.array(self.folded_weight, dtype=float))
+
 
 def _gauss_jacobi_11(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss rule for the weight ``1 - x^2`` on [-1, 1] (Golub-Welsch): Gegenbauer

@@ -431,10 +431,11 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     power_c, torque_c = _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, arm1, arm2)
     all_converged = True
     most, largest = 0, 0.0
-    for row in range(active.size):
+    for row in range(active.size):                  # as numpy's max(initial=0): a NaN residual shows
         all_converged = all_converged and converged[row]
         most = max(most, iterations[row])
-        largest = max(largest, residual[row])
+        if largest == largest and not residual[row] <= largest:
+            largest = residual[row]
     results = _ball_results(ball_index, contact_index, owner, active, inactive, power_c, u, n_r, n_z, ring_speed,
                             length_scale, pitch_radius, speed, cage_speed if inactive.size else 0.0, n_balls)
     return (0, most if all_converged else max_iterations, largest, all_converged, power_c, torque_c, results[0],

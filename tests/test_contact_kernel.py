@@ -248,6 +248,41 @@ def test_compiled_ring_product_equals_the_dense_product(balls):
 
 
 @pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
+def test_iterations_in_one_loop_equal_them_one_by_one(name, monkeypatch):
+    """The compiled loop of the iterations that keep the operator (``_kept_iterations``) against the
+    same iterations run one by one by ``BimeSolver.solve`` (the loop switched off): the same
+    iterations and states to round-off over the steps of a case, and, where the solver runs out of
+    iterations inside the loop, the same refusal."""
+    from slewing_model.bime import BimeSolver
+    from slewing_model.distribution import NoEquilibriumError
+    from slewing_model.simulator import BearingSimulator
+
+    case, sims = simulators_per_kernel(name, 20, "contact_kernel")
+    looped = sims["compiled"]
+    one_by_one = BearingSimulator(looped.bearing, looped.superelement, looped.settings)
+    run_kept = BimeSolver._kept_iterations
+
+    def switch(solver, *args):
+        return run_kept(solver, *args) if solver is looped.solver else (0, args[0], args[4])
+
+    monkeypatch.setattr(BimeSolver, "_kept_iterations", switch)
+    for k in range(case.steps):
+        a = looped.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]).distribution
+        b = one_by_one.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]).distribution
+        assert a.iterations == b.iterations, k
+        assert np.abs(a.state - b.state).max() <= 1e-12 * np.abs(b.state).max(), k
+    k = case.steps - 1
+    for sim in (looped, one_by_one):
+        sim.solver.max_iterations = 2
+    messages = []
+    for sim in (looped, one_by_one):
+        with pytest.raises(NoEquilibriumError, match="no convergence after 2 Newton iterations") as refused:
+            sim.step(Loads(*(1.5 * case.loads[k])), case.psi[k] + 0.01, case.omega[k])
+        messages.append(str(refused.value).split(" (relative residual")[0])
+    assert messages[0] == messages[1]
+
+
+@pytest.mark.parametrize("name", ["pitch", "table3_heavy"])
 def test_steps_with_compiled_contacts_equal_the_numpy_steps(name, monkeypatch):
     """Whole steps with the compiled loops (most iterations in one loop with the kept operator,
     ``contact_kernel._kept_iterations``) against the numpy path: the same iterations, loads and

@@ -165,15 +165,21 @@ def test_compiled_steps_equal_the_numpy_steps(name):
 
 
 @needs_numba
-@pytest.mark.parametrize("case", range(3))
+@pytest.mark.parametrize("case", range(4))
 @pytest.mark.parametrize("solve_quadrature", [(12, 2), None])
 def test_warm_torque_in_one_call_equals_the_loops_one_by_one(case, solve_quadrature, monkeypatch):
     """A warm-started torque (each co-simulation step's) runs its compiled loops in one call
     (``friction_kernel._friction_step``): bit for bit what the loops give called one by one from
-    Python; a ball without a warm start (a cold start) and no loaded contact take the general path."""
+    Python, also with unloaded balls (a bearing with clearance under a tilting moment); a ball
+    without a warm start (a cold start) and no loaded contact take the general path."""
     import slewing_model.friction as friction
 
-    bearing, distribution = _distributions()[case]
+    if case < 3:
+        bearing, distribution = _distributions()[case]
+    else:
+        bearing = load_bearing(BEARINGS / "table3.toml").with_preload(-50e-6)
+        distribution = solve(bearing, Loads(Fz=2e4, Mx=2e4))
+        assert np.any(distribution.contact_load.max(axis=1) == 0.0)          # unloaded balls
     start = friction_torque(bearing, distribution).state * 1.01
     calls = []
     one_call = friction.warm_friction_step
