@@ -141,7 +141,9 @@ class BimeSolver:
         self.ring_compliance = None if superelement is None else ring_compliances(superelement)
         self.compliance = None if superelement is None else contact_compliance(self.ring_compliance)
         # M's product in the compiled iterations (contact_kernel._kept_iterations)
-        self._product_operands = product_operands(self.compliance) if self._compiled and superelement is not None else None
+        self._product_operands = None
+        if self._compiled and superelement is not None:
+            self._product_operands = product_operands(self.compliance)
         # groove edge angles of contacts 1..4 (truncation check)
         self.edge_angle = np.array([bearing.groove_edge_angle(c) for c in (1, 2, 3, 4)])
         self._loaded_from = 1e-15 * bearing.ball_diameter     # a spring stretched more than this is loaded

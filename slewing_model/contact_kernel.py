@@ -676,8 +676,8 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
             t *= 0.5
         if not accepted or qs_t[0] ** 2 + qs_t[1] ** 2 + qs_t[2] ** 2 + qs_t[3] ** 2 + qs_t[4] ** 2 > dw2:
             break
-        qs, y, ring_motion, e, delta, q, force, n, length = qs_t, y_t, motion_t, e_t, delta_t, q_t, force_t, n_t, length_t
-        gradient, mismatch, loaded = gradient_t, mismatch_t, loaded_t
+        qs, y, ring_motion, e, delta, q = qs_t, y_t, motion_t, e_t, delta_t, q_t
+        force, n, length, gradient, mismatch, loaded = force_t, n_t, length_t, gradient_t, mismatch_t, loaded_t
         total, energy_scale = total_t, scale_t
         peak_force, peak_residual, n_loaded = trial_terms[3], trial_terms[4], trial_terms[5]
         iterations += 1
