@@ -64,8 +64,8 @@ from .distribution import (  # noqa: F401  (Loads, LoadDistribution and the erro
 from .friction_kernel import use_compiled
 from .geometry import RING_CONTACTS, Bearing
 from .reduced_operator import (
-    NUMPY_ARITHMETIC, PendingOperator, ReducedOperator, advance_operator, assemble_operator, complete_operator,
-    start_operator, turned_operator, update_operator,
+    APPROXIMATE_TURN, NUMPY_ARITHMETIC, PendingOperator, ReducedOperator, advance_operator, assemble_operator,
+    complete_operator, start_operator, turned_operator, update_operator,
 )
 from .ring_compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
@@ -151,8 +151,10 @@ class BimeSolver:
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
         #: a new operator being inverted over two solves (flexible, warm solves), or None: state too
         self.pending_operator: PendingOperator | None = None
-        # a turn of the ring only turns the Jacobian's columns where the moving ring's grooves have no errors
-        self._rigid_turn = bearing.errors is None or getattr(bearing.errors, bearing.moving_ring) is None
+        # a turn of the ring only turns the Jacobian's columns where the moving ring's grooves have no
+        # errors; with errors, nearly (reduced_operator.APPROXIMATE_TURN)
+        rigid_turn = bearing.errors is None or getattr(bearing.errors, bearing.moving_ring) is None
+        self._turn_tolerance = 0.0 if rigid_turn else APPROXIMATE_TURN
         self._stage_due = self._spread = False  # per solve: a stage of the pending operator is due; it may be spread
         self.assembly: Assembly | None = None
         self.set_rotation(psi, cage_angle)
@@ -350,8 +352,8 @@ class BimeSolver:
                     and not _refresh_due(residual, last_residual, self.rtol)):
                 if self._reduced is not None and self._reduced_jacobian is not self._jacobian_rows:
                     # the ring turned since (set_rotation): the coupling follows, as in _flexible_direction
-                    self._reduced = turned_operator(self._reduced, self.jacobian, mu, may_turn=self._rigid_turn,
-                                                    arithmetic=self._arithmetic)
+                    self._reduced = turned_operator(self._reduced, self.jacobian, mu, self._turn_tolerance,
+                                                    self._arithmetic)
                     self._reduced_jacobian = self._jacobian_rows
                 if self._kept_operator_serves():
                     # the iterations that keep the operator, in one compiled loop, as far as they go; the
@@ -532,7 +534,7 @@ class BimeSolver:
         if not fresh and op is not None:
             if self._reduced_jacobian is not self._jacobian_rows:
                 # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, mu, may_turn=self._rigid_turn,
+                op = turned_operator(op, self.jacobian, mu, tolerance=self._turn_tolerance,
                                      arithmetic=self._arithmetic)
             op = bordered(op)
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once

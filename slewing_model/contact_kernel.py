@@ -170,7 +170,7 @@ def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_in
     return dq, y_new
 
 
-_TURN_SIGNATURE = "Tuple((b1, f8[:, :], f8[:, :]))(f8[:, :], f8[:, :], f8[:, :], f8)"
+_TURN_SIGNATURE = "Tuple((b1, f8[:, :], f8[:, :], f8[:, :]))(f8[:, :], f8[:, :], f8[:, :], f8, f8)"
 
 
 def _solve_small(a, b):
@@ -206,10 +206,11 @@ def _solve_small(a, b):
     return True, x
 
 
-def _column_turn(old, new, coupling, mu):
-    """:func:`slewing_model.reduced_operator.column_turn` as one compiled loop: whether the turn
-    ``T`` (``new = old T``, fitted by least squares to 1e-12) exists, the coupling ``coupling T``
-    and ``(new^T coupling T + mu I)^-1``."""
+def _column_turn(old, new, coupling, mu, tolerance):
+    """:func:`slewing_model.reduced_operator.column_turn` as one compiled loop: whether a turn
+    ``T`` (``old T`` fitted to ``new`` by least squares, to 1e-12, or to ``tolerance``) exists,
+    the coupling ``coupling T``, ``(J^T coupling T + mu I)^-1`` and the Jacobian ``J`` they are
+    for (``new``, or ``old T`` where the fit is not exact)."""
     n = old.shape[0]
     normal, right = np.zeros((5, 5)), np.zeros((5, 5))           # old^T old, old^T new
     for i in range(n):
@@ -220,34 +221,37 @@ def _column_turn(old, new, coupling, mu):
     found, turn = _solve_small(normal, right)
     empty = np.empty((0, 5))
     if not found:
-        return False, empty, empty
+        return False, empty, empty, empty
+    fitted = np.empty((n, 5))                                     # old T
     worst = scale = total = 0.0
     for i in range(n):
         for c in range(5):
             value = 0.0
             for k in range(5):
                 value += old[i, k] * turn[k, c]
+            fitted[i, c] = value
             difference = abs(value - new[i, c])
             worst = max(worst, difference)
             total += difference                        # NaN or inf shows here, not in max
             scale = max(scale, abs(new[i, c]))
-    if not (math.isfinite(total) and worst <= 1e-12 * scale):        # NaN or inf: no turn, as numpy finds
-        return False, empty, empty
+    if not (math.isfinite(total) and worst <= max(tolerance, 1e-12) * scale):   # NaN or inf: none, as numpy
+        return False, empty, empty, empty
+    jacobian = new if worst <= 1e-12 * scale else fitted
     turned = np.zeros((n, 5))
     for i in range(n):
         for k in range(5):
             value = coupling[i, k]
             for c in range(5):
                 turned[i, c] += value * turn[k, c]
-    schur = mu * np.eye(5)                                       # new^T coupling T + mu I
+    schur = mu * np.eye(5)                                       # J^T coupling T + mu I
     for i in range(n):
         for r in range(5):
             for c in range(5):
-                schur[r, c] += new[i, r] * turned[i, c]
+                schur[r, c] += jacobian[i, r] * turned[i, c]
     found, schur_inverse = _solve_small(schur, np.eye(5))
     if not found:
-        return False, empty, empty
-    return True, turned, schur_inverse
+        return False, empty, empty, empty
+    return True, turned, schur_inverse, jacobian
 
 
 _JACOBIAN_SIGNATURE = "f8[:, :, :, :](f8[:], f8[:, :, :], f8, f8)"
@@ -719,10 +723,10 @@ def newton_step(op, point, f_scaled):
                                   point.y.size)
 
 
-def column_turn(old, new, coupling, mu):
+def column_turn(old, new, coupling, mu, tolerance=0.0):
     """:func:`slewing_model.reduced_operator.column_turn` by the compiled loop."""
-    found, coupling, schur_inverse = compiled_column_turn()(old, new, coupling, mu)
-    return (coupling, schur_inverse) if found else None
+    found, coupling, schur_inverse, jacobian = compiled_column_turn()(old, new, coupling, mu, tolerance)
+    return (coupling, schur_inverse, jacobian) if found else None
 
 
 def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):

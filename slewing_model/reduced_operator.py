@@ -96,7 +96,15 @@ def operator_coupling(inverse: np.ndarray, ja: np.ndarray, mu: float):
     return coupling, np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
 
 
-def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: bool = True,
+#: how far a turned Jacobian may be off the ring's own where errors move the grooves with it
+#: (relative to its largest entry): the kept operator then stands for ``J_old T`` instead of
+#: ``J_new``, a modified Newton operator like any kept one (its springs' stiffnesses are those of
+#: an earlier iterate, percents off before a refresh); table3 with errors: 4e-8 a step, at most
+#: 2e-5 after a turn of one radian
+APPROXIMATE_TURN = 1e-4
+
+
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, tolerance: float = 0.0,
                     arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
     """The kept operator after the ring turned (:meth:`slewing_model.bime.BimeSolver.set_rotation`).
 
@@ -105,36 +113,42 @@ def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, may_turn: boo
     manufacturing errors) turning the balls by an angle only mixes the Jacobian's columns,
     ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
     ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``
-    (:func:`column_turn`). Otherwise (errors move
-    the groove centres with the ring) the coupling is formed anew, without trying the turn
-    where the caller knows it (``may_turn`` False). The operator itself when the Jacobian did
-    not change."""
+    (:func:`column_turn`). Where errors move the groove centres with the ring, ``J_old T`` is
+    off ``J_new`` by the errors' share: within ``tolerance`` (the caller's, e.g.
+    :data:`APPROXIMATE_TURN`) the operator is turned all the same and stands for ``J_old T``;
+    otherwise the coupling is formed anew. The operator itself when the Jacobian did not
+    change."""
     ja = jacobian.reshape(-1, 5)[op.rows]
     if op.jacobian.shape == ja.shape and (op.jacobian == ja).all():
         return op
     arithmetic = _arithmetic(arithmetic)
     turned = None
-    if may_turn and op.jacobian.shape == ja.shape:
-        turned = arithmetic.turn(op.jacobian, ja, op.coupling, mu)
+    if op.jacobian.shape == ja.shape:
+        turned = arithmetic.turn(op.jacobian, ja, op.coupling, mu, tolerance)
     if turned is None:
         return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, arithmetic)
-    coupling, schur_inverse = turned
-    return ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, ja, coupling, schur_inverse)
+    coupling, schur_inverse, turned_jacobian = turned
+    return ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, turned_jacobian, coupling,
+                           schur_inverse)
 
 
-def column_turn(old: np.ndarray, new: np.ndarray, coupling: np.ndarray, mu: float):
-    """The coupling ``coupling T`` and the Schur complement's inverse ``(J_new^T coupling T + mu I)^-1``
-    where the Jacobian ``new`` (n, 5) is ``old T`` (``T`` fitted by least squares, used where it
-    reproduces ``new`` to 1e-12: then ``coupling T = W^-1 old T = W^-1 new``), or None (no ``T``
-    does: errors move the grooves with the ring; or the fit's normal equations are singular)."""
+def column_turn(old: np.ndarray, new: np.ndarray, coupling: np.ndarray, mu: float, tolerance: float = 0.0):
+    """The coupling ``coupling T``, the Schur complement's inverse ``(J^T coupling T + mu I)^-1`` and
+    the Jacobian ``J`` they are for, where ``old T`` (``T`` fitted to ``new`` by least squares)
+    reproduces ``new`` to 1e-12 (``J = new``: then ``coupling T = W^-1 old T = W^-1 new``) or to
+    ``tolerance`` (``J = old T``); or None (no ``T`` does: errors move the grooves with the ring;
+    or the fit's normal equations are singular)."""
     try:
         turn = np.linalg.solve(old.T @ old, old.T @ new)
     except np.linalg.LinAlgError:      # J_a of rank < 5 (fewer than three loaded diagonals)
         return None
-    if not np.abs(old @ turn - new).max() <= 1e-12 * np.abs(new).max():
+    fitted = old @ turn
+    misfit = np.abs(fitted - new).max()
+    if not misfit <= max(tolerance, 1e-12) * np.abs(new).max():
         return None
+    jacobian = new if misfit <= 1e-12 * np.abs(new).max() else fitted
     coupling = coupling @ turn
-    return coupling, np.linalg.inv(new.T @ coupling + mu * np.eye(5))
+    return coupling, np.linalg.inv(jacobian.T @ coupling + mu * np.eye(5)), jacobian
 
 
 def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
