@@ -90,7 +90,7 @@ def ship_compiled_kernels(fmu) -> list[Path]:
     """Add numba's cache of the compiled loops (friction, contacts) to the FMU's copy of ``slewing_model``.
 
     An instance compiles the loops when it starts (:func:`slewing_model.friction_kernel.compile_all`),
-    about twenty seconds, unless numba's cache beside the source holds them: numba keys that cache
+    about half a minute, unless numba's cache beside the source holds them: numba keys that cache
     by the source's content (not its path or time), so the entries made here are valid in any
     folder the FMU is unpacked to, on this machine (another CPU compiles them anew, once per
     unpacked folder). Compiles (or loads) the loops here, in ``slewing_model/__pycache__``, and
@@ -109,7 +109,7 @@ def ship_compiled_kernels(fmu) -> list[Path]:
                                  f"{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
     if not files:
         warnings.warn(f"numba's cache of the compiled loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
-                      "writable): the FMU will compile them when instantiated (about 20 s)")
+                      "writable): the FMU will compile them when instantiated (about 35 s)")
     with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive:
         for f in files:
             archive.write(f, f"resources/slewing_model/__pycache__/{f.name}")

@@ -158,9 +158,7 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
     radius = np.broadcast_to(bearing.groove_radius, (n, 4)).copy()
     for cols, rc in measured:
         radius[:, cols] = rc
-    dw = np.full(n, bearing.ball_diameter + bearing.preload)
-    if errors is not None and errors.ball_diameter_deviation is not None:
-        dw = dw + errors.ball_diameter_deviation
+    dw = ball_diameters(bearing)
     k = houpert_stiffness(dw[:, None], dw[:, None] / (2.0 * radius), bearing.youngs_modulus, bearing.poisson_ratio)
     k_tot = diagonal_stiffness(k[:, OUTER_OF_DIAGONAL], k[:, INNER_OF_DIAGONAL])
     natural = radius[:, OUTER_OF_DIAGONAL] + radius[:, INNER_OF_DIAGONAL] - dw[:, None]
@@ -169,6 +167,14 @@ def assemble(bearing: Bearing, psi: float = 0.0, cage_angle: float | None = None
         contact_stiffness=k, stiffness=k_tot, natural_length=natural,
         moving_sign=sign,
     )
+
+
+def ball_diameters(bearing: Bearing) -> np.ndarray:
+    """Diameter of every ball (B,), m: the nominal one with the preload and each ball's deviation."""
+    dw = np.full(bearing.ball_count, bearing.ball_diameter + bearing.preload)
+    if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
+        dw = dw + bearing.errors.ball_diameter_deviation
+    return dw
 
 
 def _compiled_groove_errors(centre: np.ndarray, theta: np.ndarray, error_map, cols: list) -> np.ndarray | None:

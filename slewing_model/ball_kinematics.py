@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .assembly import ball_diameters
 from .contact_friction import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .friction_kernel import (
@@ -128,11 +129,8 @@ def distribution_arrays(bearing: Bearing, distribution, writable: bool = False) 
 
 
 def ball_radii(bearing: Bearing) -> np.ndarray:
-    """Radius of every ball (B,), m: the diameter with the preload and each ball's deviation."""
-    dw = np.full(bearing.ball_count, bearing.ball_diameter + bearing.preload)
-    if bearing.errors is not None and bearing.errors.ball_diameter_deviation is not None:
-        dw = dw + bearing.errors.ball_diameter_deviation
-    return 0.5 * dw
+    """Radius of every ball (B,), m (:func:`slewing_model.assembly.ball_diameters`)."""
+    return 0.5 * ball_diameters(bearing)
 
 
 class ContactSet:
@@ -294,14 +292,12 @@ class ContactPoints:
                  compiled: bool = False):
         geo = self.geometry = geometry
         self.compiled = compiled           # evaluate with the compiled loop (friction_kernel)
-        u_nodes, t2, weight = quad.across_nodes, quad.along_squared, quad.folded_weight
+        u_nodes, self.t2, weight = quad.writable_arrays   # (the compiled loops take no read-only arrays)
         if compiled:                       # the same formulas, one compiled loop (friction_kernel)
             (self.g10, self.g12, self.h1, self.s0, self.s1, self.hs, self.arm1,
-             self.arm2) = compiled_point_coefficients()(*geo.columns, np.array(u_nodes), geo.length_scale,
-                                                        geo.pitch_radius)
+             self.arm2) = compiled_point_coefficients()(*geo.columns, u_nodes, geo.length_scale, geo.pitch_radius)
         else:
             self._coefficients(geo, u_nodes)
-        self.t2 = np.array(t2, dtype=float)          # writable (the compiled loop takes no read-only arrays)
         space = self._space = _workspace(workspace)
         shape = (self.t2.size, geo.ball_index.size, quad.n_across)
         self.weight = np.multiply(weight[:, None, :], geo.mu_load[:, None], out=space.get("weight", shape))

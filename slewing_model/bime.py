@@ -350,11 +350,8 @@ class BimeSolver:
                     f"for loads {loads}")
             if (self._product_operands is not None and not handed_back
                     and not _refresh_due(residual, last_residual, self.rtol)):
-                if self._reduced is not None and self._reduced_jacobian is not self._jacobian_rows:
-                    # the ring turned since (set_rotation): the coupling follows, as in _flexible_direction
-                    self._reduced = turned_operator(self._reduced, self.jacobian, mu, self._turn_tolerance,
-                                                    self._arithmetic)
-                    self._reduced_jacobian = self._jacobian_rows
+                if self._reduced is not None:
+                    self._reduced, self._reduced_jacobian = self._turned(self._reduced, mu), self._jacobian_rows
                 if self._kept_operator_serves():
                     # the iterations that keep the operator, in one compiled loop, as far as they go; the
                     # one it stopped before is this loop's (handed_back)
@@ -409,6 +406,14 @@ class BimeSolver:
         if self._product_operands is None:
             return self.compliance @ v
         return compiled_ring_times()(*self._product_operands, np.ascontiguousarray(v, dtype=float))
+
+    def _turned(self, op: ReducedOperator, mu: float) -> ReducedOperator:
+        """The kept operator ``op`` with its coupling to (X, Y, Z, rx, ry) following the ring's turn
+        since it was formed (:meth:`set_rotation`; ``W^-1`` holds): :func:`turned_operator`, where
+        the Jacobian is another array than the one the operator's coupling is for."""
+        if self._reduced_jacobian is self._jacobian_rows:
+            return op
+        return turned_operator(op, self.jacobian, mu, self._turn_tolerance, self._arithmetic)
 
     def _kept_operator_serves(self) -> bool:
         """Whether the next iteration may keep the reduced operator as it is, all else equal: its
@@ -532,11 +537,7 @@ class BimeSolver:
             return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
 
         if not fresh and op is not None:
-            if self._reduced_jacobian is not self._jacobian_rows:
-                # the ring turned since (set_rotation): W^-1 holds, the coupling to (X, Y, Z, rx, ry) follows
-                op = turned_operator(op, self.jacobian, mu, tolerance=self._turn_tolerance,
-                                     arithmetic=self._arithmetic)
-            op = bordered(op)
+            op = bordered(self._turned(op, mu))
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
                 op = bordered(complete_operator(self.pending_operator, self.jacobian, mu, self._arithmetic))
                 self.pending_operator = None

@@ -243,12 +243,7 @@ def _column_turn(old, new, coupling, mu, tolerance):
             value = coupling[i, k]
             for c in range(5):
                 turned[i, c] += value * turn[k, c]
-    schur = mu * np.eye(5)                                       # J^T coupling T + mu I
-    for i in range(n):
-        for r in range(5):
-            for c in range(5):
-                schur[r, c] += jacobian[i, r] * turned[i, c]
-    found, schur_inverse = _solve_small(schur, np.eye(5))
+    found, schur_inverse = _schur_inverse(jacobian, turned, mu)
     if not found:
         return False, empty, empty, empty
     return True, turned, schur_inverse, jacobian
@@ -337,13 +332,10 @@ def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, m
         for c in range(5):
             for m in range(r):
                 new_coupling[n + k, c] += schur[k, m] * d[m, c]
-    normal = mu * np.eye(5)                        # J_new^T W_new^-1 J_new + mu I
-    for i in range(n + r):
-        for a in range(5):
-            row = jacobian[i, a] if i < n else new_jacobian[i - n, a]
-            for c in range(5):
-                normal[a, c] += row * new_coupling[i, c]
-    found, schur_inverse = _solve_small(normal, np.eye(5))
+    ja = np.empty((n + r, 5))                      # J_new
+    ja[:n] = jacobian
+    ja[n:] = new_jacobian
+    found, schur_inverse = _schur_inverse(ja, new_coupling, mu)
     if not found:
         return np.empty((0, 0)), empty, empty
     return bordered, new_coupling, schur_inverse
@@ -387,15 +379,20 @@ def _operator_coupling(inverse, ja, mu):
     """:func:`slewing_model.reduced_operator.operator_coupling` as one compiled loop: ``W^-1 J_a``
     summed column by column (:func:`_symmetric_times`) and
     ``(J_a^T W^-1 J_a + mu I)^-1``, or an empty inverse where that is singular."""
-    n = ja.shape[0]
-    coupling_t = _symmetric_times(inverse, np.ascontiguousarray(ja.T))
+    coupling = np.ascontiguousarray(_symmetric_times(inverse, np.ascontiguousarray(ja.T)).T)
+    found, schur_inverse = _schur_inverse(ja, coupling, mu)
+    return coupling, schur_inverse if found else np.empty((0, 0))
+
+
+def _schur_inverse(jacobian, coupling, mu):
+    """``(J^T C + mu I)^-1`` for a Jacobian ``J`` and coupling ``C = W^-1 J`` (n, 5): the reduced
+    operator's Schur complement, inverted by :func:`_solve_small` (False where singular)."""
     normal = mu * np.eye(5)
-    for a in range(5):
-        for c in range(5):
-            for i in range(n):
-                normal[a, c] += ja[i, a] * coupling_t[c, i]
-    found, schur_inverse = _solve_small(normal, np.eye(5))
-    return np.ascontiguousarray(coupling_t.T), schur_inverse if found else np.empty((0, 0))
+    for i in range(jacobian.shape[0]):
+        for a in range(5):
+            for c in range(5):
+                normal[a, c] += jacobian[i, a] * coupling[i, c]
+    return _solve_small(normal, np.eye(5))
 
 
 def _segment(x, xp, guess):
@@ -691,12 +688,15 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
             np.array([total, energy_scale, peak_force, peak_residual, n_loaded]))
 
 
+#: the helpers the load distribution's loops call
+_HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_periodic_interp",
+            "_trial_point", "_newton_step", "_ring_times", "_schur_inverse")
+
+
 def _compile(function, signature):
     """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
     numpy code does, instead of raising."""
-    return compile_loop(function, signature, ("_segment", "_interp", "_solve_small", "_hertz_contact",
-                                              "_symmetric_times", "_periodic_interp", "_trial_point",
-                                              "_newton_step", "_ring_times"), error_model="numpy")
+    return compile_loop(function, signature, _HELPERS, error_model="numpy")
 
 
 #: (factory, Python function) of each compiled loop of the load distribution

@@ -72,7 +72,7 @@ class EllipseQuadrature:
     @functools.cached_property
     def writable_arrays(self) -> tuple:
         """``across_nodes``, ``along_squared`` and ``folded_weight`` as writable copies, made once
-        (the compiled friction loop takes no read-only arrays; it does not write them)."""
+        (the compiled friction loops take no read-only arrays; no code writes into them)."""
         return (np.array(self.across_nodes, dtype=float), np.array(self.along_squared, dtype=float),
                 np.array(self.folded_weight, dtype=float))
 

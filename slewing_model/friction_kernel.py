@@ -18,7 +18,7 @@ numba is optional (it is not part of the FMU's run-time requirements): without i
 :data:`AVAILABLE` is False and the friction model uses its numpy code, which gives the same
 results to round-off (``tests/test_friction_kernel.py``). The loops are compiled when first
 asked for (:func:`compile_all`), which the simulator does when it is built, so that the compile
-time lands in the FMU's instantiation, never in a step. Compiling takes about ten seconds;
+time lands in the FMU's instantiation, never in a step. Compiling takes about half a minute;
 numba's on-disk cache (``__pycache__`` beside this file, keyed by the source's content) makes it
 a fraction of a second after the first time, and ``build_fmu.py`` ships that cache in the FMU.
 """
