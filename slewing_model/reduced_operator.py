@@ -324,8 +324,9 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     ``r`` new rows instead of O(n^3). The new rows come after the kept ones (the operator's
     rows are in the order they entered), and the coupling follows by the same blocks:
     ``W_new^-1 J_new = [W^-1 J - X S d, S d]``, ``d = J_r - X^T J``, with ``op`` turned to
-    ``jacobian`` first (:func:`turned_operator`). Returns None (form anew) when more than a
-    quarter of the rows would be new. The blocks are :func:`bordered_inverse`'s."""
+    ``jacobian`` first (:func:`turned_operator`; where it was turned nearly, the kept rows keep the
+    Jacobian their coupling is for). Returns None (form anew) when more than a quarter of the rows
+    would be new. The blocks are :func:`bordered_inverse`'s."""
     closed = active & ~op.active
     new_rows = np.flatnonzero(np.repeat(closed, 2))
     if new_rows.size > 0.25 * op.rows.size:
@@ -335,10 +336,12 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
     c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
     _add_blocks(c_mat, new_a_inv)
+    new_jacobian = jacobian.reshape(-1, 5)[new_rows]
     inverse, coupling, schur_inverse = _arithmetic(arithmetic).border(
-        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, jacobian.reshape(-1, 5)[new_rows], mu)
+        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, new_jacobian, mu)
+    # the kept rows keep the Jacobian their coupling is for (a nearly turned one: turned_operator)
     return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
-                           jacobian.reshape(-1, 5)[rows], coupling, schur_inverse)
+                           np.concatenate([op.jacobian, new_jacobian]), coupling, schur_inverse)
 
 
 def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):

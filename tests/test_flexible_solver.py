@@ -353,6 +353,32 @@ def test_operator_after_a_turn_equals_one_formed_anew(bearing, with_errors):
     assert np.allclose(turned.schur_inverse, formed.schur_inverse, rtol=1e-9, atol=1e-12 * np.abs(formed.schur_inverse).max())
 
 
+def test_nearly_turned_operator_bordered_stays_one_operator(bearing):
+    """A kept operator nearly turned (grooves with errors, :data:`APPROXIMATE_TURN`) stands for the
+    turned old Jacobian; bordered by a contact that closes, its rows keep that Jacobian, so that
+    its coupling is still ``W^-1 J`` of the Jacobian it holds."""
+    from slewing_model.errors import synthetic_errors
+    from slewing_model.reduced_operator import APPROXIMATE_TURN, assemble_operator, turned_operator, update_operator
+
+    bearing = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=2))
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    result = solver.solve(LOADS[1])
+    f_scaled = solver._scaled_load(LOADS[1])
+    point = solver._evaluate(result.state[:5], result.state[5:], f_scaled)
+    mu, stiffness = 1e-12 * solver.reference_stiffness, solver.assembly.stiffness
+    fewer = point.loaded.copy()
+    fewer[np.flatnonzero(fewer)[0]] = False                   # one loaded diagonal left out, to border in
+    op = assemble_operator(point, solver.compliance, stiffness, solver.jacobian, fewer, mu)
+    solver.set_rotation(0.3)
+    near = turned_operator(op, solver.jacobian, mu, APPROXIMATE_TURN)
+    assert not np.array_equal(near.jacobian, solver.jacobian.reshape(-1, 5)[near.rows])      # nearly, not exactly
+    bordered = update_operator(near, point, solver.compliance, stiffness, solver.jacobian, point.loaded, mu)
+    assert bordered.rows.size == near.rows.size + 2
+    assert np.array_equal(bordered.jacobian[:near.rows.size], near.jacobian)
+    coupling = bordered.inverse @ bordered.jacobian
+    assert np.abs(bordered.coupling - coupling).max() <= 1e-9 * np.abs(coupling).max()
+
+
 def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
     """On one or two loaded diagonals the Jacobian has rank below 5 and no column turn can be
     fitted: the coupling is then formed anew, without error (found by a review: a singular solve)."""
