@@ -1,16 +1,24 @@
 #!/usr/bin/env python3
-"""Build the slewing bearing FMU (FMI 2.0 co-simulation) for one bearing definition.
+"""Build the slewing bearing FMU (FMI 2.0 or 3.0 co-simulation) for one bearing definition.
 
-    python build_fmu.py BEARING.toml [-o FILE.fmu] [--bc free|clamped|frictionless] [--mesh coarse|fine] [--fmi-version 2|3]
+    python build_fmu.py BEARING.toml [-o FILE.fmu] [--bc free|clamped|frictionless] [--mesh coarse|fine]
+                        [--fmi-version 2|3] [--runtime standalone|host] [--numba | --no-numba]
 
 Builds (or takes from the cache) the ring superelement, then packages with
-pythonfmu: the slave ``fmu_src/SlewingBearing.py``, the run-time modules of
-``slewing_model`` (numpy only: no scipy, no scikit-fem), ``bearing.json`` (the
-definition in SI units) and ``superelement.npz``. For FMI 2.0 it then compiles
-the FMU's Linux binary (``fmu_src/shim/``, needs a C compiler), which loads the
-Python named in ``resources/python_runtime.txt`` in front of pythonfmu's binary:
-C and C++ hosts need no LD_PRELOAD and no Python on their PATH
-(``docs/fmu_hosts.md``).
+pythonfmu (FMI 2.0) or pythonfmu3 (FMI 3.0): the slave ``fmu_src/SlewingBearing.py``,
+the run-time modules of ``slewing_model`` (numpy only: no scipy, no scikit-fem),
+``bearing.json`` (the definition in SI units) and ``superelement.npz``. It then
+compiles the FMU's Linux binary (``fmu_src/shim/``, needs a C compiler), a layer in
+front of pythonfmu's that starts Python in a C host:
+
+* ``--runtime standalone`` (default): the FMU carries its own Python
+  (``build_runtime.py``: libpython, the standard library, numpy and, with ``--numba``,
+  numba and the compiled loops), found relative to the unpacked FMU. The target
+  needs nothing but Linux x86-64 with the glibc floor the build prints.
+* ``--runtime host``: the light "tool coupling" FMU, which runs in the Python named in
+  ``resources/python_runtime.txt`` (the building one) or by ``SLEWING_FMU_PYTHONHOME``.
+
+See the README's "The FMU on another machine" and ``docs/fmu_hosts.md``.
 """
 from __future__ import annotations
 
@@ -27,10 +35,12 @@ import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
+from build_runtime import building_machine_paths, newest_version, scrub_paths, version_needs  # noqa: E402
 from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing_model the FMU runs with)
 
 
-def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2) -> Path:
+def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
+              runtime="standalone", numba=None) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -46,9 +56,16 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     fmi_version : {2, 3}
         2 (default): FMI 2.0 with pythonfmu, per-ball results as scalars ``ball[i].Q1``...;
         3: FMI 3.0 with pythonfmu3 (``fmu_src/SlewingBearing3.py``), per-ball results as arrays.
+    runtime : {"standalone", "host"}
+        "standalone" (default): the FMU carries its Python runtime and runs where there is no
+        Python; "host": it runs in the building Python (or one named on the target).
+    numba : bool, optional
+        Carry numba and the compiled loops (faster steps, a larger FMU). Default: False for a
+        standalone FMU; for a host FMU, True where numba is installed here.
     """
     if fmi_version not in (2, 3):
         raise ValueError(f"fmi_version = {fmi_version!r}: must be 2 or 3")
+    numba = resolve_numba(runtime, numba)
     from pythonfmu import FmuBuilder
 
     from slewing_model import load_bearing
@@ -69,21 +86,42 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 shutil.copy2(source, package / source.name)
         (tmp / "bearing.json").write_text(json.dumps(bearing.to_dict()))
         superelement.save(tmp / "superelement.npz")
+        (tmp / KERNELS_FILE).write_text("auto\n" if numba else "numpy\n")
+        files = [package, tmp / "bearing.json", tmp / "superelement.npz", tmp / KERNELS_FILE,
+                 ROOT / "fmu_src" / "bearing_variables.py"]
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
-            built = _build_fmi3(output, [package, tmp / "bearing.json", tmp / "superelement.npz",
-                                         ROOT / "fmu_src" / "bearing_variables.py"])
-            ship_compiled_kernels(built)
-            return built
-        built = FmuBuilder.build_FMU(
-            ROOT / "fmu_src" / "SlewingBearing.py", dest=output,
-            project_files=[package, tmp / "bearing.json", tmp / "superelement.npz",
-                           ROOT / "fmu_src" / "bearing_variables.py"],
-            canGetAndSetFMUstate=True, canSerializeFMUstate=True,
-            needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
-        )
-    install_python_shim(built, "SlewingBearing", fmi_version=2)
-    ship_compiled_kernels(built)
+            built = _build_fmi3(output, files)
+        else:
+            built = FmuBuilder.build_FMU(
+                ROOT / "fmu_src" / "SlewingBearing.py", dest=output, project_files=files,
+                canGetAndSetFMUstate=True, canSerializeFMUstate=True,
+                needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
+            )
+    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba)
+    if numba:
+        ship_compiled_kernels(built)
     return Path(built)
+
+
+#: the file of the FMU's resources that names the loops it runs (fmu_src/bearing_variables.py reads it)
+KERNELS_FILE = "kernels.txt"
+RUNTIMES = ("standalone", "host")
+
+
+def resolve_numba(runtime: str, numba=None) -> bool:
+    """Whether an FMU of ``runtime`` carries numba: ``numba`` where given, else False for a
+    standalone FMU and, for a host FMU, whether numba is installed here. ValueError for an
+    unknown runtime; RuntimeError where numba is asked for and not installed."""
+    if runtime not in RUNTIMES:
+        raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
+    from slewing_model import friction_kernel
+
+    if numba is None:
+        return runtime == "host" and friction_kernel.AVAILABLE
+    if numba and not friction_kernel.AVAILABLE:
+        raise RuntimeError("numba = True: numba is not installed in this Python (pip install numba==0.68.1, "
+                           "or build without numba)")
+    return bool(numba)
 
 
 def ship_compiled_kernels(fmu) -> list[Path]:
@@ -110,9 +148,16 @@ def ship_compiled_kernels(fmu) -> list[Path]:
     if not files:
         warnings.warn(f"numba's cache of the compiled loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
                       "writable): the FMU will compile them when instantiated (about 35 s)")
-    with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive:
+    paths = building_machine_paths()
+    with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive, \
+            tempfile.TemporaryDirectory(prefix="slewing_cache_") as tmp:
         for f in files:
-            archive.write(f, f"resources/slewing_model/__pycache__/{f.name}")
+            # the compiled code's error texts name the sources it was compiled from: overwritten with
+            # '/' of the same length (numba checks the source's hash, numba's version and the CPU)
+            copy = Path(tmp) / f.name
+            shutil.copy2(f, copy)
+            scrub_paths(copy, paths)
+            archive.write(copy, f"resources/slewing_model/__pycache__/{f.name}")
     return files
 
 
@@ -132,7 +177,7 @@ def _build_fmi3(output: Path, project_files) -> Path:
 # ---- the Linux binary: our layer in front of pythonfmu's (fmu_src/shim/) -------------------------
 SHIM_DIR = ROOT / "fmu_src" / "shim"
 #: C sources of the Linux binary, per FMI version: the FMI layer and the Python loader it calls
-SHIM_SOURCES = {2: ("fmi2_shim.c", "python_runtime.c")}
+SHIM_SOURCES = {2: ("fmi2_shim.c", "python_runtime.c"), 3: ("fmi3_shim.c", "python_runtime.c")}
 #: folder of the Linux x86-64 binary in the FMU, per FMI version
 LINUX_BINARIES = {2: "binaries/linux64", 3: "binaries/x86_64-linux"}
 #: name our layer gives pythonfmu's binary (it loads it from its own folder)
@@ -167,8 +212,9 @@ def compile_shim(output, fmi_version=2) -> Path:
         raise ValueError(f"fmi_version = {fmi_version!r}: the Linux shim exists for FMI "
                          + ", ".join(map(str, SHIM_SOURCES))) from None
     output = Path(output)
-    command = [c_compiler(), "-shared", "-fPIC", "-O2", "-g0", "-fvisibility=hidden", "-Wall",
-               "-o", str(output), *map(str, sources), "-ldl", "-lpthread"]
+    # libdl.so.2 named: on a glibc older than 2.34 dlopen lives there (glibc_compat.h)
+    command = [c_compiler(), "-shared", "-fPIC", "-O2", "-g0", "-fvisibility=hidden", "-Wall", "-Wno-format-truncation",
+               "-o", str(output), *map(str, sources), "-Wl,--no-as-needed", "-l:libdl.so.2", "-lpthread"]
     run = subprocess.run(command, capture_output=True, text=True, cwd=SHIM_DIR)
     if run.returncode != 0:
         raise RuntimeError(f"compiling the FMU's Linux binary failed ({' '.join(command)}):\n{run.stderr}")
@@ -188,35 +234,81 @@ def python_runtime() -> dict[str, str]:
             "environment": sys.prefix}
 
 
-def install_python_shim(fmu, model_identifier, fmi_version=2) -> None:
-    """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place).
+def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False) -> dict:
+    """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
+    for a standalone FMU the Python runtime beside it.
 
     pythonfmu's binary becomes ``INNER_BINARY``; ours, compiled here, takes the model
-    identifier's name and loads the Python named by ``resources/python_runtime.txt``
-    (written here) before it. The Windows binary is left as pythonfmu wrote it."""
+    identifier's name and starts the Python that ``resources/python_runtime.txt`` (written here)
+    describes before it: the runtime the FMU carries (``binaries/<platform>/python``,
+    :mod:`build_runtime`), or for ``runtime="host"`` the building Python. The file also states the
+    FMU's glibc floor: the newest glibc version any of its Linux binaries needs. The Windows
+    binary is left as pythonfmu wrote it. Returns what the file says, as a dict."""
+    if runtime not in RUNTIMES:
+        raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
     fmu = Path(fmu)
     folder = LINUX_BINARIES[fmi_version]
     binary = f"{folder}/{model_identifier}.so"
-    runtime = "".join(f"{k}={v}\n" for k, v in python_runtime().items())
-    header = (f"# The Python this FMU runs its model in (written by build_fmu.py). On a machine where it\n"
-              f"# lives elsewhere, set {PYTHON_HOME_VARIABLE} to a Python installation or virtual environment\n"
-              f"# with numpy (same minor version), or edit this file.\n")
     with tempfile.TemporaryDirectory(prefix="slewing_shim_") as tmp:
-        shim = compile_shim(Path(tmp) / f"{model_identifier}.so", fmi_version)
-        rewritten = Path(tmp) / "rewritten.fmu"
-        with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(rewritten, "w", zipfile.ZIP_DEFLATED) as dst:
-            names = src.namelist()
-            if binary not in names:
+        tmp = Path(tmp)
+        shim = compile_shim(tmp / f"{model_identifier}.so", fmi_version)
+        rewritten = tmp / "rewritten.fmu"
+        with zipfile.ZipFile(fmu) as src:
+            if binary not in src.namelist():
                 raise RuntimeError(f"{fmu} has no {binary}: is it a pythonfmu FMU of {model_identifier}?")
-            for info in src.infolist():
-                data = src.read(info.filename)
-                if info.filename == binary:
-                    dst.writestr(f"{folder}/{INNER_BINARY}", data)
-                elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
-                    dst.writestr(info, data)
-            dst.write(shim, binary)
-            dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}", header + runtime)
+            inner = tmp / INNER_BINARY
+            inner.write_bytes(src.read(binary))
+            needs = [version_needs(inner), version_needs(shim)]
+            if runtime == "standalone":
+                from build_runtime import runtime as bundled_runtime
+
+                carried = bundled_runtime(folder, numba=numba)
+                shutil.copy2(carried.archive, rewritten)        # the runtime's entries, compressed once
+                described = {"runtime": "standalone", "folder": "python", "library": carried.library,
+                             "version": carried.python,
+                             "packages": " ".join(f"{k}=={v}" for k, v in carried.packages.items())}
+                floor = {"glibc": carried.glibc, "glibcxx": carried.glibcxx}
+            else:
+                described = {"runtime": "host", **python_runtime()}
+                floor = {"glibc": "", "glibcxx": ""}
+            floor = {key: max(filter(None, [floor[key], newest_version(needs, key.upper() + "_")]),
+                              key=lambda v: tuple(map(int, v.split("."))), default="") for key in floor}
+            described.update(floor)
+            header = ("# The Python this FMU runs its model in (written by build_fmu.py).\n"
+                      + ("# standalone: the runtime in binaries/<platform>/<folder>, found relative to the binary;\n"
+                         "# the machine needs Linux x86-64 with glibc >= the floor below, nothing else.\n"
+                         if runtime == "standalone" else
+                         f"# host: on a machine where this Python lives elsewhere, set {PYTHON_HOME_VARIABLE} to a\n"
+                         "# Python installation or virtual environment with numpy (same minor version).\n"))
+            with zipfile.ZipFile(rewritten, "a", zipfile.ZIP_DEFLATED) as dst:
+                for info in src.infolist():
+                    if info.filename == binary:
+                        dst.write(inner, f"{folder}/{INNER_BINARY}")
+                    elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
+                        dst.writestr(info, src.read(info.filename))
+                dst.write(shim, binary)
+                dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}",
+                             header + "".join(f"{k}={v}\n" for k, v in described.items()))
         shutil.move(str(rewritten), fmu)
+    return described
+
+
+def runtime_of(fmu) -> dict:
+    """What ``resources/python_runtime.txt`` of a built FMU says (runtime, glibc floor, Python, packages)."""
+    with zipfile.ZipFile(fmu) as z:
+        text = z.read(f"resources/{PYTHON_RUNTIME_FILE}").decode()
+    return dict(line.split("=", 1) for line in text.splitlines() if "=" in line and not line.startswith("#"))
+
+
+def describe_fmu(fmu) -> str:
+    """One paragraph for the user: what the target machine needs to run ``fmu``."""
+    r = runtime_of(fmu)
+    floor = f"Linux x86-64 with glibc {r['glibc']} or newer (check: ldd --version)"
+    if r.get("runtime") == "standalone":
+        return (f"standalone FMU: it carries Python {r['version']} with {r['packages'].replace(' ', ', ')}; "
+                f"the target needs {floor}, and no Python.")
+    return (f"host FMU: it runs in Python {r['version']} with numpy, at {r['environment']} or where "
+            f"{PYTHON_HOME_VARIABLE} names one; the target needs that and {floor}.")
 
 
 def main(argv=None) -> int:
@@ -227,6 +319,12 @@ def main(argv=None) -> int:
     parser.add_argument("--mesh", choices=("coarse", "fine"), default="fine")
     parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
                         help="FMI 2.0 (default; per-ball scalars) or FMI 3.0 (pythonfmu3; per-ball arrays)")
+    parser.add_argument("--runtime", choices=RUNTIMES, default="standalone",
+                        help="standalone (default): the FMU carries its Python and runs where there is none; "
+                             "host: it runs in this Python, or one named on the target by " + PYTHON_HOME_VARIABLE)
+    parser.add_argument("--numba", action=argparse.BooleanOptionalAction, default=None,
+                        help="carry numba and the compiled loops: steps about 3x faster, the FMU about 3x larger "
+                             "(default: no for standalone, yes for host where numba is installed)")
     parser.add_argument("--host-env", action="store_true",
                         help="only print the Python an FMU built here needs (C/C++ hosts need no environment)")
     args = parser.parse_args(argv)
@@ -241,8 +339,9 @@ def main(argv=None) -> int:
     if args.bearing is None:
         parser.error("the bearing definition is required")
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
-                      fmi_version=args.fmi_version)
-    print(f"wrote {path}")
+                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba)
+    print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")
+    print(describe_fmu(path))
     return 0
 
 

@@ -94,7 +94,7 @@ from slewing_model.simulator import BearingSimulator, decode_state, encode_state
 
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
     BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-    UNITS, build_simulator, choice_description, integer_default, scalar_outputs, step_or_refuse)
+    UNITS, build_simulator, choice_description, integer_default, kernels_of, scalar_outputs, step_or_refuse)
 
 
 class SlewingBearing(Fmi2Slave):
@@ -107,6 +107,7 @@ class SlewingBearing(Fmi2Slave):
         with open(os.path.join(resources, "bearing.json")) as fh:
             self.bearing = Bearing.from_si_dict(json.load(fh))
         self.superelement_path = os.path.join(resources, "superelement.npz")
+        self.kernels = kernels_of(resources)
         self.default_experiment = DefaultExperiment(start_time=0.0, stop_time=10.0, step_size=0.01)
         self.modelName = "SlewingBearing"
         self._units: dict[str, str] = {}

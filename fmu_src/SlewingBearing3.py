@@ -37,8 +37,8 @@ from pythonfmu3 import (DefaultExperiment, Dimension, Fmi3Causality, Fmi3Initial
                         Fmi3Variability, Float64, Int32, Unit)
 
 from bearing_variables import (BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
-                               UNITS, build_simulator, choice_description, integer_default, scalar_outputs,
-                               step_or_refuse)
+                               UNITS, build_simulator, choice_description, integer_default, kernels_of,
+                               scalar_outputs, step_or_refuse)
 from slewing_model import Bearing
 from slewing_model.simulator import BearingSimulator, decode_state, encode_state
 
@@ -52,6 +52,7 @@ class SlewingBearing3(Fmi3Slave):
         with open(os.path.join(resources, "bearing.json")) as fh:
             self.bearing = Bearing.from_si_dict(json.load(fh))
         self.superelement_path = os.path.join(resources, "superelement.npz")
+        self.kernels = kernels_of(resources)
         self.author = "slewing_model"
         self.description = ("Four-point contact slewing bearing: load distribution (Flexible-BIME) and friction "
                             "torque; per-ball results as arrays")

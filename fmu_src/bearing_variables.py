@@ -131,6 +131,23 @@ def check_inputs(values: dict) -> None:
 TUNABLE = tuple(name for name, _, _, tunable, _ in REAL_PARAMETERS if tunable)
 
 
+#: the file of an FMU's resources that names the loops its runtime carries (written by build_fmu.py)
+KERNELS_FILE = "kernels.txt"
+
+
+def kernels_of(resources: str) -> str:
+    """The loops the FMU was built to run (``resources/kernels.txt``): "numpy" for a runtime
+    without numba, so that the FMU computes the same numbers in every host, also in a Python
+    host that has numba; "auto" where the file is missing."""
+    import os
+
+    path = os.path.join(resources, KERNELS_FILE)
+    if not os.path.exists(path):
+        return "auto"
+    with open(path) as fh:
+        return fh.read().strip() or "auto"
+
+
 def build_simulator(slave, error) -> bool:
     """Create ``slave.simulator`` from the slave's parameters (attributes by name), its ``bearing``
     and ``superelement_path``; log why not (status ``error``) and return False."""
@@ -140,7 +157,9 @@ def build_simulator(slave, error) -> bool:
     slave.simulator = None
     try:
         names = [name for name, *_ in REAL_PARAMETERS] + [name for name, *_ in INTEGER_PARAMETERS]
-        settings = SimulatorSettings(**settings_of({name: getattr(slave, name) for name in names}))
+        kernels = getattr(slave, "kernels", "auto")
+        settings = SimulatorSettings(**settings_of({name: getattr(slave, name) for name in names}),
+                                     friction_kernel=kernels, contact_kernel=kernels)
         superelement = None
         if settings.ring_model == "flexible":
             superelement = Superelement.load(slave.superelement_path, slave.bearing)

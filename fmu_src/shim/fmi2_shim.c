@@ -25,6 +25,7 @@
  * Our own declarations of the FMI 2.0 types (the standard's ABI, fmi2TypesPlatform "default").
  */
 #define _GNU_SOURCE
+#include "glibc_compat.h"
 #include "python_runtime.h"
 
 #include <dlfcn.h>

@@ -1,6 +1,9 @@
 /* Loading the Python that an FMU built with pythonfmu runs its model in (see python_runtime.h). */
 #define _GNU_SOURCE
+#include "glibc_compat.h"
 #include "python_runtime.h"
+
+#include <gnu/libc-version.h>
 
 #include <dlfcn.h>
 #include <limits.h>
@@ -42,6 +45,10 @@ int python_runtime_binary_dir(const void *symbol, char *dir, size_t size, char *
 }
 
 struct runtime_file {
+    char runtime[32];   /* "standalone": the FMU carries its Python (folder); else the host's Python (home...) */
+    char folder[PATH_MAX];  /* standalone: the runtime's prefix, relative to the binary's folder */
+    char glibc[32];     /* the oldest glibc the FMU's binaries load with (X.Y) */
+    char packages[256]; /* what the runtime carries, for messages */
     char version[64];   /* X.Y.Z of the building Python */
     char home[PATH_MAX];
     char library[PATH_MAX + 64];
@@ -66,7 +73,15 @@ static void read_runtime_file(const char *binary_dir, struct runtime_file *rt)
             continue;
         *eq = '\0';
         const char *value = eq + 1;
-        if (!strcmp(line, "version"))
+        if (!strcmp(line, "runtime"))
+            snprintf(rt->runtime, sizeof rt->runtime, "%s", value);
+        else if (!strcmp(line, "folder"))
+            snprintf(rt->folder, sizeof rt->folder, "%s", value);
+        else if (!strcmp(line, "glibc"))
+            snprintf(rt->glibc, sizeof rt->glibc, "%s", value);
+        else if (!strcmp(line, "packages"))
+            snprintf(rt->packages, sizeof rt->packages, "%s", value);
+        else if (!strcmp(line, "version"))
             snprintf(rt->version, sizeof rt->version, "%s", value);
         else if (!strcmp(line, "home"))
             snprintf(rt->home, sizeof rt->home, "%s", value);
@@ -148,17 +163,114 @@ static void resolve_home(const char *prefix, char *home, size_t size)
     fclose(fh);
 }
 
+/* -1, 0 or 1 as version a is older than, equal to or newer than b ("2.31" against "2.35") */
+static int compare_versions(const char *a, const char *b)
+{
+    while (*a || *b) {
+        long x = strtol(a, (char **)&a, 10), y = strtol(b, (char **)&b, 10);
+        if (x != y)
+            return x < y ? -1 : 1;
+        if (*a == '.')
+            a++;
+        if (*b == '.')
+            b++;
+        if (!*a && !*b)
+            break;
+    }
+    return 0;
+}
+
+/* The FMU's binaries need glibc rt->glibc or newer: refuse an older system with a message that
+ * names the floor, before anything that needs it is loaded (the loader's own message would be a
+ * bare "version `GLIBC_2.35' not found" from inside the host). 0, or -1 with a message. */
+static int check_glibc(const struct runtime_file *rt, char *err, size_t errsize)
+{
+    const char *have = gnu_get_libc_version();
+    if (!*rt->glibc || compare_versions(have, rt->glibc) >= 0)
+        return 0;
+    message(err, errsize,
+            "this FMU needs glibc %s or newer (Linux x86-64, for example Debian 12, Ubuntu 22.04, RHEL 10 or newer); "
+            "this machine has glibc %s. Run it on a newer system, or ask for an FMU built on a system whose "
+            "glibc is at most %s (build_fmu.py states the floor of each FMU it builds).",
+            rt->glibc, have, have);
+    return -1;
+}
+
+/* Set one of Python's legacy configuration flags (Py_IgnoreEnvironmentFlag...) before it starts. */
+static void set_flag(void *handle, const char *name, int value)
+{
+    int *flag = (int *)dlsym(handle, name);
+    if (flag)
+        *flag = value;
+}
+
+/* The Python the FMU carries (runtime=standalone): <binary_dir>/<folder>, a Python prefix with
+ * the standard library, numpy and, where built so, numba. Started isolated: the host's
+ * environment (PYTHONPATH, PYTHONHOME) and user site-packages are not looked at, so the model
+ * runs with exactly the packages it was built with. */
+static int load_standalone(const char *binary_dir, const struct runtime_file *rt, char *err, size_t errsize)
+{
+    char home[PATH_MAX], library[PATH_MAX + 64], stdlib[PATH_MAX + 64], program[PATH_MAX + 32];
+    char minor[16] = "3";
+    if (!minor_version(rt->version, minor, sizeof minor)) {
+        message(err, errsize, "resources/%s names no Python version.", PYTHON_RUNTIME_FILE);
+        return -1;
+    }
+    snprintf(home, sizeof home, "%s/%s", binary_dir, rt->folder);
+    snprintf(library, sizeof library, "%s/lib/%s", home, rt->library);
+    snprintf(stdlib, sizeof stdlib, "%s/lib/python%s/encodings/__init__.py", home, minor);
+    if (!exists(library) || !exists(stdlib)) {
+        message(err, errsize, "the FMU's Python runtime is incomplete: %s is missing (was the FMU unpacked whole?).",
+                exists(library) ? stdlib : library);
+        return -1;
+    }
+    void *handle = dlopen(library, RTLD_NOW | RTLD_GLOBAL);
+    if (!handle) {
+        message(err, errsize, "cannot load the FMU's Python library %s: %s (the FMU needs Linux x86-64 with "
+                "glibc %s or newer).", library, dlerror(), rt->glibc);
+        return -1;
+    }
+    void (*set_home)(const wchar_t *) = (void (*)(const wchar_t *))dlsym(handle, "Py_SetPythonHome");
+    void (*set_program)(const wchar_t *) = (void (*)(const wchar_t *))dlsym(handle, "Py_SetProgramName");
+    wchar_t *(*decode)(const char *, size_t *) = (wchar_t * (*)(const char *, size_t *)) dlsym(handle, "Py_DecodeLocale");
+    void (*initialize)(int) = (void (*)(int))dlsym(handle, "Py_InitializeEx");
+    void *(*save_thread)(void) = (void *(*)(void))dlsym(handle, "PyEval_SaveThread");
+    if (!set_home || !decode || !initialize || !save_thread) {
+        message(err, errsize, "%s lacks Py_SetPythonHome, Py_DecodeLocale, Py_InitializeEx or PyEval_SaveThread.",
+                library);
+        return -1;
+    }
+    set_flag(handle, "Py_IgnoreEnvironmentFlag", 1);   /* no PYTHONPATH, PYTHONHOME... of the host */
+    set_flag(handle, "Py_NoUserSiteDirectory", 1);     /* no ~/.local/lib/pythonX.Y/site-packages */
+    set_home(decode(home, NULL));                      /* kept: Python keeps the pointers */
+    snprintf(program, sizeof program, "%s/bin/python%s", home, minor);
+    if (set_program)
+        set_program(decode(program, NULL));            /* sys.executable: none of the host's Pythons */
+    initialize(0);                                     /* no signal handlers: the host keeps Ctrl-C */
+    save_thread();                                     /* the GIL released for pythonfmu's PyGILState calls */
+    return 0;
+}
+
 static int load_locked(const char *binary_dir, char *err, size_t errsize)
 {
     if (python_ready)
         return 0;
+    struct runtime_file rt;
+    read_runtime_file(binary_dir, &rt);
+    if (check_glibc(&rt, err, errsize) != 0)
+        return -1;
     if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
-        /* a Python host (fmpy...) or a host linked to libpython: use its interpreter */
+        /* a Python host (fmpy...), a host linked to libpython, or another FMU of ours that
+         * started its Python in this process: one process holds one CPython, so use it */
         python_ready = 1;
         return 0;
     }
-    struct runtime_file rt;
-    read_runtime_file(binary_dir, &rt);
+    if (!strcmp(rt.runtime, "standalone")) {
+        if (load_standalone(binary_dir, &rt, err, errsize) != 0)
+            return -1;
+        python_ready = 1;
+        return 0;
+    }
     const char *env_home = getenv(PYTHON_HOME_VARIABLE);
     const char *env_library = getenv(PYTHON_LIBRARY_VARIABLE);
     if (env_home && !*env_home)
@@ -257,7 +369,13 @@ static int load_locked(const char *binary_dir, char *err, size_t errsize)
     snprintf(cfg, sizeof cfg, "%s/pyvenv.cfg", environment);
     int (*run)(const char *, void *) = (int (*)(const char *, void *))dlsym(handle, "PyRun_SimpleStringFlags");
     if (*environment && exists(cfg) && run && !strpbrk(environment, "'\\\n")) {
-        snprintf(code, sizeof code, "import site; site.addsitedir('%s/lib/python%s/site-packages')", environment, minor);
+        /* as the environment's own python3 does: its site-packages instead of the base's (which
+         * site.addsitedir alone would leave first, so the base's numpy would win over the venv's) */
+        snprintf(code, sizeof code,
+                 "import site, sys\n"
+                 "base = set(site.getsitepackages())\n"
+                 "sys.path[:] = [p for p in sys.path if p not in base]\n"
+                 "site.addsitedir('%s/lib/python%s/site-packages')\n", environment, minor);
         run(code, NULL);
     }
     save_thread();
