@@ -1,6 +1,10 @@
-/* A minimal FMI 2.0 co-simulation host, for tests/test_fmu_hosts.py.
+/* A minimal FMI 2.0 or 3.0 co-simulation host, for tests/test_fmu_hosts.py and tests/test_standalone.py.
  *
  *   host FMU_DIR MODEL_IDENTIFIER GUID SCENARIO VR... [CYCLES]
+ *
+ * Compiled as is it is an FMI 2.0 host; with -DFMI3 an FMI 3.0 host (GUID is then the
+ * instantiation token, VR the Float64 scalars' value references). With tests/c_host/start.c
+ * and -nostartfiles it starts on any x86-64 glibc (see there).
  *
  * FMU_DIR is the unzipped FMU; VR are the value references of the inputs
  * Fx Fy Fz Mx My psi omega followed by those of the outputs to print. The binary is
@@ -17,6 +21,7 @@
  */
 #include <dlfcn.h>
 #include <limits.h>
+#include <stdbool.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -26,7 +31,10 @@
 typedef void *fmi2Component;
 typedef void *fmi2FMUstate;
 typedef unsigned int fmi2ValueReference;
-typedef int fmi2Status; /* 0 OK, 1 Warning, 2 Discard, 3 Error, 4 Fatal */
+typedef int fmi2Status; /* 0 OK, 1 Warning, 2 Discard, 3 Error, 4 Fatal (FMI 3.0: the same numbers) */
+
+#ifndef FMI3
+#define PLATFORM "linux64"
 typedef struct {
     void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
     void *(*allocateMemory)(size_t, size_t);
@@ -55,6 +63,30 @@ typedef struct {
     fmi2Status (*getBooleanStatus)(fmi2Component, int, int *);
     fmi2Status (*getRealStatus)(fmi2Component, int, double *);
 } Fmu;
+#else
+#define PLATFORM "x86_64-linux"
+typedef struct {
+    void *handle;
+    fmi2Component (*instantiate)(const char *, const char *, const char *, bool, bool, bool, bool,
+                                 const fmi2ValueReference *, size_t, void *,
+                                 void (*)(void *, fmi2Status, const char *, const char *), void *);
+    void (*freeInstance)(fmi2Component);
+    fmi2Status (*enterInit)(fmi2Component, bool, double, double, bool, double);
+    fmi2Status (*exitInit)(fmi2Component);
+    fmi2Status (*terminate)(fmi2Component);
+    fmi2Status (*setFloat64)(fmi2Component, const fmi2ValueReference *, size_t, const double *, size_t);
+    fmi2Status (*getFloat64)(fmi2Component, const fmi2ValueReference *, size_t, double *, size_t);
+    fmi2Status (*doStep3)(fmi2Component, double, double, bool, bool *, bool *, bool *, double *);
+    fmi2Status (*getState)(fmi2Component, fmi2FMUstate *);
+    fmi2Status (*setState)(fmi2Component, fmi2FMUstate);
+    fmi2Status (*freeState)(fmi2Component, fmi2FMUstate *);
+    fmi2Status (*stateSize)(fmi2Component, fmi2FMUstate, size_t *);
+    fmi2Status (*serialize)(fmi2Component, fmi2FMUstate, char *, size_t);
+    fmi2Status (*deserialize)(fmi2Component, const char *, size_t, fmi2FMUstate *);
+    bool terminated;        /* FMI 3.0 has no status functions: what the last fmi3DoStep said */
+    double last_successful;
+} Fmu;
+#endif
 
 static char binary[PATH_MAX], resources[PATH_MAX + 16], guid[256];
 static fmi2ValueReference inputs[7], outputs[64];
@@ -77,7 +109,14 @@ static void logger(void *env, const char *name, fmi2Status status, const char *c
     fflush(stdout);
 }
 
+#ifndef FMI3
 static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+#else
+static void logger3(void *env, fmi2Status status, const char *category, const char *message)
+{
+    logger(env, NULL, status, category, "%s", message);
+}
+#endif
 
 static void fail(const char *what)
 {
@@ -102,11 +141,13 @@ static void *symbol(void *handle, const char *name)
 
 static void load(Fmu *fmu)
 {
+    memset(fmu, 0, sizeof *fmu);
     fmu->handle = dlopen(binary, RTLD_NOW | RTLD_LOCAL);
     if (!fmu->handle) {
         printf("error dlopen: %s\n", dlerror());
         exit(1);
     }
+#ifndef FMI3
     *(void **)&fmu->instantiate = symbol(fmu->handle, "fmi2Instantiate");
     *(void **)&fmu->freeInstance = symbol(fmu->handle, "fmi2FreeInstance");
     *(void **)&fmu->setup = symbol(fmu->handle, "fmi2SetupExperiment");
@@ -124,6 +165,82 @@ static void load(Fmu *fmu)
     *(void **)&fmu->deserialize = symbol(fmu->handle, "fmi2DeSerializeFMUstate");
     *(void **)&fmu->getBooleanStatus = symbol(fmu->handle, "fmi2GetBooleanStatus");
     *(void **)&fmu->getRealStatus = symbol(fmu->handle, "fmi2GetRealStatus");
+#else
+    *(void **)&fmu->instantiate = symbol(fmu->handle, "fmi3InstantiateCoSimulation");
+    *(void **)&fmu->freeInstance = symbol(fmu->handle, "fmi3FreeInstance");
+    *(void **)&fmu->enterInit = symbol(fmu->handle, "fmi3EnterInitializationMode");
+    *(void **)&fmu->exitInit = symbol(fmu->handle, "fmi3ExitInitializationMode");
+    *(void **)&fmu->terminate = symbol(fmu->handle, "fmi3Terminate");
+    *(void **)&fmu->setFloat64 = symbol(fmu->handle, "fmi3SetFloat64");
+    *(void **)&fmu->getFloat64 = symbol(fmu->handle, "fmi3GetFloat64");
+    *(void **)&fmu->doStep3 = symbol(fmu->handle, "fmi3DoStep");
+    *(void **)&fmu->getState = symbol(fmu->handle, "fmi3GetFMUState");
+    *(void **)&fmu->setState = symbol(fmu->handle, "fmi3SetFMUState");
+    *(void **)&fmu->freeState = symbol(fmu->handle, "fmi3FreeFMUState");
+    *(void **)&fmu->stateSize = symbol(fmu->handle, "fmi3SerializedFMUStateSize");
+    *(void **)&fmu->serialize = symbol(fmu->handle, "fmi3SerializeFMUState");
+    *(void **)&fmu->deserialize = symbol(fmu->handle, "fmi3DeserializeFMUState");
+#endif
+}
+
+/* The calls that differ between FMI 2.0 and 3.0, in one form. */
+static fmi2Component instantiate(Fmu *fmu, const char *name)
+{
+#ifndef FMI3
+    return fmu->instantiate(name, 1 /* co-simulation */, guid, resources, &callbacks, 0, 1);
+#else
+    return fmu->instantiate(name, guid, resources, false, true, false, false, NULL, 0, NULL, logger3, NULL);
+#endif
+}
+
+static int initialize(Fmu *fmu, fmi2Component c)
+{
+#ifndef FMI3
+    return fmu->setup(c, 0, 0.0, 0.0, 0, 0.0) || fmu->enterInit(c) || fmu->exitInit(c);
+#else
+    return fmu->enterInit(c, false, 0.0, 0.0, false, 0.0) || fmu->exitInit(c);
+#endif
+}
+
+static fmi2Status set_real(Fmu *fmu, fmi2Component c, const fmi2ValueReference *vr, size_t n, const double *v)
+{
+#ifndef FMI3
+    return fmu->setReal(c, vr, n, v);
+#else
+    return fmu->setFloat64(c, vr, n, v, n);
+#endif
+}
+
+static fmi2Status get_real(Fmu *fmu, fmi2Component c, const fmi2ValueReference *vr, size_t n, double *v)
+{
+#ifndef FMI3
+    return fmu->getReal(c, vr, n, v);
+#else
+    return fmu->getFloat64(c, vr, n, v, n);
+#endif
+}
+
+static fmi2Status do_step(Fmu *fmu, fmi2Component c, double t, double h)
+{
+#ifndef FMI3
+    return fmu->doStep(c, t, h, 1);
+#else
+    bool event = false, early = false;
+    return fmu->doStep3(c, t, h, true, &event, &fmu->terminated, &early, &fmu->last_successful);
+#endif
+}
+
+/* fmi2Terminated and fmi2LastSuccessfulTime; FMI 3.0: as the last fmi3DoStep returned them */
+static void step_status(Fmu *fmu, fmi2Component c, int *terminated, double *last)
+{
+#ifndef FMI3
+    CHECK(fmu->getBooleanStatus(c, 3 /* fmi2Terminated */, terminated));
+    CHECK(fmu->getRealStatus(c, 2 /* fmi2LastSuccessfulTime */, last));
+#else
+    (void)c;
+    *terminated = fmu->terminated;
+    *last = fmu->last_successful;
+#endif
 }
 
 static void unload(Fmu *fmu)
@@ -134,12 +251,10 @@ static void unload(Fmu *fmu)
 
 static fmi2Component start(Fmu *fmu, const char *name)
 {
-    fmi2Component c = fmu->instantiate(name, 1 /* co-simulation */, guid, resources, &callbacks, 0, 1);
+    fmi2Component c = instantiate(fmu, name);
     if (!c)
         fail("fmi2Instantiate");
-    CHECK(fmu->setup(c, 0, 0.0, 0.0, 0, 0.0));
-    CHECK(fmu->enterInit(c));
-    CHECK(fmu->exitInit(c));
+    CHECK(initialize(fmu, c));
     return c;
 }
 
@@ -156,13 +271,13 @@ static void set_inputs(Fmu *fmu, fmi2Component c, int k, double scale, int nan_f
                    0.4 + 0.01 * k, 0.05};
     if (nan_fz)
         u[2] = NAN;
-    CHECK(fmu->setReal(c, inputs, 7, u));
+    CHECK(set_real(fmu, c, inputs, 7, u));
 }
 
 static void print_outputs(Fmu *fmu, fmi2Component c, const char *label, int k)
 {
     double y[64];
-    CHECK(fmu->getReal(c, outputs, n_outputs, y));
+    CHECK(get_real(fmu, c, outputs, n_outputs, y));
     printf("%s %d", label, k);
     for (size_t i = 0; i < n_outputs; i++)
         printf(" %.17g", y[i]);
@@ -173,7 +288,7 @@ static void print_outputs(Fmu *fmu, fmi2Component c, const char *label, int k)
 static fmi2Status step(Fmu *fmu, fmi2Component c, int k, double scale, int nan_fz)
 {
     set_inputs(fmu, c, k, scale, nan_fz);
-    return fmu->doStep(c, k * H, H, 1);
+    return do_step(fmu, c, k * H, H);
 }
 
 static void step_ok(Fmu *fmu, fmi2Component c, const char *label, int k, double scale)
@@ -187,8 +302,7 @@ static void print_status(Fmu *fmu, fmi2Component c, const char *label, int k, fm
 {
     int terminated = -1;
     double last = NAN;
-    CHECK(fmu->getBooleanStatus(c, 3 /* fmi2Terminated */, &terminated));
-    CHECK(fmu->getRealStatus(c, 2 /* fmi2LastSuccessfulTime */, &last));
+    step_status(fmu, c, &terminated, &last);
     printf("status %s %d %d %d %.17g\n", label, k, status, terminated, last);
     fflush(stdout);
 }
@@ -290,8 +404,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: host FMU_DIR MODEL_IDENTIFIER GUID SCENARIO VR_INPUTS(7) VR_OUTPUTS... [--cycles N]\n");
         return 2;
     }
-    snprintf(binary, sizeof binary, "%s/binaries/linux64/%s.so", argv[1], argv[2]);
+    snprintf(binary, sizeof binary, "%s/binaries/" PLATFORM "/%s.so", argv[1], argv[2]);
+#ifndef FMI3
     snprintf(resources, sizeof resources, "file://%s/resources", argv[1]);
+#else
+    snprintf(resources, sizeof resources, "%s/resources/", argv[1]);  /* FMI 3.0: a path, not a URI */
+#endif
     snprintf(guid, sizeof guid, "%s", argv[3]);
     const char *scenario = argv[4];
     int cycles = 3;
