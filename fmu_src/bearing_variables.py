@@ -164,6 +164,9 @@ def build_simulator(slave, error) -> bool:
         if settings.ring_model == "flexible":
             superelement = Superelement.load(slave.superelement_path, slave.bearing)
         slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
+        from slewing_model.friction_kernel import use_compiled
+
+        slave.log(f"{slave.instance_name}: loops " + ("compiled by numba" if use_compiled(kernels) else "run by numpy"))
         return True
     except ValueError as exc:
         slave.log(f"{slave.instance_name}: {exc}", error)

@@ -28,16 +28,34 @@ def _cache_dir(tmp_path_factory):
     os.environ.setdefault("SLEWING_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
 
 
-@pytest.fixture(scope="session")
-def table3_fmu(tmp_path_factory):
-    """The bearing FMU of table3 with synthetic errors (coarse superelement, free rings), built once."""
+def _build_table3(tmp_path_factory, name, **options):
     import sys
 
     sys.path.insert(0, str(ROOT))
     from build_fmu import build_fmu
 
-    path = tmp_path_factory.mktemp("fmu") / "SlewingBearing_table3.fmu"
-    return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free")
+    path = tmp_path_factory.mktemp("fmu") / name
+    return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free", **options)
+
+
+@pytest.fixture(scope="session")
+def table3_fmu(tmp_path_factory):
+    """The bearing FMU of table3 with synthetic errors (coarse superelement, free rings), built once
+    as build_fmu.py builds by default: FMI 2.0, standalone (it carries its Python runtime)."""
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3.fmu")
+
+
+@pytest.fixture(scope="session")
+def table3_fmu3(tmp_path_factory):
+    """The FMI 3.0 FMU of table3_fmu's bearing, standalone."""
+    return _build_table3(tmp_path_factory, "SlewingBearing3_table3.fmu", fmi_version=3)
+
+
+@pytest.fixture(scope="session")
+def table3_host_fmu(tmp_path_factory):
+    """The light "tool coupling" FMU of table3_fmu's bearing (``--runtime host``): it runs in this
+    machine's Python, or one named by SLEWING_FMU_PYTHONHOME."""
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3_host.fmu", runtime="host")
 
 
 def simulators_per_kernel(name: str, steps: int, setting: str):

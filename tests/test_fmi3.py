@@ -19,13 +19,9 @@ BALLS = 67  # table3
 
 
 @pytest.fixture(scope="module")
-def fmu3(tmp_path_factory):
-    """The FMI 3.0 FMU of the table3_fmu fixture's bearing (coarse superelement, free rings)."""
-    sys.path.insert(0, str(ROOT))
-    from build_fmu import build_fmu
-
-    path = tmp_path_factory.mktemp("fmu3") / "SlewingBearing3_table3.fmu"
-    return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free", fmi_version=3)
+def fmu3(table3_fmu3):
+    """The FMI 3.0 FMU of the table3_fmu fixture's bearing (coarse superelement, free rings, standalone)."""
+    return table3_fmu3
 
 
 def test_model_description_is_valid_with_arrays(fmu3, table3_fmu):

@@ -43,15 +43,25 @@ def c_host(tmp_path_factory):
     return binary
 
 
-@pytest.fixture(scope="module")
-def fmu_dir(table3_fmu, tmp_path_factory):
+def unzipped(fmu, folder):
     """The unzipped FMU, its GUID and the value references the C host takes."""
-    folder = tmp_path_factory.mktemp("unzipped")
-    with zipfile.ZipFile(table3_fmu) as z:
+    with zipfile.ZipFile(fmu) as z:
         z.extractall(folder)
-    md = read_model_description(str(table3_fmu))
+    md = read_model_description(str(fmu))
     refs = {v.name: v.valueReference for v in md.modelVariables}
     return folder, md.guid, [str(refs[n]) for n in INPUTS + OUTPUTS]
+
+
+@pytest.fixture(scope="module")
+def fmu_dir(table3_fmu, tmp_path_factory):
+    """The standalone FMU (the default build), unzipped."""
+    return unzipped(table3_fmu, tmp_path_factory.mktemp("unzipped"))
+
+
+@pytest.fixture(scope="module")
+def host_fmu_dir(table3_host_fmu, tmp_path_factory):
+    """The host FMU (``--runtime host``: it runs in this machine's Python), unzipped."""
+    return unzipped(table3_host_fmu, tmp_path_factory.mktemp("unzipped_host"))
 
 
 def run_host(c_host, fmu_dir, scenario, *extra, env=None):
@@ -197,7 +207,7 @@ def _python_minor(executable):
     return run.stdout.strip() if run.returncode == 0 else None
 
 
-def test_a_host_python_without_numpy_gets_a_message_naming_what_to_install(c_host, fmu_dir):
+def test_a_host_python_without_numpy_gets_a_message_naming_what_to_install(c_host, host_fmu_dir):
     other = "/usr/bin/python3"
     version = _python_minor(other) if os.path.exists(other) else None
     minor = f"{sys.version_info[0]}.{sys.version_info[1]}"
@@ -205,7 +215,7 @@ def test_a_host_python_without_numpy_gets_a_message_naming_what_to_install(c_hos
         pytest.skip(f"needs a system Python {minor} at /usr besides this one")
     if subprocess.run([other, "-c", "import numpy"], capture_output=True, env=MINIMAL_ENV).returncode == 0:
         pytest.skip("the system Python has numpy")
-    code, _, _, logs, err = run_host(c_host, fmu_dir, "basic", env={"SLEWING_FMU_PYTHONHOME": "/usr"})
+    code, _, _, logs, err = run_host(c_host, host_fmu_dir, "basic", env={"SLEWING_FMU_PYTHONHOME": "/usr"})
     assert code == 1 and "fmi2Instantiate" in err  # refused, not crashed
     text = " ".join(m for _, _, m in logs)
     assert f"needs numpy in the Python that runs it, Python {version} at /usr" in text
@@ -213,7 +223,7 @@ def test_a_host_python_without_numpy_gets_a_message_naming_what_to_install(c_hos
     assert f"built with Python {sys.version.split()[0]}" in text
 
 
-def test_another_python_named_by_the_variable_runs_the_fmu(c_host, fmu_dir, reference, tmp_path):
+def test_another_python_named_by_the_variable_runs_the_fmu(c_host, host_fmu_dir, reference, tmp_path):
     # another machine, simulated: the Python named in the FMU is gone, and the user names a
     # virtual environment of the system's Python (/usr, without numpy) with numpy installed in it
     other = "/usr/bin/python3"
@@ -230,7 +240,7 @@ def test_another_python_named_by_the_variable_runs_the_fmu(c_host, fmu_dir, refe
                          capture_output=True, text=True)
     if pip.returncode != 0:
         pytest.skip(f"cannot install numpy into a test environment: {pip.stderr[-300:]}")
-    folder, guid, vrs = fmu_dir
+    folder, guid, vrs = host_fmu_dir
     moved = tmp_path / "fmu"
     shutil.copytree(folder, moved)
     (moved / "resources" / "python_runtime.txt").write_text(
@@ -244,9 +254,9 @@ def test_another_python_named_by_the_variable_runs_the_fmu(c_host, fmu_dir, refe
         assert_close(values["run"][k], reference[1.0][k])
 
 
-def test_a_missing_python_gets_a_message_instead_of_a_crash(c_host, fmu_dir, tmp_path):
+def test_a_missing_python_gets_a_message_instead_of_a_crash(c_host, host_fmu_dir, tmp_path):
     nowhere = tmp_path / "no_python_here"
-    code, _, _, logs, err = run_host(c_host, fmu_dir, "basic", env={"SLEWING_FMU_PYTHONHOME": str(nowhere)})
+    code, _, _, logs, err = run_host(c_host, host_fmu_dir, "basic", env={"SLEWING_FMU_PYTHONHOME": str(nowhere)})
     assert code == 1 and "fmi2Instantiate" in err
     (status, category, message), = logs
     assert status == 3 and category == "logStatusError"
@@ -296,10 +306,10 @@ def _build_machine_paths() -> set[str]:
     return {p for p in candidates if p and p.startswith("/") and len(p) > 5}
 
 
-def test_the_fmu_holds_no_path_of_the_building_machine_outside_its_python_file(table3_fmu):
+def test_the_host_fmu_holds_no_path_of_the_building_machine_outside_its_python_file(table3_host_fmu):
     paths = _build_machine_paths()
     runtime = "resources/python_runtime.txt"
-    with zipfile.ZipFile(table3_fmu) as z:
+    with zipfile.ZipFile(table3_host_fmu) as z:
         names = z.namelist()
         assert runtime in names and not any(n.endswith("python_paths.json") for n in names)
         for name in names:

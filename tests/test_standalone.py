@@ -1,0 +1,343 @@
+"""The standalone FMUs on bare Debian systems that have no Python at all.
+
+A user receives the ``.fmu`` and imports it on their own machine. Here that machine is a Debian
+minbase system made with debootstrap (Debian 12 "bookworm" and 13 "trixie": no Python, no
+numpy, no compiler), entered with chroot, and the hosts are independent C programs that know
+nothing of Python: fmusim (the Modelica Association's Reference-FMUs simulator, built here from
+``../shared/vendor``) and our own FMI 2.0 / 3.0 host (``tests/c_host/host.c``). Their outputs
+must equal fmpy's, driving the same FMU on the building machine, to 1e-10.
+
+A system below the FMU's glibc floor (Debian 11 "bullseye", glibc 2.31) must get a message
+naming the floor through the host's logger, not a bare loader error.
+
+The systems are made once and kept in ``$SLEWING_CHROOT_DIR`` (default
+``/var/cache/slewing-chroots``). It all needs root (debootstrap, chroot): without root the
+tests are skipped, and the skip says so.
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.validation import validate_fmu
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+
+ROOT = Path(__file__).resolve().parents[1]
+HOST = ROOT / "tests" / "c_host"
+VENDOR = ROOT.parent / "shared" / "vendor" / "fmusim-v0.0.39"
+CHROOTS = Path(os.environ.get("SLEWING_CHROOT_DIR", "/var/cache/slewing-chroots"))
+RELEASES = {"bookworm": "Debian 12", "trixie": "Debian 13"}
+BELOW_FLOOR = "bullseye"  # Debian 11, glibc 2.31
+INPUTS = ["Fx", "Fy", "Fz", "Mx", "My", "psi", "omega"]
+OUTPUTS = ["z", "rx", "friction_torque", "max_ball_load", "static_safety_factor"]
+H = 0.01
+FMUSIM_RUNS = int(os.environ.get("SLEWING_FMUSIM_RUNS", "20"))
+MODEL = {2: "SlewingBearing", 3: "SlewingBearing3"}
+
+pytestmark = pytest.mark.skipif(os.geteuid() != 0, reason="SKIPPED, not root: the standalone FMU's bare-system "
+                                "tests need root for debootstrap and chroot (CI runs as root)")
+
+
+def host_inputs(k: int, scale: float = 1.0) -> list[float]:
+    """The inputs the C host sets before step k (tests/c_host/host.c, set_inputs)."""
+    return [8e3 * scale, -3e3 * scale, (3e4 + 1e3 * k) * scale, 1.5e3 * scale, -2.5e3 * scale, 0.4 + 0.01 * k, 0.05]
+
+
+# ---- the bare systems, the hosts, the FMUs ----------------------------------------------------
+def bare_system(release: str) -> Path:
+    """A Debian minbase system of ``release``, made once with debootstrap and kept."""
+    target = CHROOTS / release
+    if (target / "usr" / "bin").is_dir():
+        return target
+    debootstrap = shutil.which("debootstrap") or "/usr/sbin/debootstrap"
+    if not os.path.exists(debootstrap):
+        pytest.fail("debootstrap is not installed: `make` installs it (apt-get install debootstrap)")
+    partial = CHROOTS / f"{release}.partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    CHROOTS.mkdir(parents=True, exist_ok=True)
+    run = subprocess.run([debootstrap, "--variant=minbase", release, str(partial)], capture_output=True, text=True,
+                         timeout=900)
+    assert run.returncode == 0, f"debootstrap {release} failed:\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
+    partial.rename(target)
+    return target
+
+
+def in_system(system: Path, *command, timeout=300):
+    """Run ``command`` (paths inside the system) in ``system`` as a desktop session would: only PATH and HOME."""
+    chroot = shutil.which("chroot") or "/usr/sbin/chroot"
+    return subprocess.run([chroot, str(system), "/usr/bin/env", "-i", "PATH=/usr/bin:/bin", "HOME=/tmp", *command],
+                          capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory):
+    """Our C host for FMI 2.0 and 3.0, linked to start on any x86-64 glibc (tests/c_host/start.c)."""
+    folder = tmp_path_factory.mktemp("hosts")
+    built = {}
+    for version, flags in ((2, []), (3, ["-DFMI3"])):
+        binary = folder / f"host{version}"
+        run = subprocess.run(["cc", "-O1", *flags, "-include", str(ROOT / "fmu_src" / "shim" / "glibc_compat.h"),
+                              "-nostartfiles", "-o", str(binary), str(HOST / "start.c"), str(HOST / "host.c"),
+                              "-Wl,--no-as-needed", "-l:libdl.so.2", "-lm"], capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        built[version] = binary
+    return built
+
+
+@pytest.fixture(scope="module")
+def fmusim(tmp_path_factory):
+    """fmusim v0.0.39 built from ../shared/vendor, its own libraries linked in (--static)."""
+    if not (VENDOR / "build.sh").exists():
+        pytest.skip(f"fmusim's source is not at {VENDOR}")
+    binary = tmp_path_factory.mktemp("fmusim") / "fmusim"
+    run = subprocess.run(["bash", str(VENDOR / "build.sh"), str(binary), "--static"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr[-3000:]
+    return binary
+
+
+@pytest.fixture(scope="module")
+def standalone(table3_fmu, table3_fmu3):
+    """The standalone FMUs of table3 (the default build), per FMI version."""
+    return {2: table3_fmu, 3: table3_fmu3}
+
+
+def runtime_of(fmu) -> dict:
+    with zipfile.ZipFile(fmu) as z:
+        text = z.read("resources/python_runtime.txt").decode()
+    return dict(line.split("=", 1) for line in text.splitlines() if "=" in line and not line.startswith("#"))
+
+
+def fmpy_steps(fmu, version, steps):
+    """Outputs after each of ``steps`` steps with the C host's inputs, driven by fmpy on this machine."""
+    md = read_model_description(str(fmu))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    unzipped = extract(str(fmu))
+    out = []
+    try:
+        if version == 2:
+            slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=MODEL[2], instanceName="ref")
+            slave.instantiate()
+            slave.setupExperiment(startTime=0.0)
+        else:
+            slave = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipped, modelIdentifier=MODEL[3],
+                              instanceName="ref")
+            slave.instantiate()
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        for k in range(steps):
+            if version == 2:
+                slave.setReal([refs[n] for n in INPUTS], host_inputs(k))
+                slave.doStep(k * H, H)
+                out.append(slave.getReal([refs[n] for n in OUTPUTS]))
+            else:
+                slave.setFloat64([refs[n] for n in INPUTS], host_inputs(k))
+                slave.doStep(k * H, H)
+                out.append(slave.getFloat64([refs[n] for n in OUTPUTS]))
+        slave.terminate()
+        slave.freeInstance()
+    finally:
+        shutil.rmtree(unzipped, ignore_errors=True)
+    return np.array(out)
+
+
+def place(fmu, system: Path, name: str) -> tuple[str, str, list[str]]:
+    """Unzip ``fmu`` into ``system``'s /tmp/<name>; returns (its path inside, token, value references)."""
+    md = read_model_description(str(fmu))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    inside = f"/tmp/{name}"
+    shutil.rmtree(system / inside.lstrip("/"), ignore_errors=True)
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(system / inside.lstrip("/"))
+    token = md.guid if md.fmiVersion.startswith("2") else md.instantiationToken
+    return inside, token, [str(refs[n]) for n in INPUTS + OUTPUTS]
+
+
+def run_host(system, host, fmu, version, scenario):
+    """Our C host on ``fmu`` inside ``system``: (return code, {label: {step: values}}, statuses, logs, output)."""
+    shutil.copy2(host, system / "tmp" / host.name)
+    inside, token, vrs = place(fmu, system, f"fmu{version}")
+    run = in_system(system, f"/tmp/{host.name}", inside, MODEL[version], token, scenario, *vrs)
+    values, statuses, logs = {}, [], []
+    for line in run.stdout.splitlines():
+        word, _, rest = line.partition(" ")
+        if word == "status":
+            label, k, status, terminated, last = rest.split()
+            statuses.append((label, int(k), int(status), int(terminated), float(last)))
+        elif word == "log":
+            logs.append(rest)
+        elif word not in ("done", "error"):
+            k, *numbers = rest.split()
+            values.setdefault(word, {})[int(k)] = [float(x) for x in numbers]
+    return run.returncode, values, statuses, logs, run.stdout + run.stderr
+
+
+# ---- the tests ----------------------------------------------------------------------------------
+@pytest.mark.parametrize("release", [*RELEASES, BELOW_FLOOR])
+def test_the_bare_systems_have_no_python(release):
+    system = bare_system(release)
+    found = [str(p.relative_to(system)) for folder in ("usr/bin", "usr/lib", "usr/local")
+             for p in (system / folder).glob("**/*python*")]
+    assert found == []
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("release", list(RELEASES))
+def test_our_c_host_steps_rolls_back_and_refuses_a_nan_in_a_bare_system_as_fmpy_does(release, version, hosts,
+                                                                                      standalone):
+    system = bare_system(release)
+    fmu = standalone[version]
+    reference = fmpy_steps(fmu, version, 8)
+    code, values, _, _, output = run_host(system, hosts[version], fmu, version, "basic")
+    assert code == 0 and output.rstrip().endswith("done"), output[-3000:]
+    for label, steps in (("run", range(6)), ("replay", range(3, 6)), ("deserialized", range(3, 6)),
+                         ("reload", range(6))):
+        for k in steps:  # the state set back, or deserialized, repeats the steps; a reloaded binary starts afresh
+            assert values[label][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), (label, k)
+    code, values, statuses, logs, output = run_host(system, hosts[version], fmu, version, "nan")
+    assert code == 0, output[-3000:]
+    # the NaN step is refused (Discard) with its reason, the state stays that of step 2, and the run goes on
+    assert ("disturbed", 3, 2, 0, pytest.approx(0.03)) in statuses
+    assert any("input Fz = nan: must be finite" in line for line in logs), logs
+    assert values["after_refusal"][3] == pytest.approx(reference[2], rel=1e-10, abs=1e-300)
+    for k in (4, 5, 6, 7):
+        assert values["disturbed"][k] == values["undisturbed"][k]
+    assert statuses[-1][2:4] == (0, 0)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("release", list(RELEASES))
+def test_fmusim_runs_the_standalone_fmu_every_time_and_exits_cleanly(release, version, fmusim, standalone):
+    system = bare_system(release)
+    fmu = standalone[version]
+    folder = system / "tmp" / "fmusim_run"
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir()
+    shutil.copy2(fmusim, folder / "fmusim")
+    shutil.copy2(fmu, folder / "bearing.fmu")
+    t = np.round(np.arange(21) * H, 10)
+    rows = ["time," + ",".join(INPUTS)] + [f"{tk:.2f}," + ",".join(repr(x) for x in host_inputs(k))
+                                           for k, tk in enumerate(t)]
+    (folder / "input.csv").write_text("\n".join(rows) + "\n")
+    data = np.zeros(len(t), dtype=[("time", float)] + [(n, float) for n in INPUTS])
+    data["time"] = t
+    for i, name in enumerate(INPUTS):
+        data[name] = [host_inputs(k)[i] for k in range(len(t))]
+    expected = simulate_fmu(str(fmu), stop_time=0.2, step_size=H, output_interval=H, input=data, output=OUTPUTS)
+    outputs = sum((["--output-variable", n] for n in OUTPUTS), [])
+    for run_index in range(FMUSIM_RUNS):
+        run = in_system(system, "/tmp/fmusim_run/fmusim", "--interface-type", "cs", "--stop-time", "0.2",
+                        "--output-interval", str(H), "--input-file", "/tmp/fmusim_run/input.csv", *outputs,
+                        "--output-file", "/tmp/fmusim_run/out.csv", "/tmp/fmusim_run/bearing.fmu")
+        assert run.returncode == 0, f"run {run_index}: exit {run.returncode}\n{run.stdout[-2000:]}{run.stderr[-2000:]}"
+        got = np.genfromtxt(folder / "out.csv", delimiter=",", names=True)
+        for name in OUTPUTS:  # fmusim writes 16 significant digits
+            assert got[name] == pytest.approx(expected[name], rel=1e-10, abs=1e-300), (run_index, name)
+    assert not list((system / "tmp").glob("fmusim.*")), "fmusim left its unpacked FMU behind"
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_below_the_glibc_floor_the_fmu_says_which_glibc_it_needs(version, hosts, standalone):
+    system = bare_system(BELOW_FLOOR)
+    have = re.search(r"GNU C Library[^\n]*?release version (\d+\.\d+)|ldd \(.*\) (\d+\.\d+)",
+                     in_system(system, "/usr/bin/ldd", "--version").stdout)
+    have = have.group(1) or have.group(2)
+    floor = runtime_of(standalone[version])["glibc"]
+    assert tuple(map(int, have.split("."))) < tuple(map(int, floor.split(".")))
+    code, _, _, logs, output = run_host(system, hosts[version], standalone[version], version, "basic")
+    assert code == 1 and "error fmi2Instantiate" in output  # refused, not crashed, not a loader error
+    assert any(f"this FMU needs glibc {floor} or newer" in line and f"this machine has glibc {have}" in line
+               for line in logs), output
+
+
+def _readelf_glibc_needs(folder: Path) -> str:
+    """The newest GLIBC_ version any ELF file below ``folder`` needs, read by binutils' readelf."""
+    newest = (0, 0)
+    for f in folder.rglob("*"):
+        if not f.is_file() or f.read_bytes()[:4] != b"\x7fELF":
+            continue
+        out = subprocess.run(["readelf", "-V", "-W", str(f)], capture_output=True, text=True).stdout
+        section = out.split("Version needs section", 1)[-1] if "Version needs section" in out else ""
+        for major, minor in re.findall(r"Name: GLIBC_(\d+)\.(\d+)", section):
+            newest = max(newest, (int(major), int(minor)))
+    return f"{newest[0]}.{newest[1]}"
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_the_stated_floor_is_the_newest_glibc_any_binary_of_the_fmu_needs(version, standalone, tmp_path):
+    if shutil.which("readelf") is None:
+        pytest.skip("binutils' readelf is not installed")
+    with zipfile.ZipFile(standalone[version]) as z:
+        z.extractall(tmp_path)
+    assert runtime_of(standalone[version])["glibc"] == _readelf_glibc_needs(tmp_path / "binaries")
+
+
+def test_standalone_fmu_with_numba_runs_its_compiled_loops_in_a_bare_system(hosts, tmp_path_factory):
+    sys.path.insert(0, str(ROOT))
+    from build_fmu import build_fmu
+
+    fmu = build_fmu(ROOT / "examples" / "bearings" / "table3_errors.toml",
+                    tmp_path_factory.mktemp("numba") / "SlewingBearing_numba.fmu", mesh="coarse", bc="free",
+                    numba=True)
+    assert validate_fmu(str(fmu)) == []
+    assert "numba==" in runtime_of(fmu)["packages"]
+    assert_no_building_paths(fmu)
+    system = bare_system("bookworm")
+    reference = fmpy_steps(fmu, 2, 6)
+    code, values, _, logs, output = run_host(system, hosts[2], fmu, 2, "basic")
+    assert code == 0, output[-3000:]
+    assert any("loops compiled by numba" in line for line in logs), logs
+    for k in range(6):
+        assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+
+
+# ---- no path of the building machine --------------------------------------------------------------
+def building_paths() -> set[str]:
+    """Absolute paths of this machine that a built FMU could carry (its Pythons, the project, the temporary builds)."""
+    import site
+    import sysconfig
+    import tempfile
+
+    candidates = {str(ROOT), sys.prefix, sys.base_prefix, sys.exec_prefix, *site.getsitepackages(),
+                  sysconfig.get_config_var("prefix"), tempfile.gettempdir() + "/slewing_", os.path.expanduser("~")}
+    return {p for p in candidates if p and p.startswith("/") and len(p) > 5}
+
+
+def assert_no_building_paths(fmu):
+    paths = building_paths()
+    with zipfile.ZipFile(fmu) as z:
+        for name in z.namelist():
+            data = z.read(name)
+            for path in paths:
+                assert path.encode() not in data, f"{fmu}: {name} holds {path}"
+
+
+def test_no_file_inside_the_standalone_fmus_holds_a_path_of_the_building_machine(standalone, pitch_drive_fmu):
+    for fmu in (*standalone.values(), pitch_drive_fmu):
+        assert runtime_of(fmu)["runtime"] == "standalone"
+        assert_no_building_paths(fmu)
+
+
+@pytest.fixture(scope="module")
+def pitch_drive_fmu(tmp_path_factory):
+    sys.path.insert(0, str(ROOT))
+    from build_drive_fmu import build_drive_fmu
+
+    return build_drive_fmu(ROOT / "examples" / "drives" / "pitch_drive.toml",
+                           tmp_path_factory.mktemp("drive") / "SlewingDrive_pitch.fmu")
+
+
+def test_the_path_check_finds_a_path_written_into_an_fmu(standalone, tmp_path):
+    # the check above can fail: an FMU with the project's path added in one file is caught
+    planted = tmp_path / "planted.fmu"
+    shutil.copy2(standalone[2], planted)
+    with zipfile.ZipFile(planted, "a") as z:
+        z.writestr("resources/planted.txt", f"built in {ROOT}\n")
+    with pytest.raises(AssertionError, match="planted.txt holds"):
+        assert_no_building_paths(planted)
