@@ -7,18 +7,22 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test bench clean
 
+# Debian packages the build and the tests need:
+#   gcc, libc6-dev, binutils: build_fmu.py compiles the FMU's Linux binary (fmu_src/shim); readelf checks its glibc floor
+#   libtbb12: the ecos C++ co-simulation host of the FMU tests
+#   debootstrap: bare Debian systems without Python, where the tests run the standalone FMUs
+#   libxml2-dev libminizip-dev libsundials-dev zlib1g-dev: fmusim (built from ../shared/vendor), an independent FMI host
+DEBIAN_PACKAGES := gcc libc6-dev binutils libtbb12 debootstrap libxml2-dev libminizip-dev libsundials-dev zlib1g-dev
+
 $(STAMP): pyproject.toml
-	@# Debian packages: libtbb12 for the ecos C++ co-simulation host of the FMU tests
-	@if ! ldconfig -p 2>/dev/null | grep -q 'libtbb.so.12 '; then \
+	@missing=$$(for p in $(DEBIAN_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
 	  if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
-	    apt-get update -qq && apt-get install -y -qq libtbb12 >/dev/null; \
-	  else echo "note: libtbb12 is missing and cannot be installed here (not root): the ecos host test will be skipped"; fi; \
-	fi
-	@# a C compiler (gcc, libc6-dev): build_fmu.py compiles the FMU's Linux binary (fmu_src/shim)
-	@if ! printf 'int main(void){return 0;}\n' | $${CC:-cc} -x c - -o /dev/null 2>/dev/null; then \
-	  if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
-	    apt-get update -qq && apt-get install -y -qq gcc libc6-dev >/dev/null; \
-	  else echo "error: no working C compiler and not root: install gcc and libc6-dev, or building the FMU fails"; fi; \
+	    echo "installing Debian packages:" $$missing; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
+	  else echo "note: Debian packages missing and not root, so not installed:" $$missing; \
+	    echo "      (without gcc building the FMU fails; the tests that need the others are skipped, saying why)"; fi; \
 	fi
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip

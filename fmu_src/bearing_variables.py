@@ -9,6 +9,7 @@ in their own status values, slewing_model does the rest.
 from __future__ import annotations
 
 import math
+import sys
 import traceback
 
 #: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
@@ -135,17 +136,49 @@ TUNABLE = tuple(name for name, _, _, tunable, _ in REAL_PARAMETERS if tunable)
 KERNELS_FILE = "kernels.txt"
 
 
+#: the CPU the FMU's compiled loops were compiled for, besides a generic x86-64 (written by build_fmu.py)
+NUMBA_TARGET_FILE = "numba_target.txt"
+
+
 def kernels_of(resources: str) -> str:
     """The loops the FMU was built to run (``resources/kernels.txt``): "numpy" for a runtime
     without numba, so that the FMU computes the same numbers in every host, also in a Python
-    host that has numba; "auto" where the file is missing."""
+    host that has numba; "auto" where the file is missing.
+
+    For compiled loops, numba's cache in the FMU holds them twice: for the building machine's
+    CPU and for a generic x86-64 CPU. On another CPU, numba would not find this CPU's loops
+    and compile them all at instantiation (about a minute, in every freshly unpacked copy):
+    there ``NUMBA_CPU_NAME=generic`` is set before numba is imported, so that it takes the
+    generic ones (about 10-25 % slower steps), unless the user set it."""
     import os
 
     path = os.path.join(resources, KERNELS_FILE)
     if not os.path.exists(path):
         return "auto"
     with open(path) as fh:
-        return fh.read().strip() or "auto"
+        kernels = fh.read().strip() or "auto"
+    target = os.path.join(resources, NUMBA_TARGET_FILE)
+    if kernels != "numpy" and os.path.exists(target) and "numba" not in sys.modules \
+            and "NUMBA_CPU_NAME" not in os.environ:
+        with open(target) as fh:
+            built_for = fh.read().split()
+        try:
+            import llvmlite.binding as llvm
+
+            this_cpu = [llvm.get_host_cpu_name(), llvm.get_host_cpu_features().flatten()]
+        except Exception:       # no llvmlite (a host without numba): the numpy loops run anyway
+            this_cpu = built_for
+        if this_cpu != built_for:
+            os.environ["NUMBA_CPU_NAME"] = "generic"
+    return kernels
+
+
+def numba_target() -> str:
+    """For the log: the CPU the compiled loops run for."""
+    import os
+
+    return ("a generic x86-64 CPU (this CPU is not the building machine's)"
+            if os.environ.get("NUMBA_CPU_NAME") == "generic" else "this CPU")
 
 
 def build_simulator(slave, error) -> bool:
@@ -166,7 +199,8 @@ def build_simulator(slave, error) -> bool:
         slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
         from slewing_model.friction_kernel import use_compiled
 
-        slave.log(f"{slave.instance_name}: loops " + ("compiled by numba" if use_compiled(kernels) else "run by numpy"))
+        slave.log(f"{slave.instance_name}: loops " + (f"compiled by numba for {numba_target()}" if use_compiled(kernels)
+                                                      else "run by numpy"))
         return True
     except ValueError as exc:
         slave.log(f"{slave.instance_name}: {exc}", error)

@@ -40,15 +40,16 @@ def _build_table3(tmp_path_factory, name, **options):
 
 @pytest.fixture(scope="session")
 def table3_fmu(tmp_path_factory):
-    """The bearing FMU of table3 with synthetic errors (coarse superelement, free rings), built once
-    as build_fmu.py builds by default: FMI 2.0, standalone (it carries its Python runtime)."""
-    return _build_table3(tmp_path_factory, "SlewingBearing_table3.fmu")
+    """The bearing FMU of table3 with synthetic errors (coarse superelement, free rings), built once:
+    FMI 2.0, standalone (it carries its Python runtime), with numpy's loops (``--no-numba``: 22 MB
+    instead of 87; tests/test_standalone.py runs the default build, with numba, on its own)."""
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3.fmu", numba=False)
 
 
 @pytest.fixture(scope="session")
 def table3_fmu3(tmp_path_factory):
-    """The FMI 3.0 FMU of table3_fmu's bearing, standalone."""
-    return _build_table3(tmp_path_factory, "SlewingBearing3_table3.fmu", fmi_version=3)
+    """The FMI 3.0 FMU of table3_fmu's bearing, standalone, numpy's loops."""
+    return _build_table3(tmp_path_factory, "SlewingBearing3_table3.fmu", fmi_version=3, numba=False)
 
 
 @pytest.fixture(scope="session")

@@ -278,23 +278,57 @@ def test_the_stated_floor_is_the_newest_glibc_any_binary_of_the_fmu_needs(versio
     assert runtime_of(standalone[version])["glibc"] == _readelf_glibc_needs(tmp_path / "binaries")
 
 
-def test_standalone_fmu_with_numba_runs_its_compiled_loops_in_a_bare_system(hosts, tmp_path_factory):
+@pytest.fixture(scope="module")
+def numba_fmu(tmp_path_factory):
+    """The default build where numba is installed: standalone, with numba and the compiled loops' cache."""
     sys.path.insert(0, str(ROOT))
     from build_fmu import build_fmu
+    from slewing_model import friction_kernel
 
-    fmu = build_fmu(ROOT / "examples" / "bearings" / "table3_errors.toml",
-                    tmp_path_factory.mktemp("numba") / "SlewingBearing_numba.fmu", mesh="coarse", bc="free",
-                    numba=True)
-    assert validate_fmu(str(fmu)) == []
-    assert "numba==" in runtime_of(fmu)["packages"]
-    assert_no_building_paths(fmu)
+    if not friction_kernel.AVAILABLE:
+        pytest.skip("numba is not installed here")
+    return build_fmu(ROOT / "examples" / "bearings" / "table3_errors.toml",
+                     tmp_path_factory.mktemp("numba") / "SlewingBearing_numba.fmu", mesh="coarse", bc="free")
+
+
+def _cache_files(system, inside):
+    return sorted(p.name for p in (system / inside.lstrip("/") / "resources/slewing_model/__pycache__").glob("*.nb*"))
+
+
+def test_the_default_build_carries_numba_and_runs_its_compiled_loops_in_a_bare_system(hosts, numba_fmu):
+    assert validate_fmu(str(numba_fmu)) == []
+    assert "numba==" in runtime_of(numba_fmu)["packages"]
+    assert_no_building_paths(numba_fmu)
     system = bare_system("bookworm")
-    reference = fmpy_steps(fmu, 2, 6)
-    code, values, _, logs, output = run_host(system, hosts[2], fmu, 2, "basic")
+    reference = fmpy_steps(numba_fmu, 2, 6)
+    code, values, _, logs, output = run_host(system, hosts[2], numba_fmu, 2, "basic")
     assert code == 0, output[-3000:]
-    assert any("loops compiled by numba" in line for line in logs), logs
+    assert any("loops compiled by numba for this CPU" in line for line in logs), logs
     for k in range(6):
         assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+    for k in range(3, 6):
+        assert values["replay"][k] == values["run"][k]
+
+
+def test_on_another_cpu_the_fmu_takes_its_generic_loops_instead_of_compiling(hosts, numba_fmu):
+    # another machine, simulated: the CPU the FMU names as its building one is not this one
+    system = bare_system("trixie")
+    shutil.copy2(hosts[2], system / "tmp" / hosts[2].name)
+    inside, token, vrs = place(numba_fmu, system, "fmu_other_cpu")
+    (system / inside.lstrip("/") / "resources" / "numba_target.txt").write_text("someothercpu +sse2\n")
+    before = _cache_files(system, inside)
+    started = __import__("time").perf_counter()
+    run = in_system(system, f"/tmp/{hosts[2].name}", inside, MODEL[2], token, "basic", *vrs)
+    elapsed = __import__("time").perf_counter() - started
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "loops compiled by numba for a generic x86-64 CPU" in run.stdout
+    assert _cache_files(system, inside) == before        # numba compiled nothing: it found the generic loops
+    reference = fmpy_steps(numba_fmu, 2, 6)
+    rows = {int(line.split()[1]): [float(x) for x in line.split()[2:]] for line in run.stdout.splitlines()
+            if line.startswith("run ")}
+    for k in range(6):  # other machine code (no AVX, no FMA): the same numbers to the solver's round-off
+        assert rows[k] == pytest.approx(reference[k], rel=1e-9, abs=1e-300), k
+    assert elapsed < 30, f"{elapsed:.0f} s: compiling the loops takes about a minute"
 
 
 # ---- no path of the building machine --------------------------------------------------------------

@@ -17,7 +17,10 @@
  *
  * Scenarios: basic (steps, state get/set/serialize, free, dlclose and reload), two (two
  * instances interleaved), nan (a NaN input at step 3 then valid steps, beside an undisturbed
- * instance), stress (CYCLES x: load, two instances, a refused step, free, dlclose).
+ * instance), stress (CYCLES x: load, two instances, a refused step, free, dlclose), bench
+ * (FMI 2.0: --inputs FILE, 7 input values a line and step, --integer VR VALUE parameters;
+ * prints "instantiate <s>" for loading, instantiation and initialisation, then "step <k> <s>"
+ * for each set-inputs, doStep, get-outputs: benchmarks/bench_fmu_runtime.py).
  */
 #include <dlfcn.h>
 #include <limits.h>
@@ -27,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef void *fmi2Component;
 typedef void *fmi2FMUstate;
@@ -398,6 +402,46 @@ static void stress(int cycles)
     }
 }
 
+#ifndef FMI3
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+static void bench(const char *input_file, const fmi2ValueReference *int_vrs, const int *int_values, size_t n_ints)
+{
+    FILE *fh = fopen(input_file, "r");
+    if (!fh)
+        fail("cannot open the inputs file");
+    double start = now();
+    Fmu fmu;
+    load(&fmu);
+    fmi2Component c = instantiate(&fmu, "bench");
+    if (!c)
+        fail("fmi2Instantiate");
+    fmi2Status (*set_integer)(fmi2Component, const fmi2ValueReference *, size_t, const int *) =
+        (fmi2Status(*)(fmi2Component, const fmi2ValueReference *, size_t, const int *))symbol(fmu.handle, "fmi2SetInteger");
+    if (n_ints)
+        CHECK(set_integer(c, int_vrs, n_ints, int_values));
+    CHECK(initialize(&fmu, c));
+    printf("instantiate %.9f\n", now() - start);
+    double u[7], y[64];
+    for (int k = 0; fscanf(fh, "%lf %lf %lf %lf %lf %lf %lf", &u[0], &u[1], &u[2], &u[3], &u[4], &u[5], &u[6]) == 7; k++) {
+        double t0 = now();
+        CHECK(set_real(&fmu, c, inputs, 7, u));
+        if (do_step(&fmu, c, k * H, H) != 0)
+            fail("fmi2DoStep");
+        CHECK(get_real(&fmu, c, outputs, n_outputs, y));
+        printf("step %d %.9f\n", k, now() - t0);
+    }
+    fclose(fh);
+    print_outputs(&fmu, c, "final", 0);
+    stop(&fmu, c);
+}
+#endif
+
 int main(int argc, char **argv)
 {
     if (argc < 6 + 7) {
@@ -413,11 +457,30 @@ int main(int argc, char **argv)
     snprintf(guid, sizeof guid, "%s", argv[3]);
     const char *scenario = argv[4];
     int cycles = 3;
+    const char *input_file = NULL;
+    fmi2ValueReference int_vrs[16];
+    int int_values[16];
+    size_t n_ints = 0;
+#ifdef FMI3
+    (void)int_vrs, (void)int_values;    /* the bench scenario is FMI 2.0 only */
+#endif
     for (int i = 0; i < 7; i++)
         inputs[i] = (fmi2ValueReference)strtoul(argv[5 + i], NULL, 10);
     for (int i = 12; i < argc && n_outputs < 64; i++) {
         if (!strcmp(argv[i], "--cycles") && i + 1 < argc) {
             cycles = atoi(argv[++i]);
+            continue;
+        }
+        if (!strcmp(argv[i], "--inputs") && i + 1 < argc) {
+            input_file = argv[++i];
+            continue;
+        }
+#ifdef FMI3
+        (void)input_file;
+#endif
+        if (!strcmp(argv[i], "--integer") && i + 2 < argc && n_ints < 16) {
+            int_vrs[n_ints] = (fmi2ValueReference)strtoul(argv[++i], NULL, 10);
+            int_values[n_ints++] = atoi(argv[++i]);
             continue;
         }
         outputs[n_outputs++] = (fmi2ValueReference)strtoul(argv[i], NULL, 10);
@@ -430,6 +493,10 @@ int main(int argc, char **argv)
         nan_step();
     else if (!strcmp(scenario, "stress"))
         stress(cycles);
+#ifndef FMI3
+    else if (!strcmp(scenario, "bench") && input_file)
+        bench(input_file, int_vrs, int_values, n_ints);
+#endif
     else
         fail("unknown scenario");
     printf("done\n");

@@ -1,0 +1,159 @@
+"""The standalone FMU against the host FMU: zipped size, build time, instantiation, doStep.
+
+Three builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0),
+all made in this run by this checkout's ``build_fmu.py``:
+
+- ``host + numba``: ``--runtime host``, the FMU as it was before the standalone runtime (issue
+  23): it runs in this machine's Python and venv, with numba and its shipped cache. The baseline.
+- ``standalone``: the default; it carries its Python and numpy, and runs the numpy loops.
+- ``standalone + numba``: ``--numba``; it also carries numba and llvmlite, and the compiled loops' cache.
+
+Each FMU is run by our C host (``tests/c_host/host.c``, scenario ``bench``) in the environment of
+a desktop session (``PATH=/usr/bin:/bin``, nothing else), as a user's C host would run it: a fresh
+process per run, the variants' runs alternating so that all see the same machine load. A run is
+the pitch case of ``cases.py``: the shipped blade-root series (1P-3P and turbulence) with the blade
+pitching +-5 deg at 0.5 rad/s, flexible rings, friction on, 10 ms steps. A step is what a host does
+each communication step: set the 7 inputs, ``fmi2DoStep``, get 5 outputs. The first ``WARM`` steps
+(cold start of the solvers) are left out of the percentiles.
+
+Build time: with the runtime staged anew (its cache emptied) and with the runtime cached; the
+superelement is cached in both (built before the timing). Instantiation: loading the binary,
+``fmi2Instantiate``, the parameters and initialisation, in the C host.
+
+Run: .venv/bin/python benchmarks/bench_fmu_runtime.py [--steps 1000] [--runs 3]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from cases import CASES  # noqa: E402
+from timing import print_table  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
+OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
+VARIANTS = {"host + numba": {"runtime": "host", "numba": True},
+            "standalone": {"runtime": "standalone", "numba": False},
+            "standalone + numba": {"runtime": "standalone", "numba": True}}
+BASELINE = "host + numba"
+WARM = 20
+
+
+def compile_host(folder: Path) -> Path:
+    binary = folder / "host"
+    subprocess.run(["cc", "-O2", "-include", str(ROOT / "fmu_src/shim/glibc_compat.h"), "-nostartfiles", "-o",
+                    str(binary), str(ROOT / "tests/c_host/start.c"), str(ROOT / "tests/c_host/host.c"),
+                    "-Wl,--no-as-needed", "-l:libdl.so.2", "-lm"], check=True)
+    return binary
+
+
+def build(variant: dict, output: Path, cold: bool) -> float:
+    """Build the pitch FMU of ``variant``; seconds. ``cold``: the runtime staged anew."""
+    import build_runtime
+    from build_fmu import LINUX_BINARIES, build_fmu
+
+    if cold and variant["runtime"] == "standalone":
+        key = build_runtime.runtime_key(variant["numba"], LINUX_BINARIES[2])
+        for f in build_runtime.runtime_cache_dir().glob(f"runtime-{key}.*"):
+            f.unlink()
+    start = time.perf_counter()
+    build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", output, **variant)
+    return time.perf_counter() - start
+
+
+def run(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) -> tuple[float, np.ndarray, list]:
+    """One run of the C host: (instantiation s, step times s, final outputs)."""
+    integers = sum((["--integer", str(refs[k]), str(v)] for k, v in parameters.items()), [])
+    command = [str(host), str(folder), "SlewingBearing", refs["guid"], "bench",
+               *(str(refs[n]) for n in INPUTS + OUTPUTS), "--inputs", str(inputs), *integers]
+    out = subprocess.run(command, env={"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/root")},
+                         capture_output=True, text=True, timeout=3600)
+    if out.returncode != 0 or "done" not in out.stdout:
+        raise RuntimeError(f"the C host failed on {folder}:\n{out.stdout[-3000:]}\n{out.stderr[-3000:]}")
+    steps, instantiation, final = [], None, None
+    for line in out.stdout.splitlines():
+        word, *rest = line.split()
+        if word == "instantiate":
+            instantiation = float(rest[0])
+        elif word == "step":
+            steps.append(float(rest[1]))
+        elif word == "final":
+            final = [float(x) for x in rest[1:]]
+    return instantiation, np.array(steps), final
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=1000)
+    parser.add_argument("--runs", type=int, default=3)
+    args = parser.parse_args()
+    from fmpy import read_model_description
+
+    from slewing_model import load_bearing
+    from slewing_model.superelement import build_superelement
+
+    case = CASES["pitch"](args.steps)
+    build_superelement(load_bearing(case.bearing), mesh="fine", bc="free")     # cached: not in the build times
+    with tempfile.TemporaryDirectory(prefix="bench_runtime_") as tmp:
+        tmp = Path(tmp)
+        host = compile_host(tmp)
+        inputs = tmp / "inputs.txt"
+        np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
+        built, rows_build = {}, []
+        for name, variant in VARIANTS.items():
+            fmu = tmp / f"{name.replace(' + ', '_')}.fmu"
+            cold = build(variant, fmu, cold=True)
+            warm = build(variant, fmu, cold=False)
+            folder = tmp / fmu.stem
+            with zipfile.ZipFile(fmu) as z:
+                z.extractall(folder)
+                raw = sum(i.file_size for i in z.infolist())
+            md = read_model_description(str(fmu))
+            refs = {v.name: v.valueReference for v in md.modelVariables}
+            refs["guid"] = md.guid
+            built[name] = (folder, refs)
+            rows_build.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB", f"{raw / 1e6:.0f} MB",
+                               f"{cold:.1f} s" if variant["runtime"] == "standalone" else "—", f"{warm:.1f} s"])
+        times = {name: [] for name in VARIANTS}
+        starts = {name: [] for name in VARIANTS}
+        finals = {}
+        for r in range(args.runs):
+            for name in VARIANTS:
+                folder, refs = built[name]
+                instantiation, steps, final = run(host, folder, refs, inputs, case.parameters)
+                starts[name].append(instantiation)
+                times[name].append(steps[WARM:])
+                finals[name] = final
+    print(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU, "
+          f"C host, PATH=/usr/bin:/bin")
+    print_table("FMU variants: size and build", ["FMU", "zipped", "unpacked", "build, runtime staged",
+                                                   "build, runtime cached"], rows_build)
+    base = np.median(np.concatenate(times[BASELINE]))
+    rows = []
+    for name in VARIANTS:
+        t = np.concatenate(times[name]) * 1e3
+        rows.append([name, f"{np.median(starts[name]):.2f} s", f"{np.median(t):.2f} ms",
+                     f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms",
+                     f"{np.median(t) / (base * 1e3):.2f}"])
+    print_table("doStep in the C host (set inputs, doStep, get outputs)",
+                ["FMU", "instantiation", "median", "95th pct", "99th pct", f"median / {BASELINE}"], rows)
+    reference = np.array(finals[BASELINE])
+    for name, final in finals.items():
+        deviation = np.max(np.abs(np.array(final) - reference) / np.maximum(np.abs(reference), 1e-300))
+        print(f"final outputs of {name}: largest relative difference to {BASELINE}: {deviation:.1e}")
+
+
+if __name__ == "__main__":
+    main()
