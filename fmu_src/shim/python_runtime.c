@@ -251,6 +251,32 @@ static int load_standalone(const char *binary_dir, const struct runtime_file *rt
     return 0;
 }
 
+/* In a process whose Python was started by someone else (a Python host, or another FMU of ours
+ * that carries other packages, such as a drive FMU without numba beside a bearing FMU with it):
+ * where that Python is of the version this FMU carries, append this FMU's site-packages to
+ * sys.path. Packages already imported (numpy) stay the first ones; what the process lacks
+ * (numba, or numpy in a Python host without it) comes from this FMU. Appended, never put first:
+ * the host's own packages win. */
+static void offer_packages(const char *binary_dir, const struct runtime_file *rt)
+{
+    const char *(*get_version)(void) = (const char *(*)(void))dlsym(RTLD_DEFAULT, "Py_GetVersion");
+    int (*ensure)(void) = (int (*)(void))dlsym(RTLD_DEFAULT, "PyGILState_Ensure");
+    void (*release)(int) = (void (*)(int))dlsym(RTLD_DEFAULT, "PyGILState_Release");
+    int (*run)(const char *, void *) = (int (*)(const char *, void *))dlsym(RTLD_DEFAULT, "PyRun_SimpleStringFlags");
+    char running[16], carried[16], code[2 * PATH_MAX + 256];
+    if (!get_version || !ensure || !release || !run || !minor_version(get_version(), running, sizeof running)
+        || !minor_version(rt->version, carried, sizeof carried) || strcmp(running, carried)
+        || strpbrk(binary_dir, "'\\\n") || strpbrk(rt->folder, "'\\\n"))
+        return;
+    snprintf(code, sizeof code,
+             "import sys\n"
+             "p = '%s/%s/lib/python%s/site-packages'\n"
+             "if p not in sys.path: sys.path.append(p)\n", binary_dir, rt->folder, carried);
+    int state = ensure();
+    run(code, NULL);
+    release(state);
+}
+
 static int load_locked(const char *binary_dir, char *err, size_t errsize)
 {
     if (python_ready)
@@ -262,6 +288,8 @@ static int load_locked(const char *binary_dir, char *err, size_t errsize)
     if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
         /* a Python host (fmpy...), a host linked to libpython, or another FMU of ours that
          * started its Python in this process: one process holds one CPython, so use it */
+        if (!strcmp(rt.runtime, "standalone"))
+            offer_packages(binary_dir, &rt);
         python_ready = 1;
         return 0;
     }
