@@ -352,10 +352,28 @@ def assert_no_building_paths(fmu):
                 assert path.encode() not in data, f"{fmu}: {name} holds {path}"
 
 
-def test_no_file_inside_the_standalone_fmus_holds_a_path_of_the_building_machine(standalone, pitch_drive_fmu):
-    for fmu in (*standalone.values(), pitch_drive_fmu):
+@pytest.fixture(scope="module")
+def table_fmu(tmp_path_factory):
+    sys.path.insert(0, str(ROOT))
+    from build_drive_fmu import build_table_fmu
+
+    return build_table_fmu(tmp_path_factory.mktemp("table") / "command.fmu", "a command", [0.0, 1.0],
+                           [("command", "rad", "pitch angle command")], [[0.0], [0.1]])
+
+
+def test_no_file_inside_the_standalone_fmus_holds_a_path_of_the_building_machine(standalone, pitch_drive_fmu,
+                                                                                 table_fmu):
+    for fmu in (*standalone.values(), pitch_drive_fmu, table_fmu):
         assert runtime_of(fmu)["runtime"] == "standalone"
         assert_no_building_paths(fmu)
+
+
+def test_the_drive_and_table_fmus_of_the_ssp_are_standalone_and_valid(pitch_drive_fmu, table_fmu):
+    for fmu in (pitch_drive_fmu, table_fmu):
+        assert validate_fmu(str(fmu)) == []
+        with zipfile.ZipFile(fmu) as z:
+            assert "binaries/linux64/python/lib/libpython3.11.so.1.0".replace(
+                "3.11", f"{sys.version_info[0]}.{sys.version_info[1]}") in z.namelist()
 
 
 @pytest.fixture(scope="module")
