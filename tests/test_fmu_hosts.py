@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
+from host_output import parse_host_output
 
 ROOT = Path(__file__).resolve().parents[1]
 HOST_SOURCE = ROOT / "tests" / "c_host" / "host.c"
@@ -69,19 +70,7 @@ def run_host(c_host, fmu_dir, scenario, *extra, env=None):
     folder, guid, vrs = fmu_dir
     run = subprocess.run([str(c_host), str(folder), "SlewingBearing", guid, scenario, *vrs, *extra],
                          env=dict(MINIMAL_ENV, **(env or {})), capture_output=True, text=True, timeout=300)
-    values, statuses, logs = {}, [], []
-    for line in run.stdout.splitlines():
-        word, _, rest = line.partition(" ")
-        if word == "status":
-            label, k, status, terminated, last = rest.split()
-            statuses.append((label, int(k), int(status), int(terminated), float(last)))
-        elif word == "log":
-            status, category, message = rest.split(" ", 2)
-            logs.append((int(status), category, message))
-        elif word not in ("done", "error"):
-            k, *numbers = rest.split()
-            values.setdefault(word, {})[int(k)] = [float(x) for x in numbers]
-    errors = [line for line in run.stdout.splitlines() if line.startswith("error")]
+    values, statuses, logs, errors = parse_host_output(run.stdout)
     return run.returncode, values, statuses, logs, run.stderr + "\n".join(errors)
 
 

@@ -28,6 +28,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
+from host_output import parse_host_output
 
 ROOT = Path(__file__).resolve().parents[1]
 HOST = ROOT / "tests" / "c_host"
@@ -164,17 +165,8 @@ def run_host(system, host, fmu, version, scenario):
     shutil.copy2(host, system / "tmp" / host.name)
     inside, token, vrs = place(fmu, system, f"fmu{version}")
     run = in_system(system, f"/tmp/{host.name}", inside, MODEL[version], token, scenario, *vrs)
-    values, statuses, logs = {}, [], []
-    for line in run.stdout.splitlines():
-        word, _, rest = line.partition(" ")
-        if word == "status":
-            label, k, status, terminated, last = rest.split()
-            statuses.append((label, int(k), int(status), int(terminated), float(last)))
-        elif word == "log":
-            logs.append(rest)
-        elif word not in ("done", "error"):
-            k, *numbers = rest.split()
-            values.setdefault(word, {})[int(k)] = [float(x) for x in numbers]
+    values, statuses, logs, _ = parse_host_output(run.stdout)
+    logs = [f"{status} {category} {message}" for status, category, message in logs]
     return run.returncode, values, statuses, logs, run.stdout + run.stderr
 
 

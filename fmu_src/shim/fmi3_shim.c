@@ -117,7 +117,7 @@ static pthread_mutex_t inner_lock = PTHREAD_MUTEX_INITIALIZER;
 
 #define RESOLVE_NAME(name)                                                                \
     if (status == 0 && !(*(void **)&inner.name = dlsym(handle, #name))) {                 \
-        snprintf(err, size, "%s/%s has no function %s", dir, INNER_BINARY, #name);        \
+        snprintf(err, size, "%s has no function %s", INNER_BINARY, #name);                 \
         status = -1;                                                                      \
     }
 #define RESOLVE(name, params, args) RESOLVE_NAME(name)
@@ -131,13 +131,9 @@ static int load_inner(char *err, size_t size)
         snprintf(err, size, "the FMU's binary was released (the process is exiting)");
         status = -1;
     } else if (!inner_loaded) {
-        char dir[PATH_MAX];
-        void *handle = NULL;
-        status = -1;
-        if (python_runtime_binary_dir((const void *)&load_inner, dir, sizeof dir, err, size) == 0
-            && python_runtime_load(dir, err, size) == 0
-            && (handle = python_runtime_open_binary(dir, INNER_BINARY, err, size)) != NULL) {
-            status = 0;
+        void *handle = python_runtime_start((const void *)&load_inner, INNER_BINARY, err, size);
+        status = handle ? 0 : -1;
+        if (handle) {
             FMI3_FORWARDED(RESOLVE)
             RESOLVE_NAME(fmi3InstantiateModelExchange)
             RESOLVE_NAME(fmi3InstantiateCoSimulation)

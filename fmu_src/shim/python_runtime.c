@@ -467,6 +467,17 @@ void *python_runtime_open_binary(const char *binary_dir, const char *name, char 
     return handle;
 }
 
+void *python_runtime_start(const void *symbol, const char *name, char *err, size_t errsize)
+{
+    char dir[PATH_MAX];
+    if (binary_handle)
+        return binary_handle;
+    if (python_runtime_binary_dir(symbol, dir, sizeof dir, err, errsize) != 0
+        || python_runtime_load(dir, err, errsize) != 0)
+        return NULL;
+    return python_runtime_open_binary(dir, name, err, errsize);
+}
+
 int python_runtime_binary_open(void)
 {
     return binary_handle != NULL;

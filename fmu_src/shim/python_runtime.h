@@ -37,6 +37,11 @@ int python_runtime_load(const char *binary_dir, char *err, size_t errsize);
  * otherwise). Returns the handle, or NULL with a message in err. */
 void *python_runtime_open_binary(const char *binary_dir, const char *name, char *err, size_t errsize);
 
+/* What both FMI layers do first: Python made available (python_runtime_load), then the binary
+ * `name` beside the library that holds `symbol` opened (python_runtime_open_binary). Returns its
+ * handle, or NULL with a message in err (also once the binary was released at exit). */
+void *python_runtime_start(const void *symbol, const char *name, char *err, size_t errsize);
+
 /* 1 while that binary may be called: not after it was released at exit. */
 int python_runtime_binary_open(void);
 
