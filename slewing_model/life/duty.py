@@ -224,8 +224,8 @@ class LifeAccumulator:
     def get_state(self) -> dict:
         h = self.half
         return {"map": self.map.get_state(),
-                "half": {"direction": h.direction, "turn": h.turn, "extreme": h.extreme, "b_max": h.b_max.copy(),
-                         "angle": h.angle.copy(), "last_ratio": h.last_ratio, "last_swing": h.last_swing,
+                "half": {"direction": h.direction, "turn": h.turn, "extreme": h.extreme, "b_max": h.b_max,
+                         "angle": h.angle, "last_ratio": h.last_ratio, "last_swing": h.last_swing,
                          "completed": h.completed},
                 "rows": len(self.rows)}
 

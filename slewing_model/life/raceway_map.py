@@ -104,12 +104,17 @@ class RacewayMap:
         q3 = np.maximum(contact_load, 0.0) ** 3
         if self._angle is not None:
             mean = 0.5 * (q3 + self._q3) * self.scale
+            added = None
             for ring_moving in (False, True):
                 shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)
                 ball, where = crossed_slices(self._angle - shift_old, ball_angle - shift_new, self.slices)
                 if ball.size:
                     for k in np.nonzero(self.moving == ring_moving)[0]:
-                        self.damage_map[k] += np.bincount(where, mean[ball, k], minlength=self.slices)
+                        if added is None:
+                            added = np.zeros_like(self.damage_map)
+                        added[k] = np.bincount(where, mean[ball, k], minlength=self.slices)
+            if added is not None:
+                self.damage_map = self.damage_map + added     # a new array: states keep theirs unchanged
         self._angle = np.array(ball_angle, dtype=float)
         self._psi = float(psi)
         self._q3 = q3
@@ -119,8 +124,8 @@ class RacewayMap:
         return track_damage(self.damage_map)
 
     def get_state(self) -> dict:
-        return {"map": self.damage_map.copy(), "angle": None if self._angle is None else self._angle.copy(),
-                "psi": self._psi, "q3": None if self._q3 is None else self._q3.copy()}
+        """The map's state (arrays not copied: :meth:`update` never changes them in place)."""
+        return {"map": self.damage_map, "angle": self._angle, "psi": self._psi, "q3": self._q3}
 
     def set_state(self, state: dict) -> None:
         self.damage_map = np.array(state["map"], dtype=float).reshape(4, self.slices)

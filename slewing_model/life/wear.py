@@ -37,7 +37,7 @@ def rolling_travel(swing, pitch_diameter, ball_diameter, contact_angle):
 
     Examples
     --------
-    >>> round(rolling_travel(math.radians(1.0), 1.0, 0.05, 0.0) * 1e3, 4)   # dm 1000 mm, γ = 0.05
+    >>> round(float(rolling_travel(math.radians(1.0), 1.0, 0.05, 0.0)) * 1e3, 4)   # dm 1000 mm, γ = 0.05
     4.3524
     """
     g = gamma(ball_diameter, pitch_diameter, contact_angle)
