@@ -259,7 +259,7 @@ class LifeResult:
     life_hours : float, h
         ``duration / damage``.
     worst_track : int
-        Contact 1..4 with the largest damage.
+        Contact 1..4 with the largest damage (0: no damage, the ring never moved).
     map_track_damage : ndarray (4,), map_damage : float, map_life_hours : float
         The same from the raceway map.
     damage_map : ndarray (4, slices)
@@ -348,7 +348,7 @@ def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
     dg = dg03_life(pea, cyc.swing, cyc.count, m.rating, m.bearing.ball_count, float(m.critical.max()), duration)
     return LifeResult(
         duration=duration, track_damage=track, damage=damage, life_hours=_hours(duration, damage),
-        worst_track=int(np.argmax(track)) + 1, map_track_damage=map_track, map_damage=map_damage,
+        worst_track=int(np.argmax(track)) + 1 if damage > 0 else 0, map_track_damage=map_track, map_damage=map_damage,
         map_life_hours=_hours(duration, map_damage), damage_map=accumulator.map.damage_map.copy(), dg03=dg,
         swing=cyc.swing, count=cyc.count, below_critical=below, travel_ratio=ratio, share_below_one=share,
         peak_pressure=r["p_max"].max(axis=0),

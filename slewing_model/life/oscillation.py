@@ -8,8 +8,7 @@
   tracks on a raceway do not overlap, ``θcrit = 720° / (Z (1 ± γ))``, upper sign for the
   inner raceway (the ball moves over it by ``(1 + γ)/2`` of the ring's swing).
 * Above it a cycle counts as ``θ/180°`` revolutions (the raceway is overrolled as in
-  rotation, ``2θ/360°`` revolutions per cycle; Rumbarger and Jones; Houpert and Menck,
-  Life calculation of oscillating rolling bearings ..., Lubricants 10, 2022).
+  rotation, ``2θ/360°`` revolutions per cycle; Rumbarger and Jones; Houpert and Menck 2022).
 * Below it the rating is raised by NREL DG03's factor for balls (Harris, Rumbarger and
   Butterfield, Wind turbine design guideline DG03: yaw and pitch rolling bearing life,
   NREL/TP-500-42362, 2009): ``Ca_osc = Ca (180°/θ)^(3/10) Z^0.033``, so a cycle counts as
