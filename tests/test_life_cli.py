@@ -28,3 +28,16 @@ def test_life_command_writes_table_and_figure(tmp_path, capsys):
     assert summary["life_L10_h"] > 0 and summary["life_map_L10_h"] > 0
     for name in ("raceway_damage.csv", "life_cycles.csv", "life.png"):
         assert (out / name).stat().st_size > 0
+
+
+def test_parquet_time_series_round_trip(tmp_path):
+    """A case's time series written as Parquet reads back bit for bit (CSV keeps 10 digits)."""
+    pq = __import__("pytest").importorskip("pyarrow.parquet")
+    from slewing_model.study.case import TIMESERIES_COLUMNS
+    from slewing_model.study.engine import write_parquet
+
+    table = np.random.default_rng(3).normal(size=(50, len(TIMESERIES_COLUMNS)))
+    assert write_parquet(str(tmp_path / "t.parquet"), table, TIMESERIES_COLUMNS)
+    back = pq.read_table(tmp_path / "t.parquet")
+    assert back.column_names == list(TIMESERIES_COLUMNS)
+    np.testing.assert_array_equal(np.column_stack([back.column(c).to_numpy() for c in TIMESERIES_COLUMNS]), table)
