@@ -196,7 +196,10 @@ def life_figure(path: str, case_dirs: list[str], title: str | None = None) -> st
     for folder in case_dirs:
         d = np.loadtxt(os.path.join(folder, "raceway_damage.csv"), delimiter=",", skiprows=1, ndmin=2)
         damage = d if damage is None else np.column_stack([d[:, 0], damage[:, 1:] + d[:, 1:]])
-        c = np.loadtxt(os.path.join(folder, "life_cycles.csv"), delimiter=",", skiprows=1, ndmin=2)
+        cycles = os.path.join(folder, "life_cycles.csv")
+        with open(cycles) as fh:
+            empty = len(fh.read().splitlines()) < 2          # a ring that never moved: no cycles
+        c = np.zeros((0, 3)) if empty else np.loadtxt(cycles, delimiter=",", skiprows=1, ndmin=2)
         if c.size:
             ratios.append(c[:, 2])
             counts.append(c[:, 1])
