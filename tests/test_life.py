@@ -237,3 +237,28 @@ def test_bad_input_names_field_value_and_rule():
         life.LifeSettings(rating=-1.0)
     with pytest.raises(life.LifeInputError, match="groove_radius"):
         life.raceway_capacity("inner", 7, 0.01, 0.05, 0.0, 0.004)
+
+
+def test_iso281_axial_rating_branches_meet_at_one_inch():
+    """ISO 281's two formulas, bm fc (cos α)^0.7 tan α Z^(2/3) Dw^1.8 and 3.647 bm fc ... Dw^1.4, meet at
+    Dw = 25.4 mm (3.647 = 25.4^0.4): the rating is continuous in the ball size, and equals the formula."""
+    a, z, fc = math.radians(45.0), 40, 50.0
+    below = life.iso281_axial_rating(fc, z, 25.4e-3, a)
+    above = life.iso281_axial_rating(fc, z, 25.4e-3 * (1 + 1e-12), a)
+    assert above == pytest.approx(below, rel=1e-4)
+    assert below == pytest.approx(1.3 * fc * math.cos(a) ** 0.7 * math.tan(a) * z ** (2 / 3) * 25.4 ** 1.8, rel=1e-14)
+
+
+def test_per_track_wear_indicators_of_a_steady_swing():
+    """Each loaded track's x/2b in a cycle is θ (dm/4)(1 - γ²) / 2b; unloaded tracks have none (inf)."""
+    model = life.LifeModel(BEARING, "inner", "fixed")
+    acc = life.LifeAccumulator(model, record=True)
+    theta, b = math.radians(2.0), 1.5e-3
+    psi = np.concatenate([np.linspace(0, theta, 21), np.linspace(theta, 0, 21)[1:]] * 3)
+    for k, p in enumerate(psi):
+        acc.step(0.1 * k, p, synthetic_step(BEARING, p, lambda phi: np.full_like(phi, 1e5), b=b), (0, 0, 1e6, 0, 0))
+    r = life.analyse_run(acc)
+    x = life.rolling_travel(theta, BEARING.pitch_diameter, BEARING.ball_diameter, BEARING.contact_angle)
+    big = np.isclose(r.swing, theta)
+    assert np.all(r.track_travel_ratio[big][:, [0, 2]] == pytest.approx(x / (2 * b), rel=1e-12))
+    assert np.all(np.isinf(r.track_travel_ratio[:, [1, 3]]))

@@ -78,7 +78,8 @@ def run(args) -> int:
 
         os.makedirs(args.output, exist_ok=True)
         write_life(args.output, {"damage_map": res.damage_map, "swing": res.swing, "count": res.count,
-                                 "travel_ratio": res.travel_ratio})
+                                 "travel_ratio": res.travel_ratio, "track_travel_ratio": res.track_travel_ratio,
+                                 "cycle_peak_pressure": res.cycle_peak_pressure, "critical_angle": model.critical})
         with open(os.path.join(args.output, "life_summary.json"), "w") as fh:
             json.dump({**summary, "track_damage": res.track_damage.tolist(),
                        "map_track_damage": res.map_track_damage.tolist(), "capacity_N": model.capacity.tolist(),

@@ -270,6 +270,10 @@ class LifeResult:
         Share of cycles (by count) whose swing is below the inner raceway's critical angle.
     travel_ratio : ndarray
         ``x/2b`` of each cycle (the smallest over the loaded tracks).
+    track_travel_ratio : ndarray (cycles, 4)
+        ``x/2b`` of each cycle and contact 1..4 (the contact's widest patch in the cycle; inf: unloaded).
+    cycle_peak_pressure : ndarray (cycles, 4), Pa
+        Largest Hertz pressure of each contact in each cycle.
     share_below_one : float
         Share of cycles (by count) with ``x/2b < 1``.
     peak_pressure : ndarray (4,), Pa
@@ -294,6 +298,8 @@ class LifeResult:
     below_critical: float
     travel_ratio: np.ndarray
     share_below_one: float
+    track_travel_ratio: np.ndarray
+    cycle_peak_pressure: np.ndarray
     peak_pressure: np.ndarray
     relubrication_gap: float
     relubrication_swing: float
@@ -330,15 +336,19 @@ def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
     map_track = accumulator.track_damage
     map_damage = float(combined_damage(map_track))
 
-    b, ang = r["b_max"], r["angle_at_b_max"]
-    ratio = np.empty(cyc.swing.size)
+    b, ang, pmax = r["b_max"], r["angle_at_b_max"], r["p_max"]
+    track_ratio = np.full((cyc.swing.size, 4), np.inf)            # x/2b per cycle and track (inf: unloaded)
+    cycle_pressure = np.zeros((cyc.swing.size, 4))
+    cols = np.arange(4)
     for i, (s, e) in enumerate(zip(cyc.start, cyc.end)):
         bb = b[s:e + 1]
-        k = np.argmax(bb, axis=0)
-        bmax, a = bb[k, np.arange(4)], ang[s:e + 1][k, np.arange(4)]
+        k = np.argmax(bb, axis=0)                                  # the widest patch of each track in the cycle
+        bmax, a = bb[k, cols], ang[s:e + 1][k, cols]
         loaded = bmax > 0
         x = rolling_travel(cyc.swing[i], m.bearing.pitch_diameter, m.bearing.ball_diameter, a[loaded])
-        ratio[i] = np.min(x / (2 * bmax[loaded])) if np.any(loaded) else math.inf
+        track_ratio[i, loaded] = x / (2 * bmax[loaded])
+        cycle_pressure[i] = pmax[s:e + 1].max(axis=0)
+    ratio = track_ratio.min(axis=1) if cyc.swing.size else np.zeros(0)
     total = float(cyc.count.sum())
     share = float(cyc.count[ratio < 1.0].sum() / total) if total else math.nan
     below = float(cyc.count[cyc.swing < m.critical.min()].sum() / total) if total else math.nan
@@ -351,6 +361,7 @@ def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
         worst_track=int(np.argmax(track)) + 1 if damage > 0 else 0, map_track_damage=map_track, map_damage=map_damage,
         map_life_hours=_hours(duration, map_damage), damage_map=accumulator.map.damage_map.copy(), dg03=dg,
         swing=cyc.swing, count=cyc.count, below_critical=below, travel_ratio=ratio, share_below_one=share,
+        track_travel_ratio=track_ratio, cycle_peak_pressure=cycle_pressure,
         peak_pressure=r["p_max"].max(axis=0),
         relubrication_gap=relubrication_gap(t, psi, m.relubrication_swing),
         relubrication_swing=m.relubrication_swing)

@@ -196,8 +196,20 @@ def run_case(task: CaseTask) -> CaseResult:
                           {"error": one_line(exc)})
     stats.update(result.summary())
     cycles = {"damage_map": result.damage_map, "swing": result.swing, "count": result.count,
-              "travel_ratio": result.travel_ratio, "peak_pressure": result.peak_pressure}
+              "travel_ratio": result.travel_ratio, "peak_pressure": result.peak_pressure,
+              "track_travel_ratio": result.track_travel_ratio, "cycle_peak_pressure": result.cycle_peak_pressure,
+              "critical_angle": model_critical(sim)}
     return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram, cycles)
+
+
+def model_critical(sim) -> np.ndarray:
+    """Critical angles of contacts 1..4 of the simulator's bearing, rad."""
+    from ..life.oscillation import critical_angle
+    from ..life.rating import TRACK_RINGS
+
+    b = sim.bearing
+    return np.array([float(critical_angle(b.ball_count, b.ball_diameter, b.pitch_diameter, b.contact_angle, r))
+                     for r in TRACK_RINGS])
 
 
 def time_weights(t: np.ndarray) -> np.ndarray:

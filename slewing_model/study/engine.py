@@ -21,7 +21,9 @@ Output directory::
                                        reads each case's file)
     DIR/cases/<key>/raceway_damage.csv slice centre angle (deg, in its ring's frame) and the damage of
                                        contacts 1..4 in that slice (slewing_model.life.raceway_map)
-    DIR/cases/<key>/life_cycles.csv    rainflow cycles of psi: swing (rad), count, x/2b
+    DIR/cases/<key>/life_cycles.csv    rainflow cycles of psi: swing (rad), count, x/2b (smallest over the
+                                       loaded contacts), and per contact 1..4 x/2b, swing over its
+                                       critical angle and peak Hertz pressure (Pa)
     DIR/cases/<key>/ball_load_histogram.csv   ball, diagonal, load bin, time, rotation
     DIR/cases/<key>/result.json        status, statistics, wall time, worker (written last)
     DIR/figures/*.png                  see slewing_model.study.figures
@@ -158,9 +160,16 @@ def write_life(folder: str, life: dict) -> None:
     angle = (np.arange(slices) + 0.5) * 360.0 / slices
     np.savetxt(os.path.join(folder, "raceway_damage.csv"), np.column_stack([angle, damage.T]), delimiter=",",
                fmt="%.10g", header="angle_deg,contact1,contact2,contact3,contact4", comments="")
-    np.savetxt(os.path.join(folder, "life_cycles.csv"),
-               np.column_stack([life["swing"], life["count"], life["travel_ratio"]]), delimiter=",", fmt="%.10g",
-               header="swing_rad,count,travel_ratio", comments="")
+    columns = [life["swing"], life["count"], life["travel_ratio"]]
+    header = ["swing_rad", "count", "travel_ratio"]
+    if "track_travel_ratio" in life:
+        swing = np.asarray(life["swing"])
+        for k in range(4):
+            columns += [np.asarray(life["track_travel_ratio"])[:, k], swing / life["critical_angle"][k],
+                        np.asarray(life["cycle_peak_pressure"])[:, k]]
+            header += [f"travel_ratio_{k + 1}", f"swing_over_critical_{k + 1}", f"peak_pressure_{k + 1}_Pa"]
+    np.savetxt(os.path.join(folder, "life_cycles.csv"), np.column_stack(columns), delimiter=",", fmt="%.10g",
+               header=",".join(header), comments="")
 
 
 def summary_row(case: Case, record: dict | None, status: str | None = None) -> dict:
