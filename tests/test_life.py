@@ -262,3 +262,20 @@ def test_per_track_wear_indicators_of_a_steady_swing():
     big = np.isclose(r.swing, theta)
     assert np.all(r.track_travel_ratio[big][:, [0, 2]] == pytest.approx(x / (2 * b), rel=1e-12))
     assert np.all(np.isinf(r.track_travel_ratio[:, [1, 3]]))
+
+
+def test_a_given_rating_scales_every_life_by_its_cube():
+    """Qc ∝ Ca (the tracks keep their ratios) and DG03 uses the same Ca: giving twice the derived Ca
+    multiplies our life, the map's and DG03's by 2³ and leaves their ratio alone."""
+    lives = []
+    for rating in (None, 2 * life.axial_rating(BEARING)):
+        model = life.LifeModel(BEARING, "inner", "fixed", life.LifeSettings(rating=rating))
+        acc = life.LifeAccumulator(model, record=True)
+        psi = np.concatenate([np.linspace(0, 0.02, 11), np.linspace(0.02, 0, 11)[1:]] * 4)
+        for k, p in enumerate(psi):
+            acc.step(0.1 * k, p, synthetic_step(BEARING, p, lambda phi: 1e5 * (1 + 0.3 * np.cos(phi))),
+                     (1e4, 0, 1e6, 2e5, 0))
+        r = life.analyse_run(acc)
+        lives.append((r.life_hours, r.map_life_hours, r.dg03.hours))
+    for a, b in zip(*lives):
+        assert b == pytest.approx(8 * a, rel=1e-10)

@@ -275,10 +275,11 @@ def axial_rating(bearing, capacities=None) -> float:
 
     The axial load whose equal ball loads ``Q = Ca / (Z sin α)`` give ``L10 = 10^6`` revolutions
     on the diagonal's two tracks: ``Ca = Z sin α [Qc_o^(-10/3) + Qc_i^(-10/3)]^(-3/10)``, the
-    weaker diagonal taken. This is how ISO 281's rating of thrust ball bearings with α ≠ 90°,
+    weaker diagonal taken. ISO 281's rating of thrust ball bearings with α ≠ 90°,
     ``Ca = bm fc (cos α)^0.7 tan α Z^(2/3) Dw^1.8`` (``Dw ≤ 25.4 mm``; ``3.647 ... Dw^1.4`` above),
-    follows from the raceway capacities; :func:`iso281_axial_rating` evaluates the standard's
-    formula for a tabulated ``fc``.
+    has the structure of ``Z sin α Qc``, without the empirical reductions of the standard's ``fc``
+    table (so it can differ from an ISO 281 or catalogue value); :func:`iso281_axial_rating`
+    evaluates the standard's formula for a tabulated ``fc``.
     """
     qc = four_point_capacities(bearing) if capacities is None else np.asarray(capacities, dtype=float)
     e = LIFE_EXPONENT * WEIBULL_SLOPE
