@@ -279,3 +279,20 @@ def test_a_given_rating_scales_every_life_by_its_cube():
         lives.append((r.life_hours, r.map_life_hours, r.dg03.hours))
     for a, b in zip(*lives):
         assert b == pytest.approx(8 * a, rel=1e-10)
+
+
+def test_radial_bearing_life_reproduces_the_published_case():
+    """The same published case through the one-call form (inner ring rotating, C given)."""
+    r = life.radial_bearing_life(rigid_radial_ball_loads(1000.0, Z), Z, DW, DM, 0.0, RI, RE, "inner", C)
+    assert r.equivalent_load == pytest.approx([347.86, 363.99], abs=0.005)
+    assert r.capacity == pytest.approx([8423.2, 18288.7], abs=0.05)
+    assert r.life == pytest.approx(13163.0, rel=2e-5)
+
+
+def test_outer_ring_rotating_swaps_the_exponents():
+    """With the outer ring turning, the inner raceway stands relative to the load: its Qe takes the
+    exponent 10/3 and the outer's 3 (ISO/TS 16281)."""
+    q = rigid_radial_ball_loads(1000.0, Z)
+    r = life.radial_bearing_life(q, Z, DW, DM, 0.0, RI, RE, "outer", C)
+    assert r.equivalent_load[0] == pytest.approx((np.sum(q ** (10 / 3)) / Z) ** 0.3, rel=1e-14)
+    assert r.equivalent_load[1] == pytest.approx((np.sum(q ** 3) / Z) ** (1 / 3), rel=1e-14)

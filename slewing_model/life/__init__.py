@@ -14,7 +14,7 @@ counting of a finished run).
 """
 from .rating import (LifeInputError, Raceway, RacewayLife, axial_rating, combined_life, equivalent_load,
                      four_point_capacities, iso281_axial_rating, raceway_capacity, raceway_life,
-                     radial_raceway_capacities)
+                     radial_bearing_life, radial_raceway_capacities)
 from .oscillation import critical_angle, dg03_rating_factor, equivalent_revolutions, rainflow_cycles
 from .raceway_map import RacewayMap, track_damage
 from .wear import rolling_travel, relubrication_gap
@@ -23,7 +23,8 @@ from .duty import LifeAccumulator, LifeModel, LifeResult, LifeSettings, analyse_
 
 __all__ = [
     "LifeInputError", "Raceway", "RacewayLife", "axial_rating", "combined_life", "equivalent_load",
-    "four_point_capacities", "iso281_axial_rating", "raceway_capacity", "raceway_life", "radial_raceway_capacities",
+    "four_point_capacities", "iso281_axial_rating", "raceway_capacity", "raceway_life", "radial_bearing_life",
+    "radial_raceway_capacities",
     "critical_angle", "dg03_rating_factor", "equivalent_revolutions", "rainflow_cycles",
     "RacewayMap", "track_damage", "rolling_travel", "relubrication_gap",
     "DG03Life", "dg03_life", "equivalent_axial_load",

@@ -248,6 +248,47 @@ def raceway_life(raceways, ball_count: int, ball_diameter: float, pitch_diameter
     return RacewayLife(qc, qe, float(combined_life(qc, qe)))
 
 
+def radial_bearing_life(ball_loads, ball_count, ball_diameter, pitch_diameter, contact_angle,
+                        inner_groove_radius, outer_groove_radius, rotating_ring="inner", rating=None,
+                        outer_ball_loads=None, rows=1) -> RacewayLife:
+    """ISO/TS 16281 life of a (single-row) radial or angular contact ball bearing under a load of fixed
+    direction: its inner and outer raceway, in that order.
+
+    Parameters
+    ----------
+    ball_loads : array_like (Z,), N
+        Ball loads on the inner raceway (and on the outer one unless ``outer_ball_loads``).
+    ball_count : int
+    ball_diameter, pitch_diameter : float, m
+    contact_angle : float, rad
+        Nominal contact angle.
+    inner_groove_radius, outer_groove_radius : float, m
+    rotating_ring : {"inner", "outer"}
+        The ring that turns; under a load of fixed direction it turns relative to the load
+        (exponent 3), the other stands (exponent 10/3).
+    rating : float or None, N
+        Basic dynamic radial rating ``C``: capacities by :func:`radial_raceway_capacities`; None:
+        from the geometry (:func:`raceway_capacity`).
+    outer_ball_loads : array_like (Z,) or None, N
+    rows : int
+
+    Returns
+    -------
+    RacewayLife
+    """
+    _check_ring("rotating_ring", rotating_ring)
+    q_in = np.asarray(ball_loads, dtype=float)
+    q_out = q_in if outer_ball_loads is None else np.asarray(outer_ball_loads, dtype=float)
+    if rating is None:
+        qci = qce = None
+    else:
+        qci, qce = radial_raceway_capacities(rating, ball_count, ball_diameter, pitch_diameter, contact_angle,
+                                             inner_groove_radius, outer_groove_radius, rows)
+    return raceway_life([Raceway("inner", inner_groove_radius, contact_angle, q_in, rotating_ring == "inner", qci),
+                         Raceway("outer", outer_groove_radius, contact_angle, q_out, rotating_ring == "outer", qce)],
+                        ball_count, ball_diameter, pitch_diameter)
+
+
 # ---- the four-point contact bearing ------------------------------------------------------
 #: column of each contact 1..4 in the (B, 4) arrays, and its ring
 TRACK_RINGS = ("outer", "inner", "inner", "outer")
