@@ -225,7 +225,7 @@ class SlewingBearing(Fmi2Slave):
         result = step_or_refuse(self, current_time, Fmi2Status.discard, Fmi2Status.error)
         if result is None:
             return False
-        for name, value in scalar_outputs(result).items():
+        for name, value in scalar_outputs(result, self.simulator).items():
             setattr(self, name, value)
         d = result.distribution
         self._q = d.contact_load.tolist()

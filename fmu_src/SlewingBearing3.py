@@ -151,7 +151,7 @@ class SlewingBearing3(Fmi3Slave):
         result = step_or_refuse(self, current_time, Fmi3Status.discard, Fmi3Status.error)
         if result is None:
             return False
-        for name, value in scalar_outputs(result).items():
+        for name, value in scalar_outputs(result, self.simulator).items():
             setattr(self, name, value)
         d = result.distribution
         for name, _, columns, _, attribute in BALL_ARRAYS:

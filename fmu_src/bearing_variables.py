@@ -47,6 +47,16 @@ OUTPUTS = [  # name, unit, description
     ("static_safety_factor", "1", "ISO 76 static safety factor (4200 MPa / p_max)^3"),
 ]
 
+#: life and wear outputs (slewing_model.life), 0 while the parameter life is 0 (off)
+LIFE_OUTPUTS = [
+    ("life_damage", "1", "rolling contact fatigue damage of the worst raceway track so far, from the raceway map "
+                         "(1: its L10 is used up; ISO/TS 16281 capacities, docs/life.md)"),
+    ("life_travel_ratio", "1", "x/2b of the last completed half-cycle of psi: rolling travel of the contacts over "
+                               "the Hertz patch width (smallest over the loaded tracks; < 1: the patch is never "
+                               "uncovered; 0 until the first half-cycle is completed)"),
+]
+OUTPUTS = OUTPUTS + LIFE_OUTPUTS
+
 #: integer output (FMI 2.0 Integer, FMI 3.0 Int32): name, description
 COUNT_OUTPUT = ("balls_in_four_point_contact", "number of balls loaded on both diagonals")
 
@@ -64,12 +74,14 @@ REAL_PARAMETERS = [
 RING_MODELS = {1: "rigid", 2: "flexible"}
 MOVING_RINGS = {1: "inner", 2: "outer"}
 LOAD_FRAMES = {1: "fixed", 2: "rotating"}
+LIFE = {0: "off", 1: "on"}
 
 #: integer parameters: name, choices, description (the choices are listed after it)
 INTEGER_PARAMETERS = [
     ("ring_model", RING_MODELS, "ring model"),
     ("moving_ring", MOVING_RINGS, "ring the loads act on and that turns"),
     ("load_frame", LOAD_FRAMES, "frame of the input loads"),
+    ("life", LIFE, "life and wear accumulators (outputs life_damage, life_travel_ratio)"),
 ]
 
 #: per-ball results: FMI 3.0 array name, unit, columns (FMI 2.0 scalar suffixes), description,
@@ -117,6 +129,7 @@ def settings_of(values: dict) -> dict:
     ValueError naming a bad integer choice (the settings check the rest)."""
     settings = check_choices(values)
     settings.update({name: float(values[name]) for name, *_ in REAL_PARAMETERS})
+    settings["life"] = settings["life"] == "on"
     return settings
 
 
@@ -245,12 +258,17 @@ def step_or_refuse(slave, current_time, discard, error):
     return result
 
 
-def scalar_outputs(result) -> dict:
-    """The scalar outputs (:data:`OUTPUTS` and :data:`COUNT_OUTPUT`) of a step result, by name."""
+def scalar_outputs(result, simulator=None) -> dict:
+    """The scalar outputs (:data:`OUTPUTS` and :data:`COUNT_OUTPUT`) of a step result, by name; the
+    life outputs from ``simulator.life`` (0 without it)."""
     d = result.distribution
     values = dict(zip(("x", "y", "z", "rx", "ry"), map(float, d.displacement)))
     values.update(friction_torque=result.friction_torque, friction_torque_magnitude=result.friction_torque_magnitude,
                   max_ball_load=d.max_ball_load, max_contact_pressure=d.max_contact_pressure,
                   static_safety_factor=min(d.static_safety_factor, 1e300))
     values[COUNT_OUTPUT[0]] = d.balls_in_four_point_contact
+    life = getattr(simulator, "life", None)
+    ratio = math.nan if life is None else life.last_ratio
+    values.update(life_damage=0.0 if life is None else life.worst_damage,
+                  life_travel_ratio=0.0 if math.isnan(ratio) else ratio)
     return values

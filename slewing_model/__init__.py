@@ -18,10 +18,14 @@ from .friction import FrictionTorque, catalogue_torque, friction_torque
 __version__ = "0.1.0"
 
 #: the run-time part of the package (numpy and the standard library): the modules an FMU carries
+#: (paths below slewing_model/, without .py)
 RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "contact_kernel", "assembly", "distribution",
                    "ring_stiffness", "ring_compliance", "reduced_operator", "bime", "blas", "ellipse_quadrature",
                    "contact_friction", "ball_kinematics", "friction_kernel", "catalogue", "friction_studies",
-                   "friction", "simulator")
+                   "friction", "simulator",
+                   # the life subpackage's run-time modules: build_fmu copies each file flat into the FMU's
+                   # slewing_model (they import only their siblings, relatively, so they work there too)
+                   "life/rating", "life/oscillation", "life/raceway_map", "life/wear", "life/dg03", "life/duty")
 
 __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",

@@ -212,6 +212,16 @@ def _add_batch(sub) -> None:
     p.set_defaults(func=command.run)
 
 
+def _add_life(sub) -> None:
+    """``slewing life LOADS.csv BEARING.toml`` (slewing_model.life.command)."""
+    from .life import command
+
+    p = sub.add_parser("life", help="life and wear of one load series: ISO/TS 16281 with oscillations, raceway "
+                                    "damage map, DG03, x/2b (docs/life.md)")
+    command.add_arguments(p)
+    p.set_defaults(func=command.run)
+
+
 def main(argv=None) -> int:
     argv = _attach_negative_numbers(sys.argv[1:] if argv is None else list(argv))
     parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
@@ -221,6 +231,7 @@ def main(argv=None) -> int:
     _add_superelement(sub, wanted=bool(argv) and argv[0] == "superelement")
     _add_batch(sub)
     _add_loads(sub)
+    _add_life(sub)
     args = parser.parse_args(argv)
     try:
         code = int(args.func(args) or 0)

@@ -77,6 +77,10 @@ class SimulatorSettings:
     contact_kernel : {"auto", "numpy", "compiled"}
         The same for the load distribution's loops (its per-contact work and the reduced ring
         operator's: ``kernel`` of :class:`slewing_model.bime.BimeSolver`).
+    life : bool
+        Accumulate the raceway life and wear step by step (:class:`slewing_model.life.LifeAccumulator`
+        as ``BearingSimulator.life``, default :class:`slewing_model.life.LifeSettings`): the
+        raceway damage map and the half-cycles of ``psi``; part of the simulator's state.
     """
 
     ring_model: str = "flexible"
@@ -91,6 +95,7 @@ class SimulatorSettings:
     blas_threads: int | None = 1
     friction_kernel: str = "auto"
     contact_kernel: str = "auto"
+    life: bool = False
 
     def __post_init__(self):
         _choice("ring_model", self.ring_model, RING_MODELS)
@@ -180,6 +185,14 @@ class BearingSimulator:
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
         self._psi = 0.0
         self.last: StepResult | None = None
+        self.life = None
+        if s.life:
+            try:
+                from .life import LifeAccumulator, LifeModel
+            except ImportError:        # in an FMU the life modules sit flat beside this one (RUNTIME_MODULES)
+                from .duty import LifeAccumulator, LifeModel
+
+            self.life = LifeAccumulator(LifeModel(bearing, s.moving_ring, s.load_frame))
 
     def tune(self, **changes) -> None:
         """Change the tunable settings (``friction_coefficient``, ``seal_torque``,
@@ -228,6 +241,8 @@ class BearingSimulator:
                 magnitude = friction.magnitude
                 self._friction_warm = friction.state
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
+        if self.life is not None:
+            self.life.step(None, psi, distribution)
         self._previous, self._warm = self._warm, distribution.state
         self._psi = psi
         self.last = StepResult(distribution, signed, magnitude)
@@ -249,7 +264,8 @@ class BearingSimulator:
         operator, pending = self.solver.operator, self.solver.pending_operator
         return {"warm": self._warm, "previous": self._previous, "psi": self._psi,
                 "operator": None if operator is None else operator.as_tuple(),
-                "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm}
+                "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm,
+                "life": None if self.life is None else self.life.get_state()}
 
     def set_state(self, state: dict) -> None:
         """Restore :meth:`get_state` (or its :func:`decode_state`)."""
@@ -261,6 +277,8 @@ class BearingSimulator:
         pending = state.get("pending")
         self.solver.pending_operator = None if pending is None else PendingOperator.from_tuple(pending)
         self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
+        if self.life is not None and state.get("life") is not None:
+            self.life.set_state(state["life"])
 
 
 def encode_state(value):

@@ -21,6 +21,15 @@ Statistics (SI units)
     the ring rotation ``v = |omega| dt`` (by time when the ring stands still), the
     dynamic equivalent load of the rolling-contact life formula.
 
+Life and wear (:mod:`slewing_model.life`, ``docs/life.md``)
+    ``life_L10_h``: the ISO/TS 16281 rating life of the raceways with the oscillation rule, in hours
+    of the case's duty repeated, and ``life_worst_track`` (contact 1..4); ``life_damage_per_h``;
+    ``life_map_L10_h``: the same from the raceway damage map; ``life_dg03_L10_h`` and
+    ``life_dg03_ratio`` (DG03's life over ours); ``life_cycles`` (rainflow count of ``psi``);
+    ``life_share_x2b_below_1`` and ``life_share_below_critical`` (shares of the cycles);
+    ``life_relubrication_gap_s``. The raceway map (4 tracks x slices) and the cycles (swing,
+    count, x/2b) come back in ``CaseResult.life``.
+
 Load spectrum (for a life calculation)
     Per ball and diagonal (``13``: contacts 1 and 3; ``24``: 2 and 4), the time and
     the ring rotation spent with the diagonal load in each of ``histogram_bins``
@@ -37,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..bime import Loads
+from ..life import LifeAccumulator, LifeModel, analyse_run
 from ..simulator import BearingSimulator, SimulatorSettings
 from .series import MotionSeries
 
@@ -46,7 +56,10 @@ TIMESERIES_COLUMNS = ("time", "psi", "omega", "Fx", "Fy", "Fz", "Mx", "My", "Mz"
                       "static_safety_factor", "balls_in_four_point_contact")
 STATISTICS = ("friction_torque_mean", "friction_torque_max", "friction_torque_p99", "friction_energy",
               "max_ball_load", "max_contact_pressure", "min_static_safety_factor", "equivalent_ball_load",
-              "rotation", "duration", "steps")
+              "rotation", "duration", "steps",
+              "life_L10_h", "life_worst_track", "life_damage_per_h", "life_map_L10_h", "life_dg03_L10_h",
+              "life_dg03_ratio", "life_cycles", "life_share_x2b_below_1", "life_share_below_critical",
+              "life_relubrication_gap_s")
 HISTOGRAM_COLUMNS = ("ball", "diagonal", "load_lower_N", "load_upper_N", "time_s", "rotation_rad")
 
 
@@ -92,6 +105,9 @@ class CaseResult:
     timeseries : ndarray (n, len(TIMESERIES_COLUMNS)) or None
     statistics : dict or None
     histogram : ndarray (m, len(HISTOGRAM_COLUMNS)) or None
+    life : dict or None
+        ``damage_map`` (4, slices) of contacts 1..4; ``swing`` (rad), ``count`` and ``travel_ratio``
+        (x/2b) of the rainflow cycles; ``peak_pressure`` (4,), Pa.
     """
 
     key: str
@@ -101,6 +117,7 @@ class CaseResult:
     timeseries: np.ndarray | None = None
     statistics: dict | None = None
     histogram: np.ndarray | None = None
+    life: dict | None = None
 
 
 def one_line(exc: BaseException) -> str:
@@ -156,9 +173,11 @@ def run_case(task: CaseTask) -> CaseResult:
         out = np.empty((n, len(TIMESERIES_COLUMNS)))
         out[:, 0], out[:, 1], out[:, 2], out[:, 3:9] = series.time, series.psi, series.omega, series.loads
         diagonal = np.empty((n, sim.bearing.ball_count, 2), dtype=np.float32)
+        life = LifeAccumulator(LifeModel(sim.bearing, sim.settings.moving_ring, sim.settings.load_frame), record=True)
         for k in range(n):
             r = sim.step(Loads.from_array(series.loads[k, :5]), float(series.psi[k]), float(series.omega[k]))
             d = r.distribution
+            life.step(float(series.time[k]), float(series.psi[k]), d, series.loads[k, :5])
             out[k, 9:14] = d.displacement
             out[k, 14:] = (r.friction_torque, r.friction_torque_magnitude, d.max_ball_load, d.max_contact_pressure,
                            d.static_safety_factor, d.balls_in_four_point_contact)
@@ -170,7 +189,27 @@ def run_case(task: CaseTask) -> CaseResult:
         return CaseResult(task.key, one_line(exc).replace(": ", f"{where}: ", 1) if where else one_line(exc),
                           time.perf_counter() - start, worker)
     stats, histogram = statistics(out, diagonal, task.simulation["histogram_bins"])
-    return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram)
+    try:
+        result = analyse_run(life)
+    except Exception as exc:  # noqa: BLE001 - e.g. rainflow not installed: the case's other results stand
+        return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram,
+                          {"error": one_line(exc)})
+    stats.update(result.summary())
+    cycles = {"damage_map": result.damage_map, "swing": result.swing, "count": result.count,
+              "travel_ratio": result.travel_ratio, "peak_pressure": result.peak_pressure,
+              "track_travel_ratio": result.track_travel_ratio, "cycle_peak_pressure": result.cycle_peak_pressure,
+              "critical_angle": model_critical(sim)}
+    return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram, cycles)
+
+
+def model_critical(sim) -> np.ndarray:
+    """Critical angles of contacts 1..4 of the simulator's bearing, rad."""
+    from ..life.oscillation import critical_angle
+    from ..life.rating import TRACK_RINGS
+
+    b = sim.bearing
+    return np.array([float(critical_angle(b.ball_count, b.ball_diameter, b.pitch_diameter, b.contact_angle, r))
+                     for r in TRACK_RINGS])
 
 
 def time_weights(t: np.ndarray) -> np.ndarray:

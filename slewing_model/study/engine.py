@@ -16,6 +16,14 @@ Output directory::
     DIR/summary.csv                    one row per case (case, status, statistics, parameters)
     DIR/cases/<key>/case.json          the case: name, load series, bearing variant, settings
     DIR/cases/<key>/timeseries.csv     see slewing_model.study.case.TIMESERIES_COLUMNS (SI)
+    DIR/cases/<key>/timeseries.parquet the same columns as Parquet (when pyarrow is installed; pandas and
+                                       Dask read it natively: ``pandas.read_parquet(DIR + "/cases")``
+                                       reads each case's file)
+    DIR/cases/<key>/raceway_damage.csv slice centre angle (deg, in its ring's frame) and the damage of
+                                       contacts 1..4 in that slice (slewing_model.life.raceway_map)
+    DIR/cases/<key>/life_cycles.csv    rainflow cycles of psi: swing (rad), count, x/2b (smallest over the
+                                       loaded contacts), and per contact 1..4 x/2b, swing over its
+                                       critical angle and peak Hertz pressure (Pa)
     DIR/cases/<key>/ball_load_histogram.csv   ball, diagonal, load bin, time, rotation
     DIR/cases/<key>/result.json        status, statistics, wall time, worker (written last)
     DIR/figures/*.png                  see slewing_model.study.figures
@@ -118,14 +126,50 @@ def write_case(out_dir: str, case: Case, result: CaseResult) -> dict:
     if result.timeseries is not None:
         np.savetxt(os.path.join(folder, "timeseries.csv"), result.timeseries, delimiter=",", fmt="%.10g",
                    header=",".join(TIMESERIES_COLUMNS), comments="")
+        write_parquet(os.path.join(folder, "timeseries.parquet"), result.timeseries, TIMESERIES_COLUMNS)
+    life = result.life or {}
+    if "damage_map" in life:
+        write_life(folder, life)
     if result.histogram is not None:
         np.savetxt(os.path.join(folder, "ball_load_histogram.csv"), result.histogram, delimiter=",",
                    fmt=["%d", "%d", "%.6g", "%.6g", "%.10g", "%.10g"], header=",".join(HISTOGRAM_COLUMNS),
                    comments="")
     record = {"key": case.key, "name": case.name, "status": result.status, "elapsed_s": result.elapsed,
               "worker": result.worker, "statistics": result.statistics}
+    if "error" in life:
+        record["life_error"] = life["error"]
     _write_json(os.path.join(folder, "result.json"), record)
     return record
+
+
+def write_parquet(path: str, table: np.ndarray, columns) -> bool:
+    """Write ``table`` (n, len(columns)) as Parquet with pyarrow; False (nothing written) without it."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return False
+    pq.write_table(pa.table({c: np.ascontiguousarray(table[:, j]) for j, c in enumerate(columns)}), path)
+    return True
+
+
+def write_life(folder: str, life: dict) -> None:
+    """A case's raceway damage map and rainflow cycles (see the module docstring)."""
+    damage = np.asarray(life["damage_map"])
+    slices = damage.shape[1]
+    angle = (np.arange(slices) + 0.5) * 360.0 / slices
+    np.savetxt(os.path.join(folder, "raceway_damage.csv"), np.column_stack([angle, damage.T]), delimiter=",",
+               fmt="%.10g", header="angle_deg,contact1,contact2,contact3,contact4", comments="")
+    columns = [life["swing"], life["count"], life["travel_ratio"]]
+    header = ["swing_rad", "count", "travel_ratio"]
+    if "track_travel_ratio" in life:
+        swing = np.asarray(life["swing"])
+        for k in range(4):
+            columns += [np.asarray(life["track_travel_ratio"])[:, k], swing / life["critical_angle"][k],
+                        np.asarray(life["cycle_peak_pressure"])[:, k]]
+            header += [f"travel_ratio_{k + 1}", f"swing_over_critical_{k + 1}", f"peak_pressure_{k + 1}_Pa"]
+    np.savetxt(os.path.join(folder, "life_cycles.csv"), np.column_stack(columns), delimiter=",", fmt="%.10g",
+               header=",".join(header), comments="")
 
 
 def summary_row(case: Case, record: dict | None, status: str | None = None) -> dict:

@@ -8,6 +8,9 @@
   friction torque of each case against it, with the median and the 5-95 % band over
   the other axes of the product (error seeds, load series), per load series, bearing
   and ring model.
+* ``life.png`` -- the raceway damage map of each track, all cases together (each run once:
+  their slice damages add up), unrolled around the ring, and the histogram of ``x/2b`` over
+  all cases' rainflow cycles (``slewing_model.life``; ``docs/life.md``).
 * ``worst_case.png`` -- the time series of the case with the largest friction torque:
   ring angle and drive moment, friction torque, largest ball load.
 """
@@ -47,6 +50,10 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
         values = {r[key] for r in ok if r[key] != ""}
         if len(values) >= 3:
             written.append(band_against(os.path.join(folder, f"friction_torque_vs_{key}.png"), ok, key, label))
+    maps = [os.path.join(out_dir, "cases", r["case"]) for r in ok]
+    maps = [m for m in maps if os.path.exists(os.path.join(m, "raceway_damage.csv"))]
+    if maps:
+        written.append(life_figure(os.path.join(folder, "life.png"), maps))
     if ok:
         worst = max(ok, key=lambda r: _value(r, "friction_torque_max"))
         path = os.path.join(out_dir, "cases", worst["case"], "timeseries.csv")
@@ -176,6 +183,51 @@ def time_series(path: str, csv_path: str, name: str) -> str:
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(f"largest friction torque: {name}", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def life_figure(path: str, case_dirs: list[str], title: str | None = None) -> str:
+    """Raceway damage around each track (summed over the cases) and the histogram of x/2b."""
+    plt = _pyplot()
+    damage, ratios, counts = None, [], []
+    for folder in case_dirs:
+        d = np.loadtxt(os.path.join(folder, "raceway_damage.csv"), delimiter=",", skiprows=1, ndmin=2)
+        damage = d if damage is None else np.column_stack([d[:, 0], damage[:, 1:] + d[:, 1:]])
+        cycles = os.path.join(folder, "life_cycles.csv")
+        with open(cycles) as fh:
+            empty = len(fh.read().splitlines()) < 2          # a ring that never moved: no cycles
+        c = np.zeros((0, 3)) if empty else np.loadtxt(cycles, delimiter=",", skiprows=1, ndmin=2)
+        if c.size:
+            ratios.append(c[:, 2])
+            counts.append(c[:, 1])
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    labels = ("1 (outer ring)", "2 (inner ring)", "3 (inner ring)", "4 (outer ring)")
+    for k in range(4):
+        ax1.plot(damage[:, 0], damage[:, k + 1], lw=1.0, label=f"contact {labels[k]}")
+    ax1.set_xlabel("slice centre, angle around its own ring [deg]")
+    ax1.set_ylabel("slice damage d_j [-]")
+    ax1.set_xlim(0, 360)
+    ax1.set_title(f"raceway damage map, {len(case_dirs)} case(s) each run once")
+    ax1.legend(fontsize=8)
+    ax1.grid(alpha=0.3)
+    if ratios:
+        r, w = np.concatenate(ratios), np.concatenate(counts)
+        keep = np.isfinite(r) & (r > 0)
+        r, w = r[keep], w[keep]
+        edges = np.logspace(np.floor(np.log10(r.min())), np.ceil(np.log10(r.max())), 41)
+        ax2.hist(r, bins=edges, weights=w, color="tab:blue", alpha=0.8)
+        ax2.axvline(1.0, color="k", ls="--", lw=1)
+        below = w[r < 1].sum() / w.sum() if w.sum() else float("nan")
+        ax2.set_xscale("log")
+        ax2.set_title(f"x/2b of the rainflow cycles: {below:.0%} below 1 (patch never uncovered)")
+    ax2.set_xlabel("rolling travel over contact width, x/2b [-]")
+    ax2.set_ylabel("cycles")
+    ax2.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

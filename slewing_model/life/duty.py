@@ -1,0 +1,367 @@
+"""Life and wear of a run: the step-by-step accumulator (FMU, studies) and the run's analysis.
+
+:class:`LifeModel` holds what does not change during a run (the tracks' ``Qc``, critical
+angles, which ring turns relative to the load). :class:`LifeAccumulator` takes each step's
+load distribution: it adds the raceway map's passes (:mod:`.raceway_map`), detects completed
+half-cycles of the ring angle online (a reversal of ``ψ`` by more than a tolerance) and gives
+their ``x/2b``; with ``record=True`` it also keeps a few numbers per step and track for
+:func:`analyse_run`, which counts the run's cycles by rainflow and returns the ISO/TS 16281
+life with the oscillation rule, the raceway map's life, DG03's life, and the wear indicators.
+
+Which ring turns relative to the load (ISO/TS 16281's choice of the ``Qe`` exponent): loads
+given in the fixed ring's frame stand relative to the fixed ring, so the moving ring turns
+relative to them; loads in the moving ring's frame (blade-root loads of a pitch bearing)
+turn with it, so the fixed ring turns relative to them.
+
+Run-time module: numpy and the standard library (``rainflow`` in :func:`analyse_run`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .dg03 import DG03Life, dg03_life, equivalent_axial_load
+from .oscillation import critical_angle, equivalent_revolutions, rainflow_cycles, span_mean
+from .rating import TRACK_RINGS, LifeInputError, axial_rating, combined_damage, equivalent_load, \
+    four_point_capacities
+from .raceway_map import DEFAULT_SLICES, RacewayMap, passes_per_revolution, track_damage
+from .wear import rolling_travel, relubrication_gap
+
+#: default reversal tolerance of the online half-cycle detector and smallest rainflow swing, rad:
+#: above the 16-bit quantisation of recorded pitch angles (about 5e-6 rad over 18°)
+DEFAULT_REVERSAL_TOLERANCE = 1e-5
+
+
+@dataclass(frozen=True)
+class LifeSettings:
+    """What a user sets for a life calculation (SI units).
+
+    Attributes
+    ----------
+    rating : float or None, N
+        Basic dynamic axial rating ``Ca`` of the bearing (ISO 281, from the maker's catalogue);
+        None: from the raceway geometry (:func:`slewing_model.life.rating.axial_rating`).
+    slices : int
+        Slices of each track in the raceway map.
+    reversal_tolerance : float, rad
+        Smallest movement against the current direction that counts as a reversal of ``ψ``
+        (online half-cycles), and smallest rainflow swing kept.
+    relubrication_swing : float or None, rad
+        Movement that relubricates the raceway; None: the largest critical angle of the tracks
+        (a swing over which neighbouring balls' tracks overlap, so the balls spread the grease
+        over the whole raceway).
+    rating_factor : callable or None
+        ``f(theta, Z)`` raising the rating below the critical angle; None: DG03's
+        ``(180°/θ)^(3/10) Z^0.033``.
+    """
+
+    rating: float | None = None
+    slices: int = DEFAULT_SLICES
+    reversal_tolerance: float = DEFAULT_REVERSAL_TOLERANCE
+    relubrication_swing: float | None = None
+    rating_factor: object = None
+
+    def __post_init__(self):
+        if isinstance(self.slices, bool) or not isinstance(self.slices, (int, np.integer)) or self.slices < 4:
+            raise LifeInputError(f"slices = {self.slices!r}: must be a whole number >= 4")
+        if self.rating is not None and not (math.isfinite(self.rating) and self.rating > 0):
+            raise LifeInputError(f"rating = {self.rating!r}: must be finite and > 0 (N), or None")
+        if not (math.isfinite(self.reversal_tolerance) and self.reversal_tolerance > 0):
+            raise LifeInputError(f"reversal_tolerance = {self.reversal_tolerance!r}: must be finite and > 0 (rad)")
+        if self.relubrication_swing is not None and not (math.isfinite(self.relubrication_swing)
+                                                         and self.relubrication_swing > 0):
+            raise LifeInputError(f"relubrication_swing = {self.relubrication_swing!r}: must be finite and > 0 (rad)")
+
+
+class LifeModel:
+    """The run-independent part of a four-point bearing's life calculation.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    moving_ring : {"inner", "outer"}, optional
+        Default the bearing's.
+    load_frame : {"fixed", "rotating"}
+        Frame of the loads (see the module docstring).
+    settings : LifeSettings
+    """
+
+    def __init__(self, bearing, moving_ring: str | None = None, load_frame: str = "fixed",
+                 settings: LifeSettings | None = None):
+        if load_frame not in ("fixed", "rotating"):
+            raise LifeInputError(f"load_frame = {load_frame!r}: must be 'fixed' or 'rotating'")
+        self.bearing = bearing
+        self.settings = settings or LifeSettings()
+        self.moving_ring = moving_ring or bearing.moving_ring
+        self.capacity = four_point_capacities(bearing, self.settings.rating)          # Qc, (4,)
+        self.rating = axial_rating(bearing, self.capacity)                            # Ca
+        self.passes = passes_per_revolution(bearing.ball_count, bearing.ball_diameter, bearing.pitch_diameter,
+                                            bearing.contact_angle)
+        self.critical = np.array([float(critical_angle(bearing.ball_count, bearing.ball_diameter,
+                                                       bearing.pitch_diameter, bearing.contact_angle, r))
+                                  for r in TRACK_RINGS])
+        moving = np.array([r == self.moving_ring for r in TRACK_RINGS])
+        self.rotating = moving if load_frame == "fixed" else ~moving                 # turns relative to the load
+        self.relubrication_swing = self.settings.relubrication_swing or float(self.critical.max())
+
+    def track_equivalent_loads(self, contact_load) -> np.ndarray:
+        """ISO/TS 16281 ``Qe`` of the four tracks at one step from the ball loads (B, 4), N (4,)."""
+        q = np.asarray(contact_load, dtype=float)
+        return np.array([float(equivalent_load(q[:, k], bool(self.rotating[k]))) for k in range(4)])
+
+
+#: the per-step numbers :class:`LifeAccumulator` records (``record=True``), per track where (4,)
+RECORD_FIELDS = ("time", "psi", "qe", "b_max", "angle_at_b_max", "p_max", "pea")
+
+
+@dataclass
+class HalfCycles:
+    """State of the online half-cycle detector of ``ψ``."""
+
+    direction: float = 0.0          # +1, -1, 0 before the first movement
+    turn: float = math.nan          # ψ at the last reversal
+    extreme: float = math.nan       # furthest ψ since then
+    b_max: np.ndarray = field(default_factory=lambda: np.zeros(4))      # largest b per track since, m
+    angle: np.ndarray = field(default_factory=lambda: np.zeros(4))      # contact angle at it, rad
+    last_ratio: float = math.nan    # x/2b of the last completed half-cycle
+    last_swing: float = 0.0         # its swing, rad
+    completed: int = 0
+
+
+class LifeAccumulator:
+    """Step-by-step life and wear of one bearing (what the FMU carries; plain numpy state).
+
+    Parameters
+    ----------
+    model : LifeModel
+    record : bool
+        Keep the per-step numbers :func:`analyse_run` needs (:data:`RECORD_FIELDS`).
+
+    Examples
+    --------
+    >>> acc = LifeAccumulator(LifeModel(bearing))                       # doctest: +SKIP
+    >>> for t, psi, loads in series: acc.step(t, psi, sim.step(...).distribution, loads)  # doctest: +SKIP
+    >>> acc.worst_damage, acc.last_ratio                                # doctest: +SKIP
+    """
+
+    def __init__(self, model: LifeModel, record: bool = False):
+        self.model = model
+        self.map = RacewayMap(model.capacity, model.passes, model.moving_ring, model.settings.slices)
+        self.half = HalfCycles()
+        self.record = record
+        self.rows: list = []
+
+    # ---- one step ------------------------------------------------------------------------
+    def step(self, time: float, psi: float, distribution, loads=None) -> None:
+        """Add a step: its time (s), ring angle ``psi`` (rad), load distribution and (for DG03,
+        ``record`` only) loads ``(Fx, Fy, Fz, Mx, My)`` (N, N m)."""
+        d = distribution
+        self.map.update(d.ball_angle, psi, d.contact_load)
+        b = d.semi_axis_b
+        j = np.argmax(b, axis=0)                                   # the widest patch of each track
+        cols = np.arange(4)
+        self._half_cycle(psi, b[j, cols], d.contact_angle[j, cols])
+        if self.record:
+            pea = float(equivalent_axial_load(np.asarray(loads, float)[:5], self.model.bearing.pitch_diameter)[0]) \
+                if loads is not None else math.nan
+            self.rows.append((time, psi, self.model.track_equivalent_loads(d.contact_load), b[j, cols],
+                              d.contact_angle[j, cols], d.contact_pressure.max(axis=0), pea))
+
+    def _half_cycle(self, psi, b, angle) -> None:
+        h, tol = self.half, self.model.settings.reversal_tolerance
+        if h.direction == 0.0:
+            if math.isnan(h.turn):
+                h.turn = h.extreme = psi
+                h.b_max, h.angle = b.copy(), angle.copy()
+                return
+            if abs(psi - h.turn) > tol:
+                h.direction = math.copysign(1.0, psi - h.turn)
+                h.extreme = psi
+            self._widest(b, angle)
+            return
+        if (psi - h.extreme) * h.direction >= 0.0:                  # still going the same way
+            h.extreme = psi
+            self._widest(b, angle)
+            return
+        if (h.extreme - psi) * h.direction <= tol:                  # a small step back: not yet a reversal
+            self._widest(b, angle)
+            return
+        swing = abs(h.extreme - h.turn)                             # a half-cycle completed at the extreme
+        loaded = h.b_max > 0.0
+        if np.any(loaded):
+            x = rolling_travel(swing, self.model.bearing.pitch_diameter, self.model.bearing.ball_diameter,
+                               h.angle[loaded])
+            h.last_ratio = float(np.min(x / (2.0 * h.b_max[loaded])))
+        h.last_swing, h.completed = swing, h.completed + 1
+        h.turn, h.extreme, h.direction = h.extreme, psi, -h.direction
+        h.b_max, h.angle = b.copy(), angle.copy()
+
+    def _widest(self, b, angle) -> None:
+        h = self.half
+        wider = b > h.b_max
+        h.b_max = np.where(wider, b, h.b_max)
+        h.angle = np.where(wider, angle, h.angle)
+
+    # ---- outputs -------------------------------------------------------------------------
+    @property
+    def track_damage(self) -> np.ndarray:
+        """Raceway-map damage of contacts 1..4 so far (weakest link over the slices), (4,)."""
+        return self.map.track_damage()
+
+    @property
+    def worst_damage(self) -> float:
+        """Damage of the worst track so far (1: its L10 is used up)."""
+        return float(self.track_damage.max())
+
+    @property
+    def last_ratio(self) -> float:
+        """``x/2b`` of the last completed half-cycle (NaN before the first)."""
+        return self.half.last_ratio
+
+    # ---- state ---------------------------------------------------------------------------
+    def get_state(self) -> dict:
+        h = self.half
+        return {"map": self.map.get_state(),
+                "half": {"direction": h.direction, "turn": h.turn, "extreme": h.extreme, "b_max": h.b_max,
+                         "angle": h.angle, "last_ratio": h.last_ratio, "last_swing": h.last_swing,
+                         "completed": h.completed},
+                "rows": len(self.rows)}
+
+    def set_state(self, state: dict) -> None:
+        self.map.set_state(state["map"])
+        s = state["half"]
+        self.half = HalfCycles(float(s["direction"]), float(s["turn"]), float(s["extreme"]),
+                               np.array(s["b_max"], dtype=float), np.array(s["angle"], dtype=float),
+                               float(s["last_ratio"]), float(s["last_swing"]), int(s["completed"]))
+        del self.rows[int(state.get("rows", len(self.rows))):]
+
+    def records(self) -> dict:
+        """The recorded steps as arrays (:data:`RECORD_FIELDS`)."""
+        if not self.rows:
+            raise LifeInputError("records: no steps were recorded (record=True and at least one step)")
+        cols = list(zip(*self.rows))
+        return {name: np.array(c, dtype=float) for name, c in zip(RECORD_FIELDS, cols)}
+
+
+@dataclass(frozen=True)
+class LifeResult:
+    """Life and wear of one run (SI units; hours of the run's duty repeated).
+
+    Attributes
+    ----------
+    duration : float, s
+    track_damage : ndarray (4,)
+        ISO/TS 16281 loads with the oscillation rule: damage of contacts 1..4 over the run.
+    damage : float
+        The bearing's (tracks combined by the weakest link).
+    life_hours : float, h
+        ``duration / damage``.
+    worst_track : int
+        Contact 1..4 with the largest damage (0: no damage, the ring never moved).
+    map_track_damage : ndarray (4,), map_damage : float, map_life_hours : float
+        The same from the raceway map.
+    damage_map : ndarray (4, slices)
+    dg03 : DG03Life
+    swing, count : ndarray
+        Rainflow cycles (rad; 1 or 0.5).
+    below_critical : float
+        Share of cycles (by count) whose swing is below the inner raceway's critical angle.
+    travel_ratio : ndarray
+        ``x/2b`` of each cycle (the smallest over the loaded tracks).
+    track_travel_ratio : ndarray (cycles, 4)
+        ``x/2b`` of each cycle and contact 1..4 (the contact's widest patch in the cycle; inf: unloaded).
+    cycle_peak_pressure : ndarray (cycles, 4), Pa
+        Largest Hertz pressure of each contact in each cycle.
+    share_below_one : float
+        Share of cycles (by count) with ``x/2b < 1``.
+    peak_pressure : ndarray (4,), Pa
+        Largest Hertz pressure of each track over the run.
+    relubrication_gap : float, s
+        Longest time without a movement of ``relubrication_swing``.
+    relubrication_swing : float, rad
+    """
+
+    duration: float
+    track_damage: np.ndarray
+    damage: float
+    life_hours: float
+    worst_track: int
+    map_track_damage: np.ndarray
+    map_damage: float
+    map_life_hours: float
+    damage_map: np.ndarray
+    dg03: DG03Life
+    swing: np.ndarray
+    count: np.ndarray
+    below_critical: float
+    travel_ratio: np.ndarray
+    share_below_one: float
+    track_travel_ratio: np.ndarray
+    cycle_peak_pressure: np.ndarray
+    peak_pressure: np.ndarray
+    relubrication_gap: float
+    relubrication_swing: float
+
+    def summary(self) -> dict:
+        """The numbers of a study's summary row."""
+        return {
+            "life_L10_h": self.life_hours, "life_worst_track": self.worst_track,
+            "life_damage_per_h": self.damage / self.duration * 3600.0 if self.duration > 0 else math.nan,
+            "life_map_L10_h": self.map_life_hours, "life_dg03_L10_h": self.dg03.hours,
+            "life_dg03_ratio": self.dg03.hours / self.life_hours if self.life_hours > 0 else math.nan,
+            "life_cycles": float(self.count.sum()), "life_share_x2b_below_1": self.share_below_one,
+            "life_share_below_critical": self.below_critical, "life_relubrication_gap_s": self.relubrication_gap,
+        }
+
+
+def _hours(duration, damage):
+    return duration / damage / 3600.0 if damage > 0 else math.inf
+
+
+def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
+    """Life and wear of a recorded run (``LifeAccumulator(record=True)`` stepped through it)."""
+    m, r = accumulator.model, accumulator.records()
+    t, psi = r["time"], r["psi"]
+    duration = float(t[-1] - t[0])
+    tol = m.settings.reversal_tolerance
+    cyc = rainflow_cycles(psi, min_swing=tol)
+    w = np.abs(np.diff(psi, prepend=psi[0]))                       # the ring's rotation at each sample
+    qe = span_mean(r["qe"], w, cyc.start, cyc.end)                 # (cycles, 4), N
+    rev = equivalent_revolutions(cyc.swing[:, None], m.critical[None, :], m.bearing.ball_count,
+                                 m.settings.rating_factor)        # (cycles, 4)
+    track = np.sum(cyc.count[:, None] * rev * (qe / m.capacity) ** 3, axis=0) / 1e6
+    damage = float(combined_damage(track))
+    map_track = accumulator.track_damage
+    map_damage = float(combined_damage(map_track))
+
+    b, ang, pmax = r["b_max"], r["angle_at_b_max"], r["p_max"]
+    track_ratio = np.full((cyc.swing.size, 4), np.inf)            # x/2b per cycle and track (inf: unloaded)
+    cycle_pressure = np.zeros((cyc.swing.size, 4))
+    cols = np.arange(4)
+    for i, (s, e) in enumerate(zip(cyc.start, cyc.end)):
+        bb = b[s:e + 1]
+        k = np.argmax(bb, axis=0)                                  # the widest patch of each track in the cycle
+        bmax, a = bb[k, cols], ang[s:e + 1][k, cols]
+        loaded = bmax > 0
+        x = rolling_travel(cyc.swing[i], m.bearing.pitch_diameter, m.bearing.ball_diameter, a[loaded])
+        track_ratio[i, loaded] = x / (2 * bmax[loaded])
+        cycle_pressure[i] = pmax[s:e + 1].max(axis=0)
+    ratio = track_ratio.min(axis=1) if cyc.swing.size else np.zeros(0)
+    total = float(cyc.count.sum())
+    share = float(cyc.count[ratio < 1.0].sum() / total) if total else math.nan
+    below = float(cyc.count[cyc.swing < m.critical.min()].sum() / total) if total else math.nan
+
+    pea = span_mean(r["pea"], w, cyc.start, cyc.end) if np.all(np.isfinite(r["pea"])) else np.full(cyc.swing.size,
+                                                                                                      math.nan)
+    dg = dg03_life(pea, cyc.swing, cyc.count, m.rating, m.bearing.ball_count, float(m.critical.max()), duration)
+    return LifeResult(
+        duration=duration, track_damage=track, damage=damage, life_hours=_hours(duration, damage),
+        worst_track=int(np.argmax(track)) + 1 if damage > 0 else 0, map_track_damage=map_track, map_damage=map_damage,
+        map_life_hours=_hours(duration, map_damage), damage_map=accumulator.map.damage_map.copy(), dg03=dg,
+        swing=cyc.swing, count=cyc.count, below_critical=below, travel_ratio=ratio, share_below_one=share,
+        track_travel_ratio=track_ratio, cycle_peak_pressure=cycle_pressure,
+        peak_pressure=r["p_max"].max(axis=0),
+        relubrication_gap=relubrication_gap(t, psi, m.relubrication_swing),
+        relubrication_swing=m.relubrication_swing)

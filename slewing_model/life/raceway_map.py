@@ -1,0 +1,140 @@
+"""Raceway damage map: each track cut into slices around its ring, each slice damaged by the
+balls that roll over it, with their loads.
+
+Derivation (the weakest-link combination used)
+    Lundberg–Palmgren give the survival of a stressed volume as
+    ``ln(1/S) ∝ N^e V`` (Weibull slope ``e = 10/9`` of ball bearings) and, at one point of a
+    raceway under loads that change from pass to pass, Miner's rule with the load-life
+    exponent 3: a pass under load ``Q`` uses ``(Q/Qc)^3`` of what the raceway's rating
+    promises. So slice ``j`` of a track (a share ``1/N`` of its circumference) carries the
+    damage
+
+        ``d_j = Σ_passes (Q_p / Qc)^3 / (m 10^6)``,
+
+    where ``m = Z (1 ± γ)/2`` is the number of passes a point of the raceway receives per
+    revolution of the rings relative to each other (upper sign inner ring): ``Qc`` is defined
+    per revolution (ISO/TS 16281), so ``d_j = 1`` is one rating life of a point that is passed
+    as in rotation. The slices are independent Weibull volumes,
+    ``ln(1/S) = ln(1/0.9) Σ_j (1/N) d_j^e``, so the track's damage (``S = 0.9`` at ``D_k = 1``) is
+
+        ``D_k = [ (1/N) Σ_j d_j^(10/9) ]^(9/10)``
+
+    and the bearing's, with the tracks again independent volumes, ``D = [Σ_k D_k^(10/9)]^(9/10)``
+    (ISO/TS 16281's combination of raceways). Checks: in full rotation under equal loads every
+    slice has ``d = n (Q/Qc)^3 / 10^6`` after ``n`` revolutions, so ``D_k = n / (Qc/Q)^3`` (the ISO
+    life); under a load pattern fixed to the other ring, a slice of the ring that turns meets all
+    the loads (``(Σ Q^3/Z)`` — ISO's rotating ``Qe``) and a slice of the ring that stands meets the
+    load at its place again and again, and the weakest-link sum gives ``(Σ Q^(10/3)/Z)^(3/10)`` —
+    ISO's standing ``Qe``. In small oscillations slices that no ball crosses get no rolling damage
+    (Menck, Stammler and Schleich, Wind Energ. Sci. 5, 2020, map the damage around the raceway in
+    the same spirit; Houpert and Menck 2022).
+
+    A ball passes a slice when its contact crosses the slice's centre; between two steps the
+    ball moves from its old to its new place on each ring (fixed ring: the ball angle ``φ_b``;
+    moving ring: ``φ_b - ψ``), and the pass carries the mean of ``Q^3`` of the two steps.
+
+Run-time module: numpy only (a step costs a few array operations over the balls).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .rating import TRACK_RINGS, WEIBULL_SLOPE, LifeInputError, gamma
+
+#: default number of slices of a track around its circumference
+DEFAULT_SLICES = 720
+
+
+def passes_per_revolution(ball_count, ball_diameter, pitch_diameter, contact_angle):
+    """``m = Z (1 ± γ)/2`` of the four tracks (contacts 1..4; + for the inner ring's 2 and 3), (4,)."""
+    g = gamma(ball_diameter, pitch_diameter, contact_angle)
+    sign = np.array([1.0 if r == "inner" else -1.0 for r in TRACK_RINGS])
+    return ball_count * (1.0 + sign * g) / 2.0
+
+
+def crossed_slices(start, end, slices):
+    """Slice indices (mod ``slices``) whose centres lie between ``start`` and ``end`` (angles, rad,
+    (B,), unwrapped) -- half-open, so back and forth over a centre counts twice -- and for each the
+    ball it belongs to. Returns ``(ball, slice)`` int arrays."""
+    u0 = np.asarray(start) * (slices / (2 * math.pi)) - 0.5
+    u1 = np.asarray(end) * (slices / (2 * math.pi)) - 0.5
+    a = np.floor(np.minimum(u0, u1)).astype(np.int64)
+    n = np.floor(np.maximum(u0, u1)).astype(np.int64) - a
+    total = int(n.sum())
+    if total == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    ball = np.repeat(np.arange(n.size), n)
+    offset = np.arange(total) - np.repeat(np.cumsum(n) - n, n)
+    return ball, (a[ball] + 1 + offset) % slices
+
+
+class RacewayMap:
+    """Damage map of the four tracks, accumulated step by step.
+
+    Parameters
+    ----------
+    capacities : ndarray (4,), N
+        ``Qc`` of contacts 1..4 (:func:`slewing_model.life.rating.four_point_capacities`).
+    passes : ndarray (4,)
+        ``m`` of the tracks (:func:`passes_per_revolution`).
+    moving_ring : {"inner", "outer"}
+    slices : int
+    """
+
+    def __init__(self, capacities, passes, moving_ring: str, slices: int = DEFAULT_SLICES):
+        if isinstance(slices, bool) or not isinstance(slices, (int, np.integer)) or slices < 4:
+            raise LifeInputError(f"slices = {slices!r}: must be a whole number >= 4")
+        if moving_ring not in ("inner", "outer"):
+            raise LifeInputError(f"moving_ring = {moving_ring!r}: must be 'inner' or 'outer'")
+        self.scale = 1.0 / (np.asarray(capacities, float) ** 3 * np.asarray(passes, float) * 1e6)
+        self.slices = int(slices)
+        self.moving = np.array([r == moving_ring for r in TRACK_RINGS])
+        self.reset()
+
+    def reset(self) -> None:
+        self.damage_map = np.zeros((4, self.slices))    # d_j of every slice of contacts 1..4
+        self._angle = None                              # ball angles of the last step (B,), rad
+        self._psi = 0.0
+        self._q3 = None                                 # Q^3 of the last step (B, 4)
+
+    def update(self, ball_angle, psi: float, contact_load) -> None:
+        """Add the passes from the last step to this one (the first call only records)."""
+        q3 = np.maximum(contact_load, 0.0) ** 3
+        if self._angle is not None:
+            mean = 0.5 * (q3 + self._q3) * self.scale
+            added = None
+            for ring_moving in (False, True):
+                shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)
+                ball, where = crossed_slices(self._angle - shift_old, ball_angle - shift_new, self.slices)
+                if ball.size:
+                    for k in np.nonzero(self.moving == ring_moving)[0]:
+                        if added is None:
+                            added = np.zeros_like(self.damage_map)
+                        added[k] = np.bincount(where, mean[ball, k], minlength=self.slices)
+            if added is not None:
+                self.damage_map = self.damage_map + added     # a new array: states keep theirs unchanged
+        self._angle = np.array(ball_angle, dtype=float)
+        self._psi = float(psi)
+        self._q3 = q3
+
+    def track_damage(self) -> np.ndarray:
+        """``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)`` of contacts 1..4, (4,)."""
+        return track_damage(self.damage_map)
+
+    def get_state(self) -> dict:
+        """The map's state (arrays not copied: :meth:`update` never changes them in place)."""
+        return {"map": self.damage_map, "angle": self._angle, "psi": self._psi, "q3": self._q3}
+
+    def set_state(self, state: dict) -> None:
+        self.damage_map = np.array(state["map"], dtype=float).reshape(4, self.slices)
+        self._angle = None if state["angle"] is None else np.array(state["angle"], dtype=float)
+        self._psi = float(state["psi"])
+        self._q3 = None if state["q3"] is None else np.array(state["q3"], dtype=float)
+
+
+def track_damage(damage_map) -> np.ndarray:
+    """Weakest-link damage of each track from its slices' damages (see the module docstring)."""
+    d = np.asarray(damage_map, dtype=float)
+    return np.mean(d ** WEIBULL_SLOPE, axis=-1) ** (1.0 / WEIBULL_SLOPE)

@@ -1,0 +1,89 @@
+"""Wear and false-brinelling indicators: the rolling travel of a contact against its Hertz patch.
+
+* Rolling travel (kinematics of rolling without slip): for a full swing ``Δψ`` of one ring
+  relative to the other, the contact point moves over either raceway by
+  ``x = Δψ (dm/4)(1 - γ_j^2)``, ``γ_j = Dw cos α_j / dm`` of the contact's own angle. The
+  same on both rings and whichever ring moves (``DESIGN.md``; Houpert and Menck 2022).
+  Derivation: the raceway radii at the contact are ``(dm/2)(1 ∓ γ)``; the cage turns
+  ``(1 - γ)/2 Δψ`` when the inner ring turns ``Δψ`` against a standing outer ring, so the
+  contact moves ``(dm/2)(1 - γ)(1 + γ)/2 Δψ`` on the inner raceway (relative angle
+  ``(1 + γ)/2 Δψ``) and ``(dm/2)(1 + γ)(1 - γ)/2 Δψ`` on the outer one.
+* ``2b``: the contact ellipse's width in the rolling direction (short axis in a conforming
+  groove). ``x/2b < 1``: part of the patch is never uncovered (false brinelling, standstill
+  marks); above 1, wear from grease starvation is the risk. Tests on full-size pitch
+  bearings find wear under steady small oscillations, prevented by occasional larger
+  movements (Behnke and Schleich 2023; Bartschat et al. 2023): hence the longest time
+  without a relubricating movement.
+
+Run-time module: numpy and the standard library.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .rating import gamma
+
+#: default swing that counts as relubricating: the ring turns far enough that every contact
+#: rolls off its own patch several times, x/2b >= 1 -- expressed as a ring angle, see
+#: :func:`relubrication_gap`
+RELUBRICATION_TRAVEL_RATIO = 1.0
+
+
+def rolling_travel(swing, pitch_diameter, ball_diameter, contact_angle):
+    """Travel ``x = Δψ (dm/4)(1 - γ²)`` of a contact over its raceway for a full swing ``swing`` (rad)
+    of the ring, m. Arrays broadcast.
+
+    Examples
+    --------
+    >>> round(float(rolling_travel(math.radians(1.0), 1.0, 0.05, 0.0)) * 1e3, 4)   # dm 1000 mm, γ = 0.05
+    4.3524
+    """
+    g = gamma(ball_diameter, pitch_diameter, contact_angle)
+    return np.abs(swing) * pitch_diameter / 4.0 * (1.0 - g * g)
+
+
+def travel_by_ring_kinematics(swing, pitch_diameter, ball_diameter, contact_angle, moving_ring):
+    """The same travel from the raceway radii and the cage's turn, whichever ring ``moving_ring``
+    turns ``swing`` (rad) against the other: ``(inner, outer)`` travel, m (they are equal; see the
+    module docstring). Used by the tests to check :func:`rolling_travel` from first principles."""
+    g = gamma(ball_diameter, pitch_diameter, contact_angle)
+    r_in, r_out = pitch_diameter / 2 * (1 - g), pitch_diameter / 2 * (1 + g)
+    if moving_ring == "inner":
+        cage = (1 - g) / 2 * swing                # Harris: cage speed of an inner ring turning
+        inner_rel, outer_rel = swing - cage, cage - 0.0
+    else:
+        cage = (1 + g) / 2 * swing
+        inner_rel, outer_rel = 0.0 - cage, swing - cage
+    # the contact point travels the raceway radius times the ball's angle relative to the ring
+    return abs(r_in * inner_rel), abs(r_out * outer_rel)
+
+
+def relubrication_gap(time, psi, threshold):
+    """Longest time (s) between movements of at least ``threshold`` (rad) of the ring angle: a
+    movement is counted whenever ``psi`` has left the last reference by ``threshold``, and the
+    reference then moves to it (a dead-band tracker, so drift in small steps counts too)."""
+    t = np.asarray(time, dtype=float)
+    p = np.asarray(psi, dtype=float)
+    if t.size == 0:
+        return 0.0
+    ref, last, gap = p[0], t[0], 0.0
+    moved = []
+    for k in range(1, p.size):          # O(n), a plain loop: post-processing only
+        if abs(p[k] - ref) >= threshold:
+            moved.append(t[k])
+            ref = p[k]
+    last = t[0]
+    for tm in moved:
+        gap = max(gap, tm - last)
+        last = tm
+    return float(max(gap, t[-1] - last))
+
+
+def relubrication_swing(pitch_diameter, ball_diameter, contact_angle, semi_axis_b,
+                        ratio: float = RELUBRICATION_TRAVEL_RATIO):
+    """Ring swing (rad) that rolls a contact of semi-axis ``semi_axis_b`` (m) ``ratio`` times its
+    patch width, ``ratio 2b / ((dm/4)(1 - γ²))``: the default relubrication threshold."""
+    g = gamma(ball_diameter, pitch_diameter, contact_angle)
+    return ratio * 2.0 * semi_axis_b / (pitch_diameter / 4.0 * (1.0 - g * g))
