@@ -80,10 +80,11 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         tmp = Path(tmp)
         package = tmp / "slewing_model"
         package.mkdir()
-        for name in RUNTIME_MODULES:
+        for name in RUNTIME_MODULES:                  # "life/duty": the subpackage's folder kept
             source = ROOT / "slewing_model" / f"{name}.py"
             if source.exists():
-                shutil.copy2(source, package / source.name)
+                (package / name).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(source, package / f"{name}.py")
         (tmp / "bearing.json").write_text(json.dumps(bearing.to_dict()))
         superelement.save(tmp / "superelement.npz")
         (tmp / KERNELS_FILE).write_text("auto\n" if numba else "numpy\n")

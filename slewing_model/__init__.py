@@ -23,9 +23,10 @@ RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "contact_kernel"
                    "ring_stiffness", "ring_compliance", "reduced_operator", "bime", "blas", "ellipse_quadrature",
                    "contact_friction", "ball_kinematics", "friction_kernel", "catalogue", "friction_studies",
                    "friction", "simulator",
-                   # the life subpackage's run-time modules: build_fmu copies each file flat into the FMU's
-                   # slewing_model (they import only their siblings, relatively, so they work there too)
-                   "life/rating", "life/oscillation", "life/raceway_map", "life/wear", "life/dg03", "life/duty")
+                   # the life subpackage's run-time modules (build_fmu copies them into the FMU's
+                   # slewing_model/life; rainflow is imported only by the post-processing)
+                   "life/__init__", "life/rating", "life/oscillation", "life/raceway_map", "life/wear", "life/dg03",
+                   "life/duty")
 
 __all__ = [
     "Bearing", "BearingDefinitionError", "RingSection", "load_bearing", "bearing_from_dict",

@@ -187,10 +187,7 @@ class BearingSimulator:
         self.last: StepResult | None = None
         self.life = None
         if s.life:
-            try:
-                from .life import LifeAccumulator, LifeModel
-            except ImportError:        # in an FMU the life modules sit flat beside this one (RUNTIME_MODULES)
-                from .duty import LifeAccumulator, LifeModel
+            from .life import LifeAccumulator, LifeModel
 
             self.life = LifeAccumulator(LifeModel(bearing, s.moving_ring, s.load_frame))
 
