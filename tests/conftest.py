@@ -53,6 +53,17 @@ def table3_fmu3(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def table3_numba_fmu(tmp_path_factory):
+    """table3_fmu's bearing as build_fmu.py builds it by default where numba is installed: standalone,
+    with numba and its compiled loops (for this CPU and a generic x86-64)."""
+    from slewing_model import friction_kernel
+
+    if not friction_kernel.AVAILABLE:
+        pytest.skip("numba is not installed here")
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3_numba.fmu")
+
+
+@pytest.fixture(scope="session")
 def table3_host_fmu(tmp_path_factory):
     """The light "tool coupling" FMU of table3_fmu's bearing (``--runtime host``): it runs in this
     machine's Python, or one named by SLEWING_FMU_PYTHONHOME."""

@@ -262,7 +262,8 @@ print(json.dumps({"available": AVAILABLE, "torque": friction_torque(b, d).magnit
 
 
 @needs_numba
-def test_fmu_ships_its_compiled_loops(table3_fmu):
+def test_fmu_ships_its_compiled_loops(table3_numba_fmu):
+    table3_fmu = table3_numba_fmu
     # unpacked to a new folder, an instance loads the loops from the cache the FMU carries
     # (numba keys it by the source's content): no compilation at instantiation
     out = subprocess.run([sys.executable, "-c", f"""
@@ -287,7 +288,8 @@ fmu.freeInstance()
     assert not any(result["misses"]) and all(h >= 1 for h in result["hits"]), result
 
 
-def test_fmu_without_numba_gives_the_same_outputs(table3_fmu):
+def test_fmu_without_numba_gives_the_same_outputs(table3_numba_fmu):
+    table3_fmu = table3_numba_fmu  # its compiled loops here, its numpy fallback where numba is missing
     from fmpy import simulate_fmu
 
     names = ["z", "rx", "friction_torque", "max_ball_load"]

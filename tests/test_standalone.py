@@ -273,16 +273,9 @@ def test_the_stated_floor_is_the_newest_glibc_any_binary_of_the_fmu_needs(versio
 
 
 @pytest.fixture(scope="module")
-def numba_fmu(tmp_path_factory):
+def numba_fmu(table3_numba_fmu):
     """The default build where numba is installed: standalone, with numba and the compiled loops' cache."""
-    sys.path.insert(0, str(ROOT))
-    from build_fmu import build_fmu
-    from slewing_model import friction_kernel
-
-    if not friction_kernel.AVAILABLE:
-        pytest.skip("numba is not installed here")
-    return build_fmu(ROOT / "examples" / "bearings" / "table3_errors.toml",
-                     tmp_path_factory.mktemp("numba") / "SlewingBearing_numba.fmu", mesh="coarse", bc="free")
+    return table3_numba_fmu
 
 
 def _cache_files(system, inside):
