@@ -30,9 +30,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .geometry import RING_CONTACTS, BearingDefinitionError
+from .geometry import BEARING_TABLES, RING_CONTACTS, BearingDefinitionError, check_known_keys
 
 _UM = 1e-6
+#: the keys of ``[errors.synthetic]``
+SYNTHETIC_KEYS = ("seed", "waviness_orders", "radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um")
 _MM = 1e-3
 
 
@@ -305,16 +307,12 @@ def synthetic_errors(
 
 def errors_from_table(table: Mapping[str, Any], base_dir: str | os.PathLike, ball_count: int) -> ManufacturingErrors:
     """The ``[errors]`` table of a definition file: CSV files, or ``[errors.synthetic]``."""
-    known = {"outer_ring_csv", "inner_ring_csv", "ball_diameters_csv", "synthetic"}
-    for key in table:
-        if key not in known:
-            raise BearingDefinitionError(f"errors.{key} = {table[key]!r}: unknown key (known: {', '.join(sorted(known))})")
+    check_known_keys(table, "errors", BEARING_TABLES["errors"])
     if "synthetic" in table:
+        if not isinstance(table["synthetic"], Mapping):
+            raise BearingDefinitionError(f"errors.synthetic = {table['synthetic']!r}: must be a table [errors.synthetic]")
         s = dict(table["synthetic"])
-        allowed = {"seed", "waviness_orders", "radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um"}
-        for key in s:
-            if key not in allowed:
-                raise BearingDefinitionError(f"errors.synthetic.{key} = {s[key]!r}: unknown key (known: {', '.join(sorted(allowed))})")
+        check_known_keys(s, "errors.synthetic", SYNTHETIC_KEYS)
         for key in ("radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um"):
             values = np.atleast_1d(np.asarray(s.get(key, 0.0), dtype=float))
             if not np.all(np.isfinite(values)) or np.any(values < 0):
