@@ -66,18 +66,25 @@ def _run_solve(args) -> int:
     options = {} if args.mu is None else {"mu": args.mu}
     friction = friction_torque(bearing, result, omega=1.0, seal_torque=args.seal_torque, **options)
     catalogue = catalogue_torque(bearing, loads)
+    for warning in result.warnings():      # a valid answer the user must not take at face value
+        print(f"slewing solve: warning: {warning}", file=sys.stderr)
     if args.json:
         data = result.to_dict()
         data["friction_torque"] = friction.magnitude              # N m, for a positive omega
         data["friction_torque_catalogue"] = catalogue              # N m, maker's start-up formula
+        data["warnings"] = result.warnings()
+        if not math.isfinite(data["static_safety_factor"]):      # unloaded: JSON has no infinity
+            data["static_safety_factor"] = None
         print(json.dumps(data))
         return 0
     print(f"{bearing.name}: {args.model} rings, {bearing.ball_count} balls, {result.iterations} Newton iterations")
     d = result.displacement
     print(f"displacement  x {d[0] * 1e6:9.3f} um  y {d[1] * 1e6:9.3f} um  z {d[2] * 1e6:9.3f} um  "
           f"rx {d[3] * 1e6:9.3f} urad  ry {d[4] * 1e6:9.3f} urad")
+    safety = result.static_safety_factor
     print(f"max ball load {result.max_ball_load / 1e3:.3f} kN, max contact pressure "
-          f"{result.max_contact_pressure / 1e6:.0f} MPa, static safety factor {result.static_safety_factor:.3g}, "
+          f"{result.max_contact_pressure / 1e6:.0f} MPa, static safety factor "
+          f"{'- (unloaded)' if math.isinf(safety) else f'{safety:.3g}'}, "
           f"{result.balls_in_four_point_contact} balls in four-point contact")
     print(f"friction torque {friction.magnitude:.4g} N m (analytical, full sliding), catalogue formula "
           f"{catalogue:.4g} N m")
