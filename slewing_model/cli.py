@@ -233,6 +233,9 @@ def main(argv=None) -> int:
         code = int(args.func(args) or 0)
         sys.stdout.flush()
         return code
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback; the status of a command ended by SIGINT
+        print(f"\nslewing {args.command}: interrupted", file=sys.stderr)
+        return 130
     except BrokenPipeError:
         if not _stdout_is_broken():
             raise

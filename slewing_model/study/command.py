@@ -18,10 +18,17 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    from .engine import run_study
+    from .engine import StudyInterrupted, run_study
 
-    report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
-                       progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures)
+    try:
+        report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
+                           progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures)
+    except StudyInterrupted as stop:   # Ctrl-C: one line, the status of a command ended by SIGINT
+        r = stop.report
+        finished = sum(1 for row in r.rows if not row["status"].startswith("not finished"))
+        print(f"\nslewing batch: interrupted; {finished} of {r.cases} cases finished, summary: {r.summary} "
+              f"(the same command resumes)", file=sys.stderr)
+        return 130
     ok = report.cases - len(report.failed)
     print(f"{report.cases} cases: {ok} ok, {len(report.failed)} failed; {len(report.ran)} run now "
           f"({report.wall_time:.1f} s{', ' + report.cluster if report.cluster else ''}), "

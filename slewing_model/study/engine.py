@@ -47,6 +47,20 @@ SUMMARY_COLUMNS = REQUIRED_COLUMNS + tuple(s for s in STATISTICS if s not in REQ
     "elapsed_s", "worker")
 
 
+class StudyInterrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) during :func:`run_study`, after ``summary.csv`` was written for the cases
+    finished so far (the others: status ``not finished: interrupted``; a rerun resumes them).
+
+    Attributes
+    ----------
+    report : StudyReport
+    """
+
+    def __init__(self, report: "StudyReport"):
+        super().__init__("interrupted")
+        self.report = report
+
+
 @dataclass
 class StudyReport:
     """What :func:`run_study` did.
@@ -268,6 +282,11 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     Returns
     -------
     StudyReport
+
+    Raises
+    ------
+    StudyInterrupted
+        On Ctrl-C (SIGINT), after writing ``summary.csv`` for the cases finished so far.
     """
     if not isinstance(study, Study):
         study = load_study(study)
@@ -286,6 +305,36 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
         else:
             pending.append(case)
 
+    try:
+        _run_pending(out_dir, pending, study, records, lost, report, workers, scheduler, client, progress,
+                     len(cases), on_result)
+    except KeyboardInterrupt:   # Ctrl-C: a valid summary of the cases finished so far, then stop
+        _finish(out_dir, cases, records, {**lost, **{c.key: "not finished: interrupted" for c in pending
+                                                     if c.key not in records and c.key not in lost}}, report)
+        raise StudyInterrupted(report) from None
+    _finish(out_dir, cases, records, lost, report)
+    if figures:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            report.notes.append("no figures: matplotlib is not installed (the 'plot' extra)")
+        else:
+            from .figures import study_figures
+
+            report.figures = study_figures(out_dir, cases, report.rows)
+    return report
+
+
+def _finish(out_dir: str, cases: list, records: dict, lost: dict, report: StudyReport) -> None:
+    """The report's rows and failures, and ``summary.csv``."""
+    report.rows = [summary_row(c, records.get(c.key), lost.get(c.key)) for c in cases]
+    report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
+    write_summary(report.summary, report.rows)
+
+
+def _run_pending(out_dir, pending, study, records, lost, report, workers, scheduler, client, progress,
+                 total, on_result) -> None:
+    """Run the cases not finished yet, writing each result as it arrives (into ``records``)."""
     prepared = _Prepared(study.simulation)
     tasks = []
     for case in pending:
@@ -307,7 +356,7 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
         if progress:
             from tqdm import tqdm
 
-            bar = tqdm(total=len(cases), initial=len(cases) - len(tasks), desc=study.name, unit="case")
+            bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
         try:
             by_key = {}
             start = time.perf_counter()
@@ -336,17 +385,3 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
                 bar.close()
             for thing in owned:
                 thing.close()
-
-    report.rows = [summary_row(c, records.get(c.key), lost.get(c.key)) for c in cases]
-    report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
-    write_summary(report.summary, report.rows)
-    if figures:
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            report.notes.append("no figures: matplotlib is not installed (the 'plot' extra)")
-        else:
-            from .figures import study_figures
-
-            report.figures = study_figures(out_dir, cases, report.rows)
-    return report
