@@ -91,3 +91,45 @@ def test_interrupted_superelement_build_prints_one_line(tmp_path):
     assert p.returncode == 130
     assert lines == ["slewing superelement: interrupted"], lines
     assert not (tmp_path / "se.npz").exists()
+
+
+# ---- an output folder holds one study ----------------------------------------------------------
+
+def _small_study(folder, name, preloads):
+    path = Path(folder) / f"{name}.toml"
+    path.write_text(STUDY.replace('name = "sigint"', f'name = "{name}"').replace(
+        "preload_um = [0, 10, 20, 30, 40]", f"preload_um = {list(preloads)}").replace(
+        "{first = 1, count = 8}", "[1]").replace("steps = 300", "steps = 5"))
+    return path
+
+
+def _batch(study, out_dir, *extra):
+    return subprocess.run([SLEWING, "batch", str(study), "-o", str(out_dir), "--workers", "1", "--quiet", *extra],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+
+
+def test_output_folder_of_another_study_is_refused_unless_overwrite(tmp_path):
+    out_dir = tmp_path / "out"
+    first = _batch(_small_study(tmp_path, "first", [0, 10]), out_dir)
+    assert first.returncode == 0, first.stderr
+    old_figures = set((out_dir / "figures").iterdir())
+    assert old_figures
+    second = _small_study(tmp_path, "second", [20])
+    refused = _batch(second, out_dir)
+    assert refused.returncode == 2
+    assert "'first'" in refused.stderr and "'second'" in refused.stderr and "--overwrite" in refused.stderr
+    assert len(list((out_dir / "cases").iterdir())) == 2                  # nothing touched
+    done = _batch(second, out_dir, "--overwrite", "--no-figures")
+    assert done.returncode == 0, done.stderr
+    with open(out_dir / "summary.csv", newline="") as fh:
+        assert [r["preload_um"] for r in csv.DictReader(fh)] == ["20.0"]
+    assert len(list((out_dir / "cases").iterdir())) == 1                  # the old cases are gone
+    assert not (out_dir / "figures").exists()                             # and the old figures
+
+
+def test_rerun_of_the_same_study_resumes_even_when_extended(tmp_path):
+    out_dir = tmp_path / "out"
+    assert _batch(_small_study(tmp_path, "mc", [0, 10]), out_dir, "--no-figures").returncode == 0
+    again = _batch(_small_study(tmp_path, "mc", [0, 10, 20]), out_dir, "--no-figures")
+    assert again.returncode == 0, again.stderr
+    assert "2 already finished" in again.stdout and "1 run now" in again.stdout

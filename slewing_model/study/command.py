@@ -15,6 +15,9 @@ def add_arguments(p) -> None:
     p.add_argument("--retry-failed", action="store_true", help="run again the cases that finished with an error")
     p.add_argument("--no-figures", action="store_true", help="do not write figures/*.png")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--overwrite", action="store_true",
+                   help="clear the results of another study found in the output directory (refused otherwise; "
+                        "the same study's finished cases are always kept)")
 
 
 def run(args) -> int:
@@ -22,7 +25,8 @@ def run(args) -> int:
 
     try:
         report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
-                           progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures)
+                           progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures,
+                           overwrite=args.overwrite)
     except StudyInterrupted as stop:   # Ctrl-C: one line, the status of a command ended by SIGINT
         r = stop.report
         finished = sum(1 for row in r.rows if not row["status"].startswith("not finished"))
