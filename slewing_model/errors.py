@@ -139,15 +139,21 @@ class ManufacturingErrors:
 
 # ---- CSV reading ------------------------------------------------------------------
 
-def _csv_rows(path: str) -> tuple[list[str], list[list[str]]]:
+def _csv_rows(path: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """The header and the data rows of a CSV file, each row with its line number in the file
+    (1-based, comment and blank lines counted)."""
+    rows = []
     try:
         with open(path, newline="") as fh:
-            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+            reader = csv.reader(fh)
+            for r in reader:
+                if r and not r[0].lstrip().startswith("#"):
+                    rows.append((reader.line_num, r))
     except OSError as exc:
         raise BearingDefinitionError(f"{path}: cannot read the error file: {exc.strerror}") from None
     if not rows:
         raise BearingDefinitionError(f"{path}: empty error file (a header line is required)")
-    return [h.strip() for h in rows[0]], rows[1:]
+    return [h.strip() for h in rows[0][1]], rows[1:]
 
 
 def _float(path: str, line: int, column: str, text: str) -> float:
@@ -177,7 +183,7 @@ def read_ring_csv(path: str | os.PathLike, ring: str) -> RingErrorMap:
     if len(rows) < 2:
         raise BearingDefinitionError(f"{path}: at least two angles are needed, found {len(rows)}")
     data = {col: [] for col in header}
-    for n, row in enumerate(rows, start=2):
+    for n, row in rows:
         if len(row) != len(header):
             raise BearingDefinitionError(f"{path}, line {n}: {len(row)} values for {len(header)} columns")
         for col, text in zip(header, row):
@@ -205,7 +211,7 @@ def read_ball_csv(path: str | os.PathLike, ball_count: int) -> np.ndarray:
         raise BearingDefinitionError(f"{path}: {len(rows)} balls listed, the bearing has ball_count = {ball_count}")
     dev = np.empty(ball_count)
     seen = set()
-    for n, row in enumerate(rows, start=2):
+    for n, row in rows:
         ball = int(_float(path, n, "ball", row[0]))
         if not 1 <= ball <= ball_count or ball in seen:
             raise BearingDefinitionError(f"{path}, line {n}, column ball = {row[0]!r}: must be a new ball number in 1..{ball_count}")
