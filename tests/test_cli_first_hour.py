@@ -60,3 +60,55 @@ def test_library_warnings_for_the_fmu():
     assert solve(table1, Loads(Fz=1e5)).warnings() == []
     idle = solve(load_bearing(ROOT / "examples/bearings/table3.toml"), Loads())
     assert idle.static_safety_factor == math.inf and idle.warnings() == []
+
+
+# ---- version, help, one mesh default, a prebuilt superelement -------------------------------------
+
+def test_version():
+    import slewing_model
+
+    out = _run("--version")
+    assert out.returncode == 0 and out.stdout.strip() == f"slewing {slewing_model.__version__}"
+
+
+def test_help_shows_the_defaults():
+    solve_help = _run("solve", "-h").stdout.split("options:", 1)[1]
+    for option, default in (("--model", "rigid"), ("--mesh", "coarse"), ("--bc", "free"), ("--fz", "0.0")):
+        block = solve_help.split(option + " ", 1)[1].split("\n  -", 1)[0]
+        assert f"(default: {default})" in " ".join(block.split()), (option, block)
+    assert "(default: the friction model's)" in " ".join(solve_help.split())      # --mu: none in numbers
+    assert "(default: free)" in " ".join(_run("superelement", "-h").stdout.split())
+
+
+def test_one_mesh_default_across_commands():
+    from slewing_model.study.definition import SIMULATION_DEFAULTS
+
+    defaults = set()
+    for command in ("solve", "plot", "superelement"):
+        text = " ".join(_run(command, "-h").stdout.split("options:", 1)[1].split())
+        mesh = text.split("--mesh {coarse,fine,finer} ", 1)[1]
+        defaults.add(mesh.split("(default: ", 1)[1].split(")", 1)[0])
+    assert defaults == {SIMULATION_DEFAULTS["mesh"]}
+
+
+def test_solve_and_plot_use_a_prebuilt_superelement(tmp_path):
+    import os
+
+    env = dict(os.environ, SLEWING_CACHE_DIR=str(tmp_path / "cache"))
+    npz = tmp_path / "table3.npz"
+    built = _run("superelement", "examples/bearings/table3.toml", "--bc", "clamped", "--quiet", "-o", str(npz), env=env)
+    assert built.returncode == 0, built.stderr
+    with_file = json.loads(_run("solve", "examples/bearings/table3.toml", "--fz", "3e4", "--superelement", str(npz),
+                                "--json", env=env).stdout)
+    built_here = json.loads(_run("solve", "examples/bearings/table3.toml", "--fz", "3e4", "--model", "flexible",
+                                 "--bc", "clamped", "--json", env=env).stdout)
+    rigid = json.loads(_run("solve", "examples/bearings/table3.toml", "--fz", "3e4", "--json").stdout)
+    assert with_file["model"] == "flexible"
+    assert with_file["displacement"]["z"] == built_here["displacement"]["z"] > rigid["displacement"]["z"]
+    png = tmp_path / "p.png"
+    plotted = _run("plot", "examples/bearings/table3.toml", "--fz", "3e4", "--superelement", str(npz), "-o", str(png),
+                   env=env)
+    assert plotted.returncode == 0 and png.exists(), plotted.stderr
+    # a superelement of another bearing is refused, naming what differs
+    other = _run("solve", "examples/bearings/table1.toml", "--superelement", str(npz), env=env)
+    assert other.returncode == 2 and "error" in other.stderr and "Traceback" not in other.stderr

@@ -9,7 +9,7 @@ def add_arguments(p) -> None:
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output directory: summary.csv, cases/<key>/, figures/ (finished cases are skipped)")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="worker processes of the embedded Dask LocalCluster (default: one per core)")
+                   help="worker processes of the embedded Dask LocalCluster (not given: one per core)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="submit to an existing Dask cluster (e.g. tcp://host:8786) instead")
     p.add_argument("--retry-failed", action="store_true", help="run again the cases that finished with an error")
