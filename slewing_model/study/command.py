@@ -39,6 +39,7 @@ def run(args) -> int:
           f"{len(report.skipped)} already finished. Summary: {report.summary}")
     for note in report.notes:
         print(f"note: {note}", file=sys.stderr)
-    for key, status in report.failed.items():
-        print(f"  {key}: {status}", file=sys.stderr)
+    names = {row["case"]: row["name"] for row in report.rows}
+    for key, status in report.failed.items():   # each failure with its case and the study file
+        print(f"  {args.study}: case {key} ({names.get(key, '?')}): {status}", file=sys.stderr)
     return 0 if not report.failed else 1
