@@ -201,16 +201,17 @@ def _set_inputs(fmu, refs, load, psi, omega):
 
 def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: ManoeuvreResult | None = None,
                    title: str = "") -> None:
-    """Four panels: angle and command, motor torque and its limit, bearing friction torque and
-    its share of the motors' torque at the ring while they drive the ring (:func:`friction_share`),
-    maximum ball load and static safety factor."""
+    """Five panels: angle and command; motor torque and its limit; bearing friction torque (from
+    zero, so that its ripple is seen at its true size); its share of the motors' torque at the ring
+    while they drive the ring (:func:`friction_share`); maximum ball load and static safety factor."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     r = result
-    fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
+    fig, ax = plt.subplots(5, 1, figsize=(9, 13), sharex=True,
+                           gridspec_kw={"height_ratios": [1, 1, 1, 0.7, 1]})
     ax[0].plot(r.time, np.degrees(r.command), "k--", label="command")
     ax[0].plot(r.time, np.degrees(r.angle), label="angle, with bearing friction")
     if without_friction is not None:
@@ -226,22 +227,32 @@ def plot_manoeuvre(result: ManoeuvreResult, path, *, without_friction: Manoeuvre
     ax[1].legend(loc="best")
     ax[2].plot(r.time, r.friction_torque / 1e3, label="bearing friction torque (full sliding)")
     ax[2].set_ylabel("friction [kN m]")
+    ax[2].set_ylim(0, 1.15 * max(float(np.max(r.friction_torque)) / 1e3, 1e-9))   # from zero: the ripple at scale
+    ax[2].legend(loc="lower right", fontsize=8)
     # the share of the motors' torque at the ring that the bearing friction takes, while the motors drive
-    # the ring through the friction (at most 100 % by construction)
-    share = ax[2].twinx()
-    share.plot(r.time, friction_share(r), "g", lw=0.8,
-               label="friction / motors' ring torque while they drive the ring [%] (right axis)")
-    share.set_ylabel("friction share of ring torque [%]", color="g")
-    share.set_ylim(0, 130)  # room above 100 % for the legend
-    lines, labels = ax[2].get_legend_handles_labels()
-    more, more_labels = share.get_legend_handles_labels()
-    ax[2].legend(lines + more, labels + more_labels, loc="upper left", fontsize=8)
-    ax[3].plot(r.time, r.outputs["max_ball_load"] / 1e3, label="max ball load")
-    ax[3].set_ylabel("max ball load [kN]")
-    sf = ax[3].twinx()
-    sf.plot(r.time, r.outputs["static_safety_factor"], "m", lw=0.8)
+    # the ring through the friction (at most 100 % by construction); gaps: at rest, or the load drives
+    ax[3].plot(r.time, friction_share(r), "g", lw=1.6,
+               label="bearing friction / motors' torque at the ring, while the motors drive the ring "
+                     "(gaps: at rest, or the load drives)")
+    ax[3].set_ylim(0, 130)           # room above 100 % for the legend
+    ax[3].set_yticks([0, 25, 50, 75, 100])
+    ax[3].set_ylabel("friction share [%]")
+    ax[3].legend(loc="upper left", fontsize=7)
+    ax[4].plot(r.time, r.outputs["max_ball_load"] / 1e3, label="max ball load (left axis)")
+    ax[4].set_ylabel("max ball load [kN]")
+    sf = ax[4].twinx()
+    sf.plot(r.time, r.outputs["static_safety_factor"], "m", lw=0.8, label="static safety factor (right axis)")
     sf.set_ylabel("static safety factor", color="m")
-    ax[3].set_xlabel("time [s]")
+    lines, labels = ax[4].get_legend_handles_labels()
+    more, more_labels = sf.get_legend_handles_labels()
+    low, high = ax[4].get_ylim()
+    ax[4].set_ylim(low, high + 0.35 * (high - low))     # room above the curves for the legend
+    low, high = sf.get_ylim()
+    sf.set_ylim(low, high + 0.35 * (high - low))
+    ax[4].legend(lines + more, labels + more_labels, loc="upper center", ncol=2, fontsize=8)
+    ax[4].set_xlabel("time [s]")
+    for a in ax:
+        a.grid(alpha=0.3)
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

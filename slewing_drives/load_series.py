@@ -111,8 +111,9 @@ class LoadSeries:
         ``psi,omega``); a missing ``Mz`` is 0."""
         frame = None
         with open(path, newline="") as fh:
-            rows = []
-            for r in csv.reader(fh):
+            rows, numbers = [], []            # the data rows and their line numbers in the file
+            reader = csv.reader(fh)
+            for r in reader:
                 if r and r[0].startswith("#"):
                     m = _FRAME_COMMENT.match(",".join(r).strip())
                     if m:
@@ -122,6 +123,7 @@ class LoadSeries:
                     continue
                 if r:
                     rows.append(r)
+                    numbers.append(reader.line_num)
         if not rows:
             raise ValueError(f"{path}: no header line")
         header = [h.strip() for h in rows[0]]
@@ -130,7 +132,7 @@ class LoadSeries:
             raise ValueError(f"{path}: header must be {','.join(COLUMNS[:6])}[,Mz] or {','.join(MOTION_COLUMNS)}, "
                              f"found {','.join(header)}")
         data = []
-        for n, row in enumerate(rows[1:], start=2):
+        for n, row in zip(numbers[1:], rows[1:]):
             try:
                 values = [float(v) for v in row]
             except ValueError:

@@ -16,6 +16,7 @@ import sys
 
 import numpy as np
 
+from . import __version__
 from .bime import LOAD_FIELDS, Loads, NoEquilibriumError, solve
 from .friction import catalogue_torque, friction_torque
 from .geometry import BearingDefinitionError, load_bearing
@@ -31,19 +32,47 @@ def _finite_float(text: str) -> float:
     return value
 
 
+#: the one default superelement mesh of every command (``slewing superelement``, ``solve``, ``plot``,
+#: a study's ``[simulation] mesh``), and what each mesh is worth (docs/superelement.md, Convergence)
+DEFAULT_MESH = "coarse"
+MESH_HELP = ("superelement cross-section mesh: coarse (quick: compliances within 1.2 %%, stiffness entries "
+             "within 15 %% of finer), fine (within 0.5 %% of finer, about 4x the build time), finer")
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """``--help`` shows each option's default, except where there is none (None, a flag's False)."""
+
+    def _get_help_string(self, action):
+        if action.default is None or action.default is False or "%(default)" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)
+
+
+def _add_parser(sub, name: str, **kw):
+    return sub.add_parser(name, formatter_class=_HelpFormatter, **kw)
+
+
+def _add_superelement_file(p) -> None:
+    p.add_argument("--superelement", default=None, metavar="FILE.npz",
+                   help="a superelement built by `slewing superelement` for this bearing: flexible rings with it "
+                        "(its mesh and ring supports; --mesh and --bc are then not used)")
+
+
 def _add_solve(sub) -> None:
-    p = sub.add_parser("solve", help="load distribution of a bearing under a load")
+    p = _add_parser(sub, "solve", help="load distribution of a bearing under a load")
     p.add_argument("bearing", help="bearing definition (TOML)")
     for name, unit in zip(LOAD_FIELDS, ("N", "N", "N", "Nm", "Nm")):
         p.add_argument(f"--{name.lower()}", type=_finite_float, default=0.0, metavar=unit,
                        help=f"{name} on the moving ring, {unit} (fixed frame)")
-    p.add_argument("--model", choices=("rigid", "flexible"), default="rigid")
+    p.add_argument("--model", choices=("rigid", "flexible"), default="rigid", help="ring model")
     p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free",
                    help="ring support of the flexible model's superelement")
-    p.add_argument("--mesh", choices=("coarse", "fine"), default="coarse")
+    p.add_argument("--mesh", choices=("coarse", "fine", "finer"), default=DEFAULT_MESH, help=MESH_HELP)
+    _add_superelement_file(p)
     p.add_argument("--preload", type=_finite_float, default=None, metavar="m",
                    help="ball preload (oversize), m, overriding the bearing file")
-    p.add_argument("--psi", type=_finite_float, default=0.0, metavar="rad", help="rotation of the moving ring")
+    p.add_argument("--psi", type=_finite_float, default=0.0, metavar="rad",
+                   help="rotation of the moving ring (turns its manufacturing errors with it)")
     p.add_argument("--mu", type=_finite_float, default=None, metavar="-",
                    help="Coulomb friction coefficient of the raceway contacts (default: the friction model's)")
     p.add_argument("--seal-torque", type=_finite_float, default=0.0, metavar="Nm",
@@ -60,24 +89,42 @@ def _bearing_and_loads(args):
     return bearing, Loads(args.fx, args.fy, args.fz, args.mx, args.my)
 
 
+def _superelement(args, bearing):
+    """The superelement of ``--superelement`` (checked against the bearing), or None."""
+    if args.superelement is None:
+        return None
+    from .ring_stiffness import Superelement
+
+    return Superelement.load(args.superelement, bearing)
+
+
 def _run_solve(args) -> int:
     bearing, loads = _bearing_and_loads(args)
-    result = solve(bearing, loads, model=args.model, bc=args.bc, mesh=args.mesh, psi=args.psi)
+    se = _superelement(args, bearing)
+    model = "flexible" if se is not None else args.model
+    result = solve(bearing, loads, model=model, superelement=se, bc=args.bc, mesh=args.mesh, psi=args.psi)
     options = {} if args.mu is None else {"mu": args.mu}
     friction = friction_torque(bearing, result, omega=1.0, seal_torque=args.seal_torque, **options)
     catalogue = catalogue_torque(bearing, loads)
+    for warning in result.warnings():      # a valid answer the user must not take at face value
+        print(f"slewing solve: warning: {warning}", file=sys.stderr)
     if args.json:
         data = result.to_dict()
         data["friction_torque"] = friction.magnitude              # N m, for a positive omega
         data["friction_torque_catalogue"] = catalogue              # N m, maker's start-up formula
+        data["warnings"] = result.warnings()
+        if not math.isfinite(data["static_safety_factor"]):      # unloaded: JSON has no infinity
+            data["static_safety_factor"] = None
         print(json.dumps(data))
         return 0
-    print(f"{bearing.name}: {args.model} rings, {bearing.ball_count} balls, {result.iterations} Newton iterations")
+    print(f"{bearing.name}: {model} rings, {bearing.ball_count} balls, {result.iterations} Newton iterations")
     d = result.displacement
     print(f"displacement  x {d[0] * 1e6:9.3f} um  y {d[1] * 1e6:9.3f} um  z {d[2] * 1e6:9.3f} um  "
           f"rx {d[3] * 1e6:9.3f} urad  ry {d[4] * 1e6:9.3f} urad")
+    safety = result.static_safety_factor
     print(f"max ball load {result.max_ball_load / 1e3:.3f} kN, max contact pressure "
-          f"{result.max_contact_pressure / 1e6:.0f} MPa, static safety factor {result.static_safety_factor:.3g}, "
+          f"{result.max_contact_pressure / 1e6:.0f} MPa, static safety factor "
+          f"{'- (unloaded)' if math.isinf(safety) else f'{safety:.3g}'}, "
           f"{result.balls_in_four_point_contact} balls in four-point contact")
     print(f"friction torque {friction.magnitude:.4g} N m (analytical, full sliding), catalogue formula "
           f"{catalogue:.4g} N m")
@@ -93,14 +140,16 @@ def _run_solve(args) -> int:
 
 
 def _add_plot(sub) -> None:
-    p = sub.add_parser("plot", help="per-ball interference or load, rigid and flexible rings side by side (PNG)")
+    p = _add_parser(sub, "plot", help="per-ball interference or load, rigid and flexible rings side by side (PNG)")
     p.add_argument("bearing", help="bearing definition (TOML)")
     for name, unit in zip(LOAD_FIELDS, ("N", "N", "N", "Nm", "Nm")):
         p.add_argument(f"--{name.lower()}", type=_finite_float, default=0.0, metavar=unit, help=f"{name}, {unit}")
     p.add_argument("--preload", type=_finite_float, default=None, metavar="m", help="ball preload, m")
-    p.add_argument("--quantity", choices=("interference", "load"), default="interference")
-    p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free")
-    p.add_argument("--mesh", choices=("coarse", "fine"), default="coarse")
+    p.add_argument("--quantity", choices=("interference", "load"), default="interference", help="what to plot")
+    p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free",
+                   help="ring support of the flexible rings' superelement")
+    p.add_argument("--mesh", choices=("coarse", "fine", "finer"), default=DEFAULT_MESH, help=MESH_HELP)
+    _add_superelement_file(p)
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
     p.set_defaults(func=_run_plot)
 
@@ -109,8 +158,10 @@ def _run_plot(args) -> int:
     from .plots import plot_distribution
 
     bearing, loads = _bearing_and_loads(args)
+    se = _superelement(args, bearing)
+    label = f"flexible rings ({args.bc})" if se is None else f"flexible rings ({args.superelement})"
     results = {"rigid rings": solve(bearing, loads),
-               f"flexible rings ({args.bc})": solve(bearing, loads, model="flexible", bc=args.bc, mesh=args.mesh)}
+               label: solve(bearing, loads, model="flexible", superelement=se, bc=args.bc, mesh=args.mesh)}
     plot_distribution(results, args.output, quantity=args.quantity,
                       title=f"{bearing.name}, preload {bearing.preload * 1e6:g} um, {loads}")
     print(f"wrote {args.output}")
@@ -130,24 +181,24 @@ def _add_superelement(sub, wanted: bool) -> None:
         p = sub.add_parser("superelement", help=help_text)
         p.set_defaults(func=lambda args: (print(reason, file=sys.stderr), 2)[1])
         return
-    p = sub.add_parser("superelement", help=help_text)
+    p = _add_parser(sub, "superelement", help=help_text)
     command.add_arguments(p)
     p.set_defaults(func=command.run)
 
 
 def _add_loads(sub) -> None:
-    p = sub.add_parser("loads", help="pitch or yaw bearing loads from an OpenFAST/FAST output file (.out, .outb) "
+    p = _add_parser(sub, "loads", help="pitch or yaw bearing loads from an OpenFAST/FAST output file (.out, .outb) "
                                      "as a CSV load series (SI)")
     p.add_argument("file", help="OpenFAST / FAST output file: .out text or .outb binary (FileID 1-4)")
     p.add_argument("--bearing", choices=("pitch", "yaw"), required=True)
-    p.add_argument("--blade", type=int, default=1, metavar="K", help="blade whose pitch bearing (default 1)")
+    p.add_argument("--blade", type=int, default=1, metavar="K", help="blade whose pitch bearing")
     p.add_argument("--mounting", default=None,
                    help="which way the bearing's +z axis points: pitch 'tip' (default) or 'hub', yaw 'up' (default) "
                         "or 'down' (docs/openfast.md)")
     p.add_argument("--frame", choices=("rotating", "fixed"), default="rotating",
-                   help="frame of Fx..My: the moving ring's (blade, nacelle; default) or the fixed ring's (hub, tower)")
+                   help="frame of Fx..My: the moving ring's (blade, nacelle) or the fixed ring's (hub, tower)")
     p.add_argument("--source", default="auto",
-                   help="channels to use: pitch 'b' or 'c', yaw 'p' or 'n' (default: the first complete set)")
+                   help="channels to use: pitch 'b' or 'c', yaw 'p' or 'n'; auto: the first complete set")
     p.add_argument("--start", type=_finite_float, default=None, metavar="s", help="start of the time window")
     p.add_argument("--end", type=_finite_float, default=None, metavar="s", help="end of the time window")
     p.add_argument("-o", "--output", required=True, help="CSV to write: time,Fx,Fy,Fz,Mx,My,Mz,psi,omega (SI)")
@@ -207,7 +258,7 @@ def _add_batch(sub) -> None:
     """``slewing batch STUDY.toml -o DIR [--workers N] [--scheduler ADDRESS]`` (slewing_model.study; Dask)."""
     from .study import command
 
-    p = sub.add_parser("batch", help="run a study of many cases (load series x bearing variants) on Dask")
+    p = _add_parser(sub, "batch", help="run a study of many cases (load series x bearing variants) on Dask")
     command.add_arguments(p)
     p.set_defaults(func=command.run)
 
@@ -224,7 +275,9 @@ def _add_life(sub) -> None:
 
 def main(argv=None) -> int:
     argv = _attach_negative_numbers(sys.argv[1:] if argv is None else list(argv))
-    parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model")
+    parser = argparse.ArgumentParser(prog="slewing", description="Four-point contact slewing bearing model",
+                                     formatter_class=_HelpFormatter)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_solve(sub)
     _add_plot(sub)
@@ -237,6 +290,9 @@ def main(argv=None) -> int:
         code = int(args.func(args) or 0)
         sys.stdout.flush()
         return code
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback; the status of a command ended by SIGINT
+        print(f"\nslewing {args.command}: interrupted", file=sys.stderr)
+        return 130
     except BrokenPipeError:
         if not _stdout_is_broken():
             raise

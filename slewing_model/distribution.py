@@ -14,6 +14,10 @@ import numpy as np
 from .contact import ISO76_PRESSURE_LIMIT
 
 LOAD_FIELDS = ("Fx", "Fy", "Fz", "Mx", "My")
+#: largest contact pressure that still counts as an unloaded bearing, Pa: 1/1000 of the ISO 76 limit, a
+#: ball load of 1e-9 of its static capacity. An unloaded bearing without preload keeps a round-off
+#: interference (about 3e-17 m, 1.5 kPa), which would give a safety factor of 2e19.
+NO_LOAD_PRESSURE = 1e-3 * ISO76_PRESSURE_LIMIT
 DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
 
 
@@ -171,9 +175,32 @@ class LoadDistribution:
     def static_safety_factor(self) -> float:
         """ISO 76 static safety factor ``(4200 MPa / p_max)^3`` (load ratio, as
         ``C0 / P0``: Hertz pressure grows with the cube root of the load);
-        infinite for an unloaded bearing."""
+        infinite for an unloaded bearing (largest pressure below :data:`NO_LOAD_PRESSURE`)."""
         p = self.max_contact_pressure
-        return math.inf if p <= 0.0 else (ISO76_PRESSURE_LIMIT / p) ** 3
+        return math.inf if p < NO_LOAD_PRESSURE else (ISO76_PRESSURE_LIMIT / p) ** 3
+
+    def warnings(self) -> list[str]:
+        """What a user must know about this result although it is a valid solution, one
+        sentence each (empty when nothing): a static safety factor below 1 (ISO 76: the
+        raceways deform permanently) and contacts loaded over the groove edge.
+
+        Examples
+        --------
+        >>> from slewing_model import load_bearing, solve, Loads
+        >>> r = solve(load_bearing("examples/bearings/table1.toml"), Loads(Fz=3e7))
+        >>> r.warnings()[0][:43]
+        'static safety factor 0.269 is below 1: the '
+        """
+        out = []
+        s = self.static_safety_factor
+        if s < 1.0:
+            out.append(f"static safety factor {s:.3g} is below 1: the largest contact pressure "
+                       f"{self.max_contact_pressure / 1e6:.0f} MPa exceeds ISO 76's {ISO76_PRESSURE_LIMIT / 1e6:.0f} MPa "
+                       f"and the raceways deform permanently (the result assumes they do not)")
+        if self.truncated_contacts:
+            out.append(f"{self.truncated_contacts} contact ellipses run over the groove edge (edge loading: "
+                       f"their pressure is higher than Hertz's)")
+        return out
 
     @property
     def truncated_contacts(self) -> int:
@@ -182,8 +209,10 @@ class LoadDistribution:
 
     @property
     def balls_in_four_point_contact(self) -> int:
-        """Number of balls whose both diagonals carry load."""
-        return int(np.count_nonzero(np.all(self.interference > 0.0, axis=1)))
+        """Number of balls whose both diagonals carry load (a contact pressure of at least
+        :data:`NO_LOAD_PRESSURE` on all four contacts: the round-off interference of an unloaded
+        bearing is no contact)."""
+        return int(np.count_nonzero(np.all(self.contact_pressure >= NO_LOAD_PRESSURE, axis=1)))
 
     def to_dict(self) -> dict:
         """Plain JSON-ready data (the ``slewing solve --json`` object)."""

@@ -30,9 +30,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .geometry import RING_CONTACTS, BearingDefinitionError
+from .geometry import BEARING_TABLES, RING_CONTACTS, BearingDefinitionError, check_known_keys
 
 _UM = 1e-6
+#: the keys of ``[errors.synthetic]``
+SYNTHETIC_KEYS = ("seed", "waviness_orders", "radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um")
 _MM = 1e-3
 
 
@@ -137,15 +139,21 @@ class ManufacturingErrors:
 
 # ---- CSV reading ------------------------------------------------------------------
 
-def _csv_rows(path: str) -> tuple[list[str], list[list[str]]]:
+def _csv_rows(path: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """The header and the data rows of a CSV file, each row with its line number in the file
+    (1-based, comment and blank lines counted)."""
+    rows = []
     try:
         with open(path, newline="") as fh:
-            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+            reader = csv.reader(fh)
+            for r in reader:
+                if r and not r[0].lstrip().startswith("#"):
+                    rows.append((reader.line_num, r))
     except OSError as exc:
         raise BearingDefinitionError(f"{path}: cannot read the error file: {exc.strerror}") from None
     if not rows:
         raise BearingDefinitionError(f"{path}: empty error file (a header line is required)")
-    return [h.strip() for h in rows[0]], rows[1:]
+    return [h.strip() for h in rows[0][1]], rows[1:]
 
 
 def _float(path: str, line: int, column: str, text: str) -> float:
@@ -175,7 +183,7 @@ def read_ring_csv(path: str | os.PathLike, ring: str) -> RingErrorMap:
     if len(rows) < 2:
         raise BearingDefinitionError(f"{path}: at least two angles are needed, found {len(rows)}")
     data = {col: [] for col in header}
-    for n, row in enumerate(rows, start=2):
+    for n, row in rows:
         if len(row) != len(header):
             raise BearingDefinitionError(f"{path}, line {n}: {len(row)} values for {len(header)} columns")
         for col, text in zip(header, row):
@@ -203,7 +211,7 @@ def read_ball_csv(path: str | os.PathLike, ball_count: int) -> np.ndarray:
         raise BearingDefinitionError(f"{path}: {len(rows)} balls listed, the bearing has ball_count = {ball_count}")
     dev = np.empty(ball_count)
     seen = set()
-    for n, row in enumerate(rows, start=2):
+    for n, row in rows:
         ball = int(_float(path, n, "ball", row[0]))
         if not 1 <= ball <= ball_count or ball in seen:
             raise BearingDefinitionError(f"{path}, line {n}, column ball = {row[0]!r}: must be a new ball number in 1..{ball_count}")
@@ -305,16 +313,12 @@ def synthetic_errors(
 
 def errors_from_table(table: Mapping[str, Any], base_dir: str | os.PathLike, ball_count: int) -> ManufacturingErrors:
     """The ``[errors]`` table of a definition file: CSV files, or ``[errors.synthetic]``."""
-    known = {"outer_ring_csv", "inner_ring_csv", "ball_diameters_csv", "synthetic"}
-    for key in table:
-        if key not in known:
-            raise BearingDefinitionError(f"errors.{key} = {table[key]!r}: unknown key (known: {', '.join(sorted(known))})")
+    check_known_keys(table, "errors", BEARING_TABLES["errors"])
     if "synthetic" in table:
+        if not isinstance(table["synthetic"], Mapping):
+            raise BearingDefinitionError(f"errors.synthetic = {table['synthetic']!r}: must be a table [errors.synthetic]")
         s = dict(table["synthetic"])
-        allowed = {"seed", "waviness_orders", "radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um"}
-        for key in s:
-            if key not in allowed:
-                raise BearingDefinitionError(f"errors.synthetic.{key} = {s[key]!r}: unknown key (known: {', '.join(sorted(allowed))})")
+        check_known_keys(s, "errors.synthetic", SYNTHETIC_KEYS)
         for key in ("radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um"):
             values = np.atleast_1d(np.asarray(s.get(key, 0.0), dtype=float))
             if not np.all(np.isfinite(values)) or np.any(values < 0):

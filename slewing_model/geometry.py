@@ -47,6 +47,35 @@ def _fail(key: str, value: Any, rule: str):
     raise BearingDefinitionError(f"{key} = {value!r}: {rule}")
 
 
+#: the tables of a bearing definition file and the keys each one knows (names are case-sensitive)
+BEARING_TABLES = {
+    "bearing": ("name", "pitch_diameter_mm", "ball_diameter_mm", "groove_radius_mm", "contact_angle_deg",
+                "ball_count", "preload_um", "first_ball_angle_deg", "moving_ring"),
+    "material": ("youngs_modulus_gpa", "poisson_ratio"),
+    "rings": ("gap_mm", "outer_ring_outer_diameter_mm", "inner_ring_bore_diameter_mm", "outer_ring_height_mm",
+              "inner_ring_height_mm", "outer_ring_bolted_face", "inner_ring_bolted_face"),
+    "errors": ("outer_ring_csv", "inner_ring_csv", "ball_diameters_csv", "synthetic"),
+}
+
+
+def check_known_keys(table: Mapping[str, Any], name: str, known) -> None:
+    """Refuse a key of the table ``[name]`` that is not in ``known``, naming the table, the key, its
+    value and the known keys (a misspelt key would otherwise be ignored and its default used)."""
+    for key in table:
+        if key not in known:
+            _fail(f"{name}.{key}", table[key],
+                  f"unknown key in table [{name}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
+
+
+def _subtable(data: Mapping[str, Any], name: str) -> Mapping[str, Any]:
+    """The table ``[name]`` of a definition (empty when absent), its keys checked."""
+    table = data.get(name, {})
+    if not isinstance(table, Mapping):
+        _fail(name, table, f"must be a table [{name}]")
+    check_known_keys(table, name, BEARING_TABLES[name])
+    return table
+
+
 @dataclass(frozen=True)
 class RingSection:
     """Rectangular ring cross-section, before the groove is cut (paper Fig. 3).
@@ -317,15 +346,14 @@ def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
     BearingDefinitionError
         Naming the key, the value and the rule broken.
     """
+    for name in data:
+        if name not in BEARING_TABLES:
+            _fail(name, data[name], f"unknown table [{name}] (known tables: "
+                  f"{', '.join(f'[{t}]' for t in BEARING_TABLES)}; names are case-sensitive)")
     if "bearing" not in data or not isinstance(data["bearing"], Mapping):
         _fail("bearing", None, "missing table [bearing] (required)")
-    b = data["bearing"]
+    b = _subtable(data, "bearing")
     w = "bearing."
-    known = {"name", "pitch_diameter_mm", "ball_diameter_mm", "groove_radius_mm", "contact_angle_deg",
-             "ball_count", "preload_um", "first_ball_angle_deg", "moving_ring"}
-    for key in b:
-        if key not in known:
-            _fail(w + key, b[key], f"unknown key (known: {', '.join(sorted(known))})")
     dm = _positive(b, "pitch_diameter_mm", w) * _MM
     dw = _positive(b, "ball_diameter_mm", w) * _MM
 
@@ -368,19 +396,19 @@ def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
     if moving not in ("inner", "outer"):
         _fail(w + "moving_ring", moving, "must be 'inner' or 'outer'")
 
-    m = data.get("material", {})
+    m = _subtable(data, "material")
     youngs = _positive(m, "youngs_modulus_gpa", "material.", 200.0) * 1e9
     nu = _number(m, "poisson_ratio", "material.", 0.3)
     if not 0.0 < nu < 0.5:
         _fail("material.poisson_ratio", nu, "must lie in (0, 0.5)")
 
-    outer, inner = _sections(data.get("rings", {}), dm, dw)
+    outer, inner = _sections(_subtable(data, "rings"), dm, dw)
 
     errors = None
     if "errors" in data:
         from .errors import errors_from_table
 
-        errors = errors_from_table(data["errors"], base_dir=base_dir, ball_count=n)
+        errors = errors_from_table(_subtable(data, "errors"), base_dir=base_dir, ball_count=n)
 
     bearing = Bearing(
         name=str(b.get("name", "bearing")), pitch_diameter=dm, ball_diameter=dw, groove_radius=rc,
@@ -431,4 +459,7 @@ def load_bearing(path: str | os.PathLike) -> Bearing:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise BearingDefinitionError(f"{path}: not valid TOML: {exc}") from None
-    return bearing_from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+    try:
+        return bearing_from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+    except BearingDefinitionError as exc:  # name the file: a study reads several
+        raise BearingDefinitionError(f"{path}: {exc}") from None

@@ -55,15 +55,18 @@ def plot_distribution(results: Mapping[str, object], path, *, quantity: str = "i
     plt.close(fig)
 
 
-def plot_axial_stiffness(curves: Mapping[str, tuple[Sequence[float], Sequence[float]]], path, *, title: str = "") -> None:
+def plot_axial_stiffness(curves: Mapping[str, tuple[Sequence[float], Sequence[float]]], path, *, title: str = "",
+                         note: str = "") -> None:
     """Axial load against axial displacement (paper Fig. 6).
 
     Parameters
     ----------
     curves : mapping of label -> (displacements in m, loads in N)
+    note : str
+        A caption under the axes (what explains the curves).
     """
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    fig, ax = plt.subplots(figsize=(6.5, 4.5 + 0.16 * note.count("\n") + (0.3 if note else 0.0)))
     for name, (z, f) in curves.items():
         ax.plot(np.asarray(z) * 1e6, np.asarray(f) / 1e3, "o-", ms=3, label=name)
     ax.set_xlabel("axial displacement [um]")
@@ -71,6 +74,10 @@ def plot_axial_stiffness(curves: Mapping[str, tuple[Sequence[float], Sequence[fl
     ax.grid(alpha=0.3)
     ax.legend()
     ax.set_title(title)
-    fig.tight_layout()
+    if note:
+        fig.text(0.01, 0.01, note, fontsize=7, va="bottom", ha="left")
+        fig.tight_layout(rect=(0, 0.04 + 0.03 * note.count("\n"), 1, 1))
+    else:
+        fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -24,7 +24,8 @@ from fmpy import read_model_description
 from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "examples" / "ssp"))
-from ssp_hosts import COMPARED, COUPLING, HOSTS, max_relative_difference, reference_values  # noqa: E402
+from ssp_hosts import (COMPARED, COUPLING, HOSTS, libtbb_missing, max_relative_difference,  # noqa: E402
+                       reference_values)
 
 T_ON, T_OFF, STOP, DT = 0.1, 0.9, 1.5, 0.01
 STEP_DEG = 5.0
@@ -116,8 +117,9 @@ def _host(name):
         pytest.importorskip("libcosimpy")
     if name == "ecos":
         pytest.importorskip("ecospy")
-        if subprocess.run(["bash", "-c", "ldconfig -p | grep -q 'libtbb.so.12 '"]).returncode != 0:
-            pytest.skip("Debian's libtbb12 is missing (make installs it when run as root)")
+        missing = libtbb_missing()     # the loader itself: no ldconfig on PATH needed
+        if missing is not None:
+            pytest.skip(f"{missing} (make installs it when run as root)")
     return HOSTS[name]
 
 
@@ -155,7 +157,8 @@ def test_ecos_program_runs_the_ssp_in_a_minimal_environment(system, tmp_path):
         pytest.skip(f"ecospy ships no ecos program at {program}")
     program.chmod(program.stat().st_mode | 0o111)
     ssp, references = system
-    env = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", str(tmp_path))}
+    # TMPDIR: ecos unpacks the SSP into TMPDIR/ecos_ssp_* and leaves it; tmp_path is removed by pytest
+    env = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", str(tmp_path)), "TMPDIR": str(tmp_path)}
     run = subprocess.run([str(program), "simulate", "--path", str(ssp), "--stepSize", str(DT), "--stopTime", str(STOP),
                           "--parameterSet", "pitch_system"], cwd=tmp_path, env=env, capture_output=True, text=True,
                          timeout=300)

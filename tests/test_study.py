@@ -194,7 +194,10 @@ def test_bad_cases_are_reported_and_the_others_finish(tmp_path, capsys):
         assert rows[("crushing", preload)]["status"].startswith("LoadCapacityError at t = 0 s")
         assert rows[("crushing", preload)]["friction_torque_max"] == ""
     assert all("\n" not in r["status"] for r in rows.values())
-    assert "6 failed" in capsys.readouterr().out
+    printed = capsys.readouterr()
+    assert "6 failed" in printed.out
+    # each failure names the study file and the case (issue 25)
+    assert f"{path}: case " in printed.err and "(garbled | table3" in printed.err
 
 
 def test_rerun_skips_finished_cases(tmp_path, cluster):

@@ -19,7 +19,11 @@ What each host needs from us:
 """
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import shutil
+import tempfile
 
 import numpy as np
 
@@ -83,23 +87,59 @@ def run_libcosim(ssp, names, *, stop_time: float, step_size: float) -> dict:
     return out
 
 
+def libtbb_missing() -> str | None:
+    """Why ecos cannot run here, or None. ecos needs Debian's libtbb12 (``libtbb.so.12``); the
+    dynamic loader is asked directly, so the check does not depend on ``ldconfig`` being on
+    ``PATH`` (it is in /sbin, which a user's ``PATH`` often lacks)."""
+    import ctypes
+
+    try:
+        ctypes.CDLL("libtbb.so.12")
+    except OSError as exc:
+        return f"ecos needs Debian's libtbb12 (libtbb.so.12), which the loader cannot find: {exc}"
+    return None
+
+
+@contextlib.contextmanager
+def private_tmpdir():
+    """A temporary folder as ``TMPDIR`` for the block, removed afterwards with what is in it.
+
+    ecos unpacks an SSP into a new ``ecos_ssp_*`` folder of the temporary directory
+    (``std::filesystem::temp_directory_path``, which reads ``TMPDIR``) at every run and never
+    removes it; giving each run its own ``TMPDIR`` keeps ``/tmp`` clean without touching
+    folders of other runs."""
+    folder = tempfile.mkdtemp(prefix="slewing_ecos_")
+    before = os.environ.get("TMPDIR")
+    os.environ["TMPDIR"] = folder
+    try:
+        yield folder
+    finally:
+        if before is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = before
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 def run_ecos(ssp, names, *, stop_time: float, step_size: float) -> dict:
-    """ecos (ecospy's in-process library), with the SSP's parameter set applied."""
+    """ecos (ecospy's in-process library), with the SSP's parameter set applied; its unpacked
+    SSP is removed afterwards (:func:`private_tmpdir`)."""
     from ecospy import EcosSimulation
 
     steps = int(round(stop_time / step_size))
     out = {name: np.empty(steps) for name in names}
     time = np.empty(steps)
-    sim = EcosSimulation(step_size=step_size, ssp_path=str(ssp))
-    try:
-        sim.init(parameter_set=PARAMETER_SET)
-        for k in range(steps):
-            time[k] = sim.step()
-            for name in names:
-                out[name][k] = sim.get_real(name.replace(".", "::", 1))
-        sim.terminate()
-    finally:
-        sim.free()
+    with private_tmpdir():
+        sim = EcosSimulation(step_size=step_size, ssp_path=str(ssp))
+        try:
+            sim.init(parameter_set=PARAMETER_SET)
+            for k in range(steps):
+                time[k] = sim.step()
+                for name in names:
+                    out[name][k] = sim.get_real(name.replace(".", "::", 1))
+            sim.terminate()
+        finally:
+            sim.free()
     out["time"] = time
     return out
 

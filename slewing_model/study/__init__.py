@@ -12,8 +12,9 @@ Not part of the FMU's run time (it imports dask); it runs the same
 """
 from .case import CaseResult, CaseTask, run_case
 from .definition import Case, Study, StudyDefinitionError, load_study, study_from_dict
-from .engine import StudyReport, run_study
+from .engine import ForeignOutputError, StudyInterrupted, StudyReport, run_study
 from .series import MotionSeries
 
-__all__ = ["Case", "CaseResult", "CaseTask", "MotionSeries", "Study", "StudyDefinitionError", "StudyReport",
+__all__ = ["Case", "CaseResult", "CaseTask", "ForeignOutputError", "MotionSeries", "Study", "StudyDefinitionError",
+           "StudyInterrupted", "StudyReport",
            "load_study", "run_case", "run_study", "study_from_dict"]

@@ -9,25 +9,37 @@ def add_arguments(p) -> None:
     p.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="output directory: summary.csv, cases/<key>/, figures/ (finished cases are skipped)")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="worker processes of the embedded Dask LocalCluster (default: one per core)")
+                   help="worker processes of the embedded Dask LocalCluster (not given: one per core)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="submit to an existing Dask cluster (e.g. tcp://host:8786) instead")
     p.add_argument("--retry-failed", action="store_true", help="run again the cases that finished with an error")
     p.add_argument("--no-figures", action="store_true", help="do not write figures/*.png")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--overwrite", action="store_true",
+                   help="clear the results of another study found in the output directory (refused otherwise; "
+                        "the same study's finished cases are always kept)")
 
 
 def run(args) -> int:
-    from .engine import run_study
+    from .engine import StudyInterrupted, run_study
 
-    report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
-                       progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures)
+    try:
+        report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
+                           progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures,
+                           overwrite=args.overwrite)
+    except StudyInterrupted as stop:   # Ctrl-C: one line, the status of a command ended by SIGINT
+        r = stop.report
+        finished = sum(1 for row in r.rows if not row["status"].startswith("not finished"))
+        print(f"\nslewing batch: interrupted; {finished} of {r.cases} cases finished, summary: {r.summary} "
+              f"(the same command resumes)", file=sys.stderr)
+        return 130
     ok = report.cases - len(report.failed)
     print(f"{report.cases} cases: {ok} ok, {len(report.failed)} failed; {len(report.ran)} run now "
           f"({report.wall_time:.1f} s{', ' + report.cluster if report.cluster else ''}), "
           f"{len(report.skipped)} already finished. Summary: {report.summary}")
     for note in report.notes:
         print(f"note: {note}", file=sys.stderr)
-    for key, status in report.failed.items():
-        print(f"  {key}: {status}", file=sys.stderr)
+    names = {row["case"]: row["name"] for row in report.rows}
+    for key, status in report.failed.items():   # each failure with its case and the study file
+        print(f"  {args.study}: case {key} ({names.get(key, '?')}): {status}", file=sys.stderr)
     return 0 if not report.failed else 1

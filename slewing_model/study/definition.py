@@ -231,7 +231,10 @@ def load_study(path: str | os.PathLike) -> Study:
         raise StudyDefinitionError(f"{path}: cannot read the study file: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise StudyDefinitionError(f"{path}: not a valid TOML file: {exc}") from None
-    return study_from_dict(data, os.path.dirname(os.path.abspath(path)), path)
+    try:
+        return study_from_dict(data, os.path.dirname(os.path.abspath(path)), path)
+    except StudyDefinitionError as exc:  # name the file
+        raise StudyDefinitionError(f"{path}: {exc}") from None
 
 
 def study_from_dict(data: Mapping[str, Any], study_dir: str, path: str = "<dict>") -> Study:
@@ -266,9 +269,16 @@ def study_from_dict(data: Mapping[str, Any], study_dir: str, path: str = "<dict>
 
 
 def _known(table: Mapping, where: str, known: set) -> None:
+    """Refuse a key of ``table`` not in ``known`` (``where``: the table's dotted name and a dot, ``""``
+    for the file's top level), naming the table, the key, its value and the known keys."""
     for key in table:
-        if key not in known:
-            _fail(where + key, table[key], f"unknown key (known: {', '.join(sorted(known))})")
+        if key in known:
+            continue
+        if not where:
+            _fail(key, table[key], f"unknown table [{key}] (known tables: "
+                  f"{', '.join(f'[{t}]' for t in sorted(known))}; names are case-sensitive)")
+        _fail(where + key, table[key],
+              f"unknown key in table [{where[:-1]}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
 
 
 def _table(data: Mapping, key: str, required: bool) -> Mapping:

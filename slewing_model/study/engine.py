@@ -13,6 +13,7 @@ others.
 
 Output directory::
 
+    DIR/study.json                     the study the folder holds (name, file)
     DIR/summary.csv                    one row per case (case, status, statistics, parameters)
     DIR/cases/<key>/case.json          the case: name, load series, bearing variant, settings
     DIR/cases/<key>/timeseries.csv     see slewing_model.study.case.TIMESERIES_COLUMNS (SI)
@@ -28,6 +29,7 @@ Output directory::
     DIR/cases/<key>/result.json        status, statistics, wall time, worker (written last)
     DIR/figures/*.png                  see slewing_model.study.figures
 
+A folder holding another study's results is refused (``overwrite`` clears them).
 A case whose ``result.json`` exists is finished: a rerun skips it (failed cases
 too, unless ``retry_failed``). A case lost to the cluster itself (e.g. a task whose
 workers died more than Dask's ``allowed-failures`` times) is listed in the summary
@@ -53,6 +55,20 @@ REQUIRED_COLUMNS = ("case", "status", "friction_torque_mean", "friction_torque_m
 SUMMARY_COLUMNS = REQUIRED_COLUMNS + tuple(s for s in STATISTICS if s not in REQUIRED_COLUMNS) + (
     "name", "load", "blade", "bearing", "ring_model", "preload_um", "friction_coefficient", "error_seed",
     "elapsed_s", "worker")
+
+
+class StudyInterrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) during :func:`run_study`, after ``summary.csv`` was written for the cases
+    finished so far (the others: status ``not finished: interrupted``; a rerun resumes them).
+
+    Attributes
+    ----------
+    report : StudyReport
+    """
+
+    def __init__(self, report: "StudyReport"):
+        super().__init__("interrupted")
+        self.report = report
 
 
 @dataclass
@@ -92,6 +108,48 @@ class StudyReport:
     cluster: str = ""
     figures: list = field(default_factory=list)
     notes: list = field(default_factory=list)
+
+
+#: the record of which study an output directory holds
+STUDY_RECORD = "study.json"
+
+
+class ForeignOutputError(ValueError):
+    """The output directory holds another study's results."""
+
+
+def _foreign_study(out_dir: str, study: Study, cases: list) -> str | None:
+    """The name of the other study whose results ``out_dir`` holds, or None (empty, or this study's).
+
+    ``study.json`` names the study that wrote the folder; a folder written before that record
+    existed is another study's when none of its cases is one of this study's."""
+    try:
+        with open(os.path.join(out_dir, STUDY_RECORD)) as fh:
+            name = json.load(fh).get("name")
+    except (OSError, ValueError, AttributeError):
+        name = None
+    if name is not None:
+        return None if name == study.name else name
+    try:
+        found = set(os.listdir(os.path.join(out_dir, "cases")))
+    except OSError:
+        found = set()
+    if found and not found & {c.key for c in cases}:
+        return "an unnamed study"
+    return None
+
+
+def _clear_results(out_dir: str) -> None:
+    """Remove what a study run writes (nothing else of the folder)."""
+    import shutil
+
+    for name in ("cases", "figures"):
+        shutil.rmtree(os.path.join(out_dir, name), ignore_errors=True)
+    for name in ("summary.csv", STUDY_RECORD):
+        try:
+            os.remove(os.path.join(out_dir, name))
+        except FileNotFoundError:
+            pass
 
 
 def case_dir(out_dir: str, key: str) -> str:
@@ -285,7 +343,7 @@ def _client(workers: int | None, scheduler: str | None):
 
 def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, workers: int | None = None,
               scheduler: str | None = None, client=None, progress: bool = True, retry_failed: bool = False,
-              figures: bool = True, on_result=None) -> StudyReport:
+              figures: bool = True, on_result=None, overwrite: bool = False) -> StudyReport:
     """Run every case of a study that is not finished in ``out_dir``.
 
     Parameters
@@ -308,16 +366,35 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
         Write ``figures/*.png`` (needs matplotlib).
     on_result : callable, optional
         ``on_result(case, record, client)`` after each result is written (tests, monitoring).
+    overwrite : bool
+        Clear the results of another study found in ``out_dir`` (``cases/``, ``figures/``,
+        ``summary.csv``) instead of refusing the folder. The same study's results are always
+        kept and its finished cases skipped.
 
     Returns
     -------
     StudyReport
+
+    Raises
+    ------
+    StudyInterrupted
+        On Ctrl-C (SIGINT), after writing ``summary.csv`` for the cases finished so far.
+    ForeignOutputError
+        ``out_dir`` holds another study's results and ``overwrite`` is not set.
     """
     if not isinstance(study, Study):
         study = load_study(study)
     out_dir = os.fspath(out_dir)
-    os.makedirs(os.path.join(out_dir, "cases"), exist_ok=True)
     cases = study.cases()
+    other = _foreign_study(out_dir, study, cases)
+    if other is not None:
+        if not overwrite:
+            raise ForeignOutputError(
+                f"output directory {out_dir} holds the results of {other!r}, not of study {study.name!r}: "
+                f"give another directory, or --overwrite to clear them")
+        _clear_results(out_dir)
+    os.makedirs(os.path.join(out_dir, "cases"), exist_ok=True)
+    _write_json(os.path.join(out_dir, STUDY_RECORD), {"name": study.name, "path": study.path})
     report = StudyReport(len(cases), summary=os.path.join(out_dir, "summary.csv"))
     records: dict[str, dict] = {}
     lost: dict[str, str] = {}
@@ -330,6 +407,36 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
         else:
             pending.append(case)
 
+    try:
+        _run_pending(out_dir, pending, study, records, lost, report, workers, scheduler, client, progress,
+                     len(cases), on_result)
+    except KeyboardInterrupt:   # Ctrl-C: a valid summary of the cases finished so far, then stop
+        _finish(out_dir, cases, records, {**lost, **{c.key: "not finished: interrupted" for c in pending
+                                                     if c.key not in records and c.key not in lost}}, report)
+        raise StudyInterrupted(report) from None
+    _finish(out_dir, cases, records, lost, report)
+    if figures:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            report.notes.append("no figures: matplotlib is not installed (the 'plot' extra)")
+        else:
+            from .figures import study_figures
+
+            report.figures = study_figures(out_dir, cases, report.rows)
+    return report
+
+
+def _finish(out_dir: str, cases: list, records: dict, lost: dict, report: StudyReport) -> None:
+    """The report's rows and failures, and ``summary.csv``."""
+    report.rows = [summary_row(c, records.get(c.key), lost.get(c.key)) for c in cases]
+    report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
+    write_summary(report.summary, report.rows)
+
+
+def _run_pending(out_dir, pending, study, records, lost, report, workers, scheduler, client, progress,
+                 total, on_result) -> None:
+    """Run the cases not finished yet, writing each result as it arrives (into ``records``)."""
     prepared = _Prepared(study.simulation)
     tasks = []
     for case in pending:
@@ -351,7 +458,7 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
         if progress:
             from tqdm import tqdm
 
-            bar = tqdm(total=len(cases), initial=len(cases) - len(tasks), desc=study.name, unit="case")
+            bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
         try:
             by_key = {}
             start = time.perf_counter()
@@ -380,17 +487,3 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
                 bar.close()
             for thing in owned:
                 thing.close()
-
-    report.rows = [summary_row(c, records.get(c.key), lost.get(c.key)) for c in cases]
-    report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
-    write_summary(report.summary, report.rows)
-    if figures:
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            report.notes.append("no figures: matplotlib is not installed (the 'plot' extra)")
-        else:
-            from .figures import study_figures
-
-            report.figures = study_figures(out_dir, cases, report.rows)
-    return report

@@ -49,7 +49,8 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
     for key, (label, _) in SWEPT.items():
         values = {r[key] for r in ok if r[key] != ""}
         if len(values) >= 3:
-            written.append(band_against(os.path.join(folder, f"friction_torque_vs_{key}.png"), ok, key, label))
+            written.append(band_against(os.path.join(folder, f"friction_torque_vs_{key}.png"), ok, key, label,
+                                        note=errors_note(cases)))
     maps = [os.path.join(out_dir, "cases", r["case"]) for r in ok]
     maps = [m for m in maps if os.path.exists(os.path.join(m, "raceway_damage.csv"))]
     if maps:
@@ -58,8 +59,48 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
         worst = max(ok, key=lambda r: _value(r, "friction_torque_max"))
         path = os.path.join(out_dir, "cases", worst["case"], "timeseries.csv")
         if os.path.exists(path):
-            written.append(time_series(os.path.join(folder, "worst_case.png"), path, worst["name"]))
+            case = next((c for c in cases if c.key == worst["case"]), None)
+            written.append(time_series(os.path.join(folder, "worst_case.png"), path, worst["name"],
+                                       psi_note=psi_note(case.load if case is not None else {})))
     return written
+
+
+def _amplitudes(values) -> str:
+    values = values if isinstance(values, list) else [values]
+    return "/".join(f"{v:g}" for v in values)
+
+
+def errors_note(cases) -> str:
+    """What manufacturing errors the cases carry, in one line for a figure's title: the seeded
+    synthetic amplitudes (um) and the number of seeds, or the bearing files' own errors."""
+    seeds = sorted({c.variant.get("error_seed") for c in cases if c.variant.get("error_seed") is not None})
+    synthetic = next((c.variant.get("synthetic_errors") for c in cases if c.variant.get("synthetic_errors")), None)
+    if not seeds:
+        return "manufacturing errors: those of the bearing files"
+    if not synthetic:
+        return f"synthetic manufacturing errors of the bearing file's amplitudes, {len(seeds)} seeds"
+    orders = synthetic.get("waviness_orders", [2, 3, 4, 5])
+    parts = [f"waviness orders {_amplitudes(orders)}"]
+    for key, what in (("radial_amplitude_um", "radial"), ("axial_amplitude_um", "axial")):
+        if key in synthetic:
+            parts.append(f"{what} {_amplitudes(synthetic[key])} um")
+    if "ball_tolerance_um" in synthetic:
+        parts.append(f"balls +-{synthetic['ball_tolerance_um']:g} um")
+    return f"synthetic errors ({', '.join(parts)}), {len(seeds)} seeds"
+
+
+def psi_note(load: dict) -> str:
+    """Why the ring angle has the sign it has, for an OpenFAST load series (docs/openfast.md):
+    psi is the blade pitch or nacelle yaw seen along the bearing's +z."""
+    if load.get("kind") != "openfast":
+        return ""
+    if load.get("bearing") == "pitch":
+        mounting = load.get("mounting", "tip")
+        return ("psi = -BldPitch: +z points to the blade tip (mounting 'tip')" if mounting == "tip"
+                else "psi = +BldPitch: +z points to the hub (mounting 'hub')")
+    mounting = load.get("mounting", "up")
+    return ("psi = +NacYaw: +z points up (mounting 'up')" if mounting == "up"
+            else "psi = -NacYaw: +z points down (mounting 'down')")
 
 
 def _labels(rows: list[dict]) -> list[str]:
@@ -100,38 +141,70 @@ def overview(path: str, rows: list[dict]) -> str:
         for ax, (keys, scale, label) in zip(axes.flat, panels):
             height = 0.8 / len(keys)
             for j, key in enumerate(keys):
-                ax.barh(y + (j - (len(keys) - 1) / 2) * height, [_value(r, key) * scale for r in ok], height,
+                values = [_value(r, key) * scale for r in ok]
+                ax.barh(y + (j - (len(keys) - 1) / 2) * height, values, height,
                         label=key.replace("friction_torque_", "") if len(keys) > 1 else None)
+                if key == "friction_energy":      # a bar too short to see: say why it is empty
+                    largest = max(values, default=0.0)
+                    for k, v in enumerate(values):
+                        if v <= 1e-3 * largest:
+                            ax.text(0, y[k], f"  {v:.2g}: the ring hardly turned", va="center", fontsize=7)
             ax.set_yticks(y, labels if ax in axes[:, 0] else [""] * len(y), fontsize=7)
             ax.invert_yaxis()
             ax.set_xlabel(label)
             ax.grid(axis="x", alpha=0.3)
             if len(keys) > 1:
                 ax.legend(fontsize=8)
-    else:
+    else:   # many cases: per group of cases (seeds, blades pooled) the median, quartiles and 5-95 % range
+        groups = _groups(ok)
+        fig.suptitle(title + f"\nper group of cases: median (line), quartiles (box), 5-95 % (whiskers); "
+                     f"{len(ok) // max(len(groups), 1)} cases a group", fontsize=10)
+        panels[0] = (("friction_torque_mean",), 1e-3, "friction torque, mean over the case [kN m]")
+        names = list(groups)
         for ax, (keys, scale, label) in zip(axes.flat, panels):
-            for key in keys:
-                ax.hist([_value(r, key) * scale for r in ok], bins=30, alpha=0.6,
-                        label=key.replace("friction_torque_", "") if len(keys) > 1 else None)
-            ax.set_xlabel(label)
-            ax.set_ylabel("cases")
-            if len(keys) > 1:
-                ax.legend(fontsize=8)
+            data = []
+            for g in names:
+                v = np.array([_value(r, keys[0]) * scale for r in groups[g]])
+                data.append(v[np.isfinite(v)])
+            ax.boxplot(data, orientation="horizontal", whis=(5, 95), showfliers=False, widths=0.6)
+            ax.set_yticks(np.arange(1, len(names) + 1), names if ax in axes[:, 0] else [""] * len(names), fontsize=7)
+            ax.invert_yaxis()
+            everything = np.concatenate(data) if data else np.array([])
+            log = everything.size > 0 and everything.min() > 0 and everything.max() / everything.min() > 100
+            if log:
+                ax.set_xscale("log")
+            ax.set_xlabel(label + (" (log scale)" if log else ""))
+            ax.grid(axis="x", alpha=0.3, which="both")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
 
-def band_against(path: str, ok: list[dict], key: str, label: str) -> str:
-    """Mean friction torque against a swept parameter: median and 5-95 % band per group (left),
-    and the band relative to the median (right: narrow bands are invisible on the left)."""
+def _groups(ok: list[dict]) -> dict:
+    """The cases by what sets them apart other than error seeds and blades: ring model, preload,
+    friction coefficient, bearing file and load series; labelled by the parts that vary."""
+    fields = ("ring_model", "preload_um", "friction_coefficient", "bearing", "load")
+    varying = [f for f in fields if len({r[f] for r in ok}) > 1]
+    groups = defaultdict(list)
+    for r in ok:
+        label = ", ".join(f"{float(r[f]):g} um" if f == "preload_um" else
+                          (f"mu {r[f]}" if f == "friction_coefficient" else r[f]) for f in varying) or "all cases"
+        groups[label].append(r)
+    return dict(groups)
+
+
+def band_against(path: str, ok: list[dict], key: str, label: str, note: str = "") -> str:
+    """Mean friction torque against a swept parameter, per group (load series, bearing, ring model):
+    every case, the median and the 5-95 % range of the cases (left, on a log axis when the torque
+    spans decades); and the width of that range relative to the median (right: a band of a few
+    per cent of 1000 N m cannot be seen on the left)."""
     plt = _pyplot()
     groups = defaultdict(list)
     for r in ok:
         groups[(r["load"], r["bearing"], r["ring_model"])].append(r)
     fig, (ax, rel) = plt.subplots(1, 2, figsize=(12, 4.8))
-    for (load, bearing, model), members in sorted(groups.items()):
+    for g, ((load, bearing, model), members) in enumerate(sorted(groups.items())):
         by_x = defaultdict(list)
         for r in members:
             by_x[float(r[key])].append(_value(r, "friction_torque_mean"))
@@ -141,42 +214,69 @@ def band_against(path: str, ok: list[dict], key: str, label: str) -> str:
         lo = np.array([np.percentile(s, 5) for s in samples])
         hi = np.array([np.percentile(s, 95) for s in samples])
         n = min(len(s) for s in samples)
-        line, = ax.plot(xs, median, "o-", label=f"{bearing}, {model}, {load}: median ({n} cases per point)")
+        line, = ax.plot(xs, median, "o-", label=f"{bearing}, {model}, {load}: median of {n} cases per point")
         color = line.get_color()
-        ax.fill_between(xs, lo, hi, color=color, alpha=0.25, label="5-95 % band")
-        for x, s in zip(xs, samples):
-            ax.plot(np.full(s.shape, x), s, ".", color=color, alpha=0.15, ms=3)
+        first = g == 0
+        ax.errorbar(xs, median, yerr=[median - lo, hi - median], fmt="none", ecolor=color, capsize=7, lw=1.5,
+                    label="5-95 % of the cases (bars)" if first else None)
+        for i, (x, s) in enumerate(zip(xs, samples)):
+            ax.plot(np.full(s.shape, x) + 0.25, s, "_", color=color, alpha=0.5, ms=8,
+                    label="each case (its mean over the run), beside the bar" if first and i == 0 else None)
         with np.errstate(divide="ignore", invalid="ignore"):
-            rel.fill_between(xs, 100 * (lo / median - 1), 100 * (hi / median - 1), color=color, alpha=0.3,
-                             label=f"{bearing}, {model}: 5-95 % band")
-            for x, s, m in zip(xs, samples, median):
-                rel.plot(np.full(s.shape, x), 100 * (s / m - 1), ".", color=color, alpha=0.15, ms=3)
+            width = 100 * (hi - lo) / median
+        rel.plot(xs, width, "o-", color=color, label=f"{bearing}, {model}")
+        for x, w in zip(xs, width):
+            if np.isfinite(w):
+                rel.annotate(f"{w:.3g} %", (x, w), textcoords="offset points", xytext=(4, 4), fontsize=7,
+                             color=color)
+    values = np.array([_value(r, "friction_torque_mean") for r in ok])
+    if values.size and values.min() > 0 and values.max() / values.min() > 20:
+        ax.set_yscale("log")      # the torque spans decades: each point's spread stays visible
     ax.set_xlabel(label)
-    ax.set_ylabel("mean friction torque [N m]")
-    ax.grid(alpha=0.3)
+    ax.set_ylabel("mean friction torque [N m]" + (" (log scale)" if ax.get_yscale() == "log" else ""))
+    ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
+    ax.set_title("mean friction torque of each case", fontsize=9)
+    rel.set_yscale("log")
     rel.set_xlabel(label)
-    rel.set_ylabel("mean friction torque / median - 1 [%]")
-    rel.grid(alpha=0.3)
+    rel.set_ylabel("5-95 % range / median [%] (log scale)")
+    rel.set_title("spread of the cases: width of the 5-95 % range relative to the median", fontsize=9)
+    rel.grid(alpha=0.3, which="both")
     rel.legend(fontsize=7)
+    if note:
+        fig.suptitle(note, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
 
-def time_series(path: str, csv_path: str, name: str) -> str:
+def time_series(path: str, csv_path: str, name: str, psi_note: str = "") -> str:
+    """The ring angle (and the drive moment Mz, where there is one), the friction torque and the
+    largest ball load over a case's run."""
     plt = _pyplot()
     data = np.loadtxt(csv_path, delimiter=",", skiprows=1, ndmin=2)
     c = {k: data[:, j] for j, k in enumerate(TIMESERIES_COLUMNS)}
     fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
     axes[0].plot(c["time"], np.degrees(c["psi"]), color="C0")
     axes[0].set_ylabel("ring angle psi [deg]", color="C0")
-    twin = axes[0].twinx()
-    twin.plot(c["time"], c["Mz"] * 1e-3, color="C1", lw=0.8)
-    twin.set_ylabel("drive moment Mz [kN m]", color="C1")
-    axes[1].plot(c["time"], c["friction_torque_magnitude"] * 1e-3, lw=0.8)
+    if np.any(c["Mz"] != 0.0):       # no second axis for a series without a drive moment (idling)
+        twin = axes[0].twinx()
+        twin.plot(c["time"], c["Mz"] * 1e-3, color="C1", lw=0.8)
+        twin.set_ylabel("drive moment Mz [kN m]", color="C1")
+    else:
+        axes[0].set_title("no drive moment Mz in this series", fontsize=8, loc="right")
+    if psi_note:
+        axes[0].set_title(psi_note, fontsize=8, loc="left")
+    torque = c["friction_torque_magnitude"] * 1e-3
+    axes[1].plot(c["time"], torque, lw=0.8)
     axes[1].set_ylabel("friction torque [kN m]")
+    top = float(np.max(torque)) if torque.size else 0.0
+    if top > 0:     # from zero, so that the ripple shows at its true size; its size in words
+        axes[1].set_ylim(0, 1.15 * top)
+        mean = float(np.mean(torque))
+        axes[1].set_title(f"{float(np.min(torque)):.4g} to {top:.4g} kN m, mean {mean:.4g}: "
+                          f"range {100 * (top - float(np.min(torque))) / mean:.2g} % of the mean", fontsize=8, loc="left")
     axes[2].plot(c["time"], c["max_ball_load"] * 1e-3, lw=0.8)
     axes[2].set_ylabel("largest ball load [kN]")
     axes[2].set_xlabel("time [s]")

@@ -83,6 +83,18 @@ def _frame(source: str, stated: str | None, asked: str | None, default: str) -> 
     return asked or stated or default
 
 
+def _data_rows(lines: list[str]) -> tuple[list[list[str]], list[int]]:
+    """The rows of a CSV file that are neither blank nor comments, and their line numbers in the
+    file (1-based, counting the comment and blank lines), so that messages point at the true line."""
+    rows, numbers = [], []
+    reader = csv.reader(lines)
+    for row in reader:
+        if row and not row[0].lstrip().startswith("#"):
+            rows.append(row)
+            numbers.append(reader.line_num)
+    return rows, numbers
+
+
 def read_csv(path: str, *, omega_default: float | None = None, load_frame: str | None = None,
              default_frame: str = "fixed") -> MotionSeries:
     """Read a load series CSV (SI): ``time,Fx,Fy,Fz,Mx,My[,Mz][,psi][,omega]``; a comment line
@@ -103,7 +115,7 @@ def read_csv(path: str, *, omega_default: float | None = None, load_frame: str |
                 stated = text.split("=", 1)[1].strip()
                 if stated not in ("fixed", "rotating"):
                     raise ValueError(f"{path}: comment load_frame = {stated!r}: must be 'fixed' or 'rotating'")
-        rows = [r for r in csv.reader(lines) if r and not r[0].lstrip().startswith("#")]
+        rows, numbers = _data_rows(lines)
     except OSError as exc:
         raise ValueError(f"{path}: cannot read the load series: {exc.strerror}") from None
     except UnicodeDecodeError:
@@ -120,15 +132,15 @@ def read_csv(path: str, *, omega_default: float | None = None, load_frame: str |
     if len(set(header)) != len(header):
         raise ValueError(f"{path}: a column is repeated in the header {','.join(header)}")
     data = np.empty((len(rows) - 1, len(header)))
-    for n, row in enumerate(rows[1:], start=2):
+    for i, (n, row) in enumerate(zip(numbers[1:], rows[1:])):
         if len(row) != len(header):
             raise ValueError(f"{path}, line {n}: {len(row)} values for {len(header)} columns")
         for j, text in enumerate(row):
             try:
-                data[n - 2, j] = float(text)
+                data[i, j] = float(text)
             except ValueError:
                 raise ValueError(f"{path}, line {n}, column {header[j]} = {text!r}: must be a number") from None
-            if not math.isfinite(data[n - 2, j]):
+            if not math.isfinite(data[i, j]):
                 raise ValueError(f"{path}, line {n}, column {header[j]} = {text!r}: must be finite")
     col = {h: data[:, j] for j, h in enumerate(header)}
     if len(data) < 2 or np.any(np.diff(col["time"]) <= 0):

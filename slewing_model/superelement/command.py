@@ -1,4 +1,4 @@
-"""``slewing superelement BEARING.toml [--mesh coarse|fine] [--bc free|clamped|frictionless] -o FILE``.
+"""``slewing superelement BEARING.toml [--mesh coarse|fine|finer] [--bc free|clamped|frictionless] -o FILE``.
 
 Issue 3, item 6. Builds the condensed ring stiffness of both rings (with a
 progress bar over the harmonic solves), writes it to one ``.npz`` and prints a
@@ -21,15 +21,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of the ``superelement`` sub-command."""
     parser.add_argument("bearing", help="bearing definition (TOML, see examples/bearings)")
     parser.add_argument("-o", "--output", required=True, help="output file (.npz)")
-    parser.add_argument("--mesh", choices=list(MESH_PRESETS), default="fine",
-                        help="cross-section mesh: coarse (tests), fine (default, within 1 %% of finer), finer")
+    from ..cli import DEFAULT_MESH, MESH_HELP
+
+    parser.add_argument("--mesh", choices=list(MESH_PRESETS), default=DEFAULT_MESH, help=MESH_HELP)
     parser.add_argument("--bc", choices=BOUNDARY_CONDITIONS, default="free",
-                        help="boundary condition of both rings (default free, as the paper's idling model)")
+                        help="boundary condition of both rings (free: the paper's idling model)")
     parser.add_argument("--bc-outer", choices=BOUNDARY_CONDITIONS, help="boundary condition of the outer ring only")
     parser.add_argument("--bc-inner", choices=BOUNDARY_CONDITIONS, help="boundary condition of the inner ring only")
-    parser.add_argument("--harmonics", type=int, help="highest Fourier harmonic (default: from the section)")
+    parser.add_argument("--harmonics", type=int, help="highest Fourier harmonic (not given: from the section)")
     parser.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
-    parser.add_argument("--cache-dir", help="cache folder (default $SLEWING_CACHE_DIR or ~/.cache/slewing_model)")
+    parser.add_argument("--cache-dir", help="cache folder (not given: $SLEWING_CACHE_DIR, else ~/.cache/slewing_model)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 

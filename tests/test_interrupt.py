@@ -1,0 +1,135 @@
+"""Ctrl-C (SIGINT) in ``slewing batch`` and ``slewing superelement`` (issue 25): one line on
+stderr, exit status 130 (128 + SIGINT, as a shell reports a command it interrupted), and for a
+study a valid ``summary.csv`` of the cases finished so far, which a rerun resumes."""
+import csv
+import glob
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SLEWING = str(Path(sys.executable).with_name("slewing"))
+TABLE3 = (ROOT / "examples" / "bearings" / "table3.toml").as_posix()
+
+pytest.importorskip("distributed", reason="the study engine needs dask[distributed] (extra 'study')")
+
+# 40 small cases (rigid rings, 300 steps each, a few tenths of a second) on one worker: the run
+# lasts long enough to be interrupted after a few of them have finished
+STUDY = f"""[study]
+name = "sigint"
+[[loads]]
+name = "light"
+constant = [0, 0, 1e4, 0, 0, 0]
+omega_rad_s = 0.1
+duration_s = 10.0
+steps = 300
+[bearings]
+files = ["{TABLE3}"]
+ring_model = ["rigid"]
+preload_um = [0, 10, 20, 30, 40]
+error_seeds = {{first = 1, count = 8}}
+[bearings.synthetic_errors]
+waviness_orders = [2, 3]
+"""
+
+
+def _interrupt_after(command, ready, timeout=120):
+    """Start ``command``, send SIGINT once ``ready()`` holds; (rc, stdout, stderr)."""
+    p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    start = time.monotonic()
+    while not ready():
+        assert p.poll() is None, p.communicate()
+        assert time.monotonic() - start < timeout
+        time.sleep(0.05)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    return p.returncode, out, err
+
+
+def test_interrupted_batch_leaves_a_summary_of_the_finished_cases_and_resumes(tmp_path):
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY)
+    out_dir = tmp_path / "out"
+    command = [SLEWING, "batch", str(study), "-o", str(out_dir), "--workers", "1", "--quiet", "--no-figures"]
+    finished = lambda: glob.glob(str(out_dir / "cases" / "*" / "result.json"))  # noqa: E731
+    rc, out, err = _interrupt_after(command, lambda: len(finished()) >= 3)
+    assert rc == 130, err
+    assert len(err.strip().splitlines()) == 1 and "interrupted" in err and "Traceback" not in err, err
+    with open(out_dir / "summary.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 40                                   # every case, each with its status
+    done = {Path(p).parent.name for p in finished()}
+    ok = {r["case"] for r in rows if r["status"] == "ok"}
+    assert ok == done and len(ok) >= 3                       # exactly the cases whose result is on disk
+    assert all(float(r["friction_torque_mean"]) > 0 for r in rows if r["status"] == "ok")
+    assert all(r["status"].startswith("not finished") for r in rows if r["case"] not in ok)
+    # the rerun resumes: it runs only the others
+    again = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"{len(ok)} already finished" in again.stdout
+
+
+def test_interrupted_superelement_build_prints_one_line(tmp_path):
+    # the fine mesh builds for several seconds: interrupted once the progress bar has started
+    err_file = tmp_path / "err.txt"
+    command = [SLEWING, "superelement", TABLE3, "--mesh", "fine", "--no-cache", "-o", str(tmp_path / "se.npz")]
+    with open(err_file, "w") as err_fh:
+        p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=err_fh, text=True, cwd=ROOT)
+        start = time.monotonic()
+        while "%" not in err_file.read_text():                # tqdm's bar: the build has begun
+            assert p.poll() is None, err_file.read_text()
+            assert time.monotonic() - start < 120
+            time.sleep(0.05)
+        p.send_signal(signal.SIGINT)
+        p.communicate(timeout=60)
+    lines = [line for line in err_file.read_text().replace("\r", "\n").splitlines()
+             if line.strip() and "%" not in line]              # without the progress bar's own lines
+    assert p.returncode == 130
+    assert lines == ["slewing superelement: interrupted"], lines
+    assert not (tmp_path / "se.npz").exists()
+
+
+# ---- an output folder holds one study ----------------------------------------------------------
+
+def _small_study(folder, name, preloads):
+    path = Path(folder) / f"{name}.toml"
+    path.write_text(STUDY.replace('name = "sigint"', f'name = "{name}"').replace(
+        "preload_um = [0, 10, 20, 30, 40]", f"preload_um = {list(preloads)}").replace(
+        "{first = 1, count = 8}", "[1]").replace("steps = 300", "steps = 5"))
+    return path
+
+
+def _batch(study, out_dir, *extra):
+    return subprocess.run([SLEWING, "batch", str(study), "-o", str(out_dir), "--workers", "1", "--quiet", *extra],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+
+
+def test_output_folder_of_another_study_is_refused_unless_overwrite(tmp_path):
+    out_dir = tmp_path / "out"
+    first = _batch(_small_study(tmp_path, "first", [0, 10]), out_dir)
+    assert first.returncode == 0, first.stderr
+    old_figures = set((out_dir / "figures").iterdir())
+    assert old_figures
+    second = _small_study(tmp_path, "second", [20])
+    refused = _batch(second, out_dir)
+    assert refused.returncode == 2
+    assert "'first'" in refused.stderr and "'second'" in refused.stderr and "--overwrite" in refused.stderr
+    assert len(list((out_dir / "cases").iterdir())) == 2                  # nothing touched
+    done = _batch(second, out_dir, "--overwrite", "--no-figures")
+    assert done.returncode == 0, done.stderr
+    with open(out_dir / "summary.csv", newline="") as fh:
+        assert [r["preload_um"] for r in csv.DictReader(fh)] == ["20.0"]
+    assert len(list((out_dir / "cases").iterdir())) == 1                  # the old cases are gone
+    assert not (out_dir / "figures").exists()                             # and the old figures
+
+
+def test_rerun_of_the_same_study_resumes_even_when_extended(tmp_path):
+    out_dir = tmp_path / "out"
+    assert _batch(_small_study(tmp_path, "mc", [0, 10]), out_dir, "--no-figures").returncode == 0
+    again = _batch(_small_study(tmp_path, "mc", [0, 10, 20]), out_dir, "--no-figures")
+    assert again.returncode == 0, again.stderr
+    assert "2 already finished" in again.stdout and "1 run now" in again.stdout

@@ -1,0 +1,108 @@
+"""The README's command lines run as written (issue 25).
+
+Every line of the README's ``sh`` blocks, and its ``python`` example, is either run here or
+skipped with the reason stated in :data:`SKIPPED` (FMU and SSP builds, full examples and
+studies of minutes, cluster set-up, placeholders). The cheap ones run in a copy of the
+repository (its tracked and new files, committed into a fresh git repository), with
+``.venv/bin/`` pointing at this checkout's environment and ``../shared`` at the real one; each
+must exit 0, and afterwards ``git status`` of the copy must show nothing: the commands write
+only to ignored folders (``results/``), never into the repository.
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+VENV_BIN = Path(sys.executable).parent
+OPENFAST = ROOT.parent / "shared" / "data" / "openfast"
+
+#: (pattern at the start of a command, why it is not run here)
+SKIPPED = (
+    (r"make ", "installs the environment / runs the whole suite: what `make test` is"),
+    (r"\.venv/bin/python build_fmu\.py", "builds an FMU (half a minute or more); tests/test_fmu*.py build and run it"),
+    (r"\.venv/bin/python build_drive_fmu\.py", "builds an FMU; tests/test_drive_fmu.py runs it"),
+    (r"\.venv/bin/python examples/ssp/", "builds and runs the SSP's four FMUs (minutes); tests/test_ssp.py runs it"),
+    (r"\.venv/bin/python examples/", "a full example (seconds to a minute); examples/timings.py times each"),
+    (r"\.venv/bin/python benchmarks/", "a benchmark (minutes)"),
+    (r"\.venv/bin/slewing batch examples/studies/", "a study of minutes (2,000 or 10 long cases); tests/test_study.py"),
+    (r"ECOS=|chmod \+x \"\$ECOS\"|mkdir -p results && cd results", "ecos needs the SSP built (minutes)"),
+    (r"export |dask ", "environment or cluster set-up for another machine"),
+    (r".*\b(STUDY\.toml|DIR|HOST)\b", "a placeholder to fill in"),
+)
+
+
+def _blocks(kind: str) -> list[str]:
+    text = (ROOT / "README.md").read_text()
+    return re.findall(rf"^```{kind}\n(.*?)^```", text, flags=re.S | re.M)
+
+
+def _commands() -> list[str]:
+    out = []
+    for block in _blocks("sh"):
+        for line in block.splitlines():
+            line = re.sub(r"\s+#\s.*$", "", line).strip()      # a trailing comment
+            if line and not line.startswith("#"):
+                out.append(line)
+    return out
+
+
+def _skip_reason(command: str):
+    for pattern, reason in SKIPPED:
+        if re.match(pattern, command):
+            return reason
+    return None
+
+
+def test_every_readme_command_is_run_or_skipped_with_a_reason():
+    commands = _commands()
+    assert len(commands) > 15
+    run = [c for c in commands if _skip_reason(c) is None]
+    assert any(c.startswith(".venv/bin/slewing solve") for c in run)
+    assert any(c.startswith(".venv/bin/slewing superelement") for c in run)
+
+
+@pytest.fixture(scope="module")
+def copy(tmp_path_factory):
+    """A copy of the repository (tracked and new files) as a fresh git repository."""
+    base = tmp_path_factory.mktemp("readme")
+    repo = base / "repo"
+    listed = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard", "-z"], cwd=ROOT,
+                            capture_output=True, text=True, check=True).stdout.split("\0")
+    for name in filter(None, listed):
+        source = ROOT / name
+        if source.is_file():
+            (repo / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(source, repo / name)
+    if OPENFAST.is_dir():
+        (base / "shared" / "data").mkdir(parents=True)
+        (base / "shared" / "data" / "openfast").symlink_to(OPENFAST)
+    git = ["git", "-c", "user.name=test", "-c", "user.email=test@example.com"]
+    for args in (["init", "-q"], ["add", "-A"], ["commit", "-qm", "copy"]):
+        subprocess.run(git + args, cwd=repo, check=True, capture_output=True)
+    return repo
+
+
+def test_readme_commands_exit_0_and_leave_nothing_in_the_repository(copy):
+    env = dict(os.environ)
+    for command in _commands():
+        if _skip_reason(command) is not None:
+            continue
+        if "../shared/data/openfast" in command and not OPENFAST.is_dir():
+            continue                                   # the shared data are not on this machine
+        line = command.replace(".venv/bin/", f"{VENV_BIN}/")
+        done = subprocess.run(["bash", "-c", line], cwd=copy, env=env, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, f"{command}\n{done.stderr[-2000:]}"
+    status = subprocess.run(["git", "status", "--porcelain", "--untracked-files=all"], cwd=copy,
+                            capture_output=True, text=True, check=True).stdout
+    assert status == "", f"README commands left files in the repository:\n{status}"
+
+
+def test_readme_python_example_runs(copy):
+    for block in _blocks("python"):
+        done = subprocess.run([sys.executable, "-c", block], cwd=copy, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr[-2000:]
