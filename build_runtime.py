@@ -379,7 +379,7 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None) -> Runtim
     cache = Path(cache_dir) if cache_dir else runtime_cache_dir()
     key = runtime_key(numba, platform_folder)
     archive, description = cache / f"runtime-{key}.zip", cache / f"runtime-{key}.json"
-    if not (archive.exists() and description.exists()):
+    if not archive.exists():
         cache.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix="slewing_runtime_", dir=cache) as tmp:
             prefix = Path(tmp) / RUNTIME_FOLDER
@@ -389,7 +389,11 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None) -> Runtim
                 for f in sorted(prefix.rglob("*")):
                     if f.is_file():
                         z.write(f, f"{platform_folder}/{RUNTIME_FOLDER}/{f.relative_to(prefix)}")
+            # the description first, the archive last, each whole (os.replace): a concurrent build that
+            # finds the archive finds its description complete
+            partial_description = Path(tmp) / "runtime.json"
+            partial_description.write_text(json.dumps(info))
+            os.replace(partial_description, description)
             os.replace(partial, archive)
-            description.write_text(json.dumps(info))
     info = json.loads(description.read_text())
     return Runtime(archive=archive, **info)

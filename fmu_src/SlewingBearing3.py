@@ -148,7 +148,7 @@ class SlewingBearing3(Fmi3Slave):
     def _update(self, current_time: float | None = None) -> bool:
         """Solve for the current inputs (:func:`bearing_variables.step_or_refuse`: a refused step
         is logged as Discard and keeps the state; the same step refused twice is an Error)."""
-        result = step_or_refuse(self, current_time, Fmi3Status.discard, Fmi3Status.error)
+        result = step_or_refuse(self, current_time, Fmi3Status.discard, Fmi3Status.error, Fmi3Status.warning)
         if result is None:
             return False
         for name, value in scalar_outputs(result, self.simulator).items():

@@ -222,7 +222,7 @@ def build_simulator(slave, error) -> bool:
     return False
 
 
-def step_or_refuse(slave, current_time, discard, error):
+def step_or_refuse(slave, current_time, discard, error, warning=None):
     """Step ``slave.simulator`` with the slave's inputs and tunable parameters (attributes by
     name); the :class:`~slewing_model.simulator.StepResult`, or None after logging why not.
 
@@ -231,7 +231,10 @@ def step_or_refuse(slave, current_time, discard, error):
     retry or go on with other inputs (FMI 2.0, 4.2.3). The same step refused again (same
     time, inputs and tunable parameters: a master that retries unchanged) cannot succeed and
     is logged with ``error``, as is an internal error; no exception leaves (it would reach
-    the host). ``slave._refused`` keeps the last refused step."""
+    the host). ``slave._refused`` keeps the last refused step. A valid result the user must
+    know about (:meth:`~slewing_model.distribution.LoadDistribution.warnings`: a static safety
+    factor below 1, edge loading) is logged with ``warning`` when it starts, and again after
+    it cleared."""
     from slewing_model import Loads, NoEquilibriumError
 
     sim = slave.simulator
@@ -255,6 +258,11 @@ def step_or_refuse(slave, current_time, discard, error):
         slave.log(f"{slave.instance_name}: internal error:\n{traceback.format_exc()}", error)
         return None
     slave._refused = None
+    found = result.distribution.warnings() if warning is not None else []
+    if found and not getattr(slave, "_warned", False):
+        for text in found:
+            slave.log(f"{slave.instance_name}: t = {current_time}: {text}", warning)
+    slave._warned = bool(found)
     return result
 
 

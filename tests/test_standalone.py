@@ -161,10 +161,10 @@ def place(fmu, system: Path, name: str) -> tuple[str, str, list[str]]:
     return inside, token, [str(refs[n]) for n in INPUTS + OUTPUTS]
 
 
-def run_host(system, host, fmu, version, scenario):
+def run_host(system, host, fmu, version, scenario, folder=None):
     """Our C host on ``fmu`` inside ``system``: (return code, {label: {step: values}}, statuses, logs, output)."""
     shutil.copy2(host, system / "tmp" / host.name)
-    inside, token, vrs = place(fmu, system, f"fmu{version}")
+    inside, token, vrs = place(fmu, system, folder or f"fmu{version}")
     run = in_system(system, f"/tmp/{host.name}", inside, MODEL[version], token, scenario, *vrs)
     values, statuses, logs, _ = parse_host_output(run.stdout)
     logs = [f"{status} {category} {message}" for status, category, message in logs]
@@ -248,6 +248,80 @@ def test_below_the_glibc_floor_the_fmu_says_which_glibc_it_needs(version, hosts,
     assert code == 1 and "error fmi2Instantiate" in output  # refused, not crashed, not a loader error
     assert any(f"this FMU needs glibc {floor} or newer" in line and f"this machine has glibc {have}" in line
                for line in logs), output
+
+
+def test_a_runtime_staged_from_debians_python3_runs_in_a_bare_system(hosts, standalone, tmp_path):
+    # a distribution's Python: its libpython and _ctypes have no RUNPATH to the bundled libexpat and
+    # libffi (the layer loads them first), and its site module adds dist-packages, not the
+    # runtime's site-packages (the layer adds that)
+    debian = Path("/usr/bin/python3")
+    probe = subprocess.run([str(debian), "-c", "import sys, sysconfig, os; print(sys.version_info[:2] == (3, 11)); "
+                            "print(os.path.isfile(os.path.join(sysconfig.get_config_var('LIBDIR') or '', "
+                            "sysconfig.get_config_var('INSTSONAME') or '')))"], capture_output=True, text=True) \
+        if debian.exists() else None
+    if probe is None or probe.stdout.split() != ["True", "True"]:
+        pytest.skip("needs Debian's python3 3.11 with its shared library at /usr/bin/python3")
+    packages = tmp_path / "packages"
+    pip = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--target", str(packages),
+                          f"numpy=={np.__version__}"], capture_output=True, text=True)
+    if pip.returncode != 0:
+        pytest.skip(f"cannot install numpy for Debian's python3: {pip.stderr[-300:]}")
+    staged = subprocess.run([str(debian), "-c", "import build_runtime, json, sys; r = build_runtime.runtime("
+                             f"'binaries/linux64', cache_dir={str(tmp_path / 'cache')!r}); "
+                             "print(json.dumps([str(r.archive), r.python, r.glibc]))"],
+                            env={"PATH": "/usr/bin:/bin", "PYTHONPATH": f"{packages}:{ROOT}"},
+                            capture_output=True, text=True, cwd=tmp_path)
+    assert staged.returncode == 0, staged.stderr[-3000:]
+    archive, version, glibc = __import__("json").loads(staged.stdout.strip().splitlines()[-1])
+    fmu = tmp_path / "debian.fmu"
+    with zipfile.ZipFile(standalone[2]) as src, zipfile.ZipFile(fmu, "w") as dst:
+        for info in src.infolist():
+            if info.filename.startswith("binaries/linux64/python/"):
+                continue
+            data = src.read(info.filename)
+            if info.filename == "resources/python_runtime.txt":
+                data = re.sub(rb"version=.*", f"version={version}".encode(), data)
+                data = re.sub(rb"glibc=.*", f"glibc={glibc}".encode(), data)
+            dst.writestr(info, data)
+        with zipfile.ZipFile(archive) as runtime:
+            for info in runtime.infolist():
+                dst.writestr(info, runtime.read(info.filename))
+    reference = fmpy_steps(standalone[2], 2, 6)
+    code, values, _, _, output = run_host(bare_system("trixie"), hosts[2], fmu, 2, "basic")
+    assert code == 0, output[-3000:]
+    for k in range(6):
+        assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+
+
+def test_an_fmu_unpacked_in_a_folder_with_a_non_ascii_name_runs_in_the_c_locale(hosts, standalone):
+    # env -i: no LANG, the C locale; the FMU's Python runs in UTF-8 mode all the same
+    reference = fmpy_steps(standalone[2], 2, 6)
+    code, values, _, _, output = run_host(bare_system("bookworm"), hosts[2], standalone[2], 2, "basic",
+                                          folder="Lager für Blattlager")
+    assert code == 0, output[-3000:]
+    for k in range(6):
+        assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+
+
+def test_a_host_linked_to_libpython_that_did_not_start_it_gets_a_message(standalone, tmp_path):
+    import sysconfig
+
+    libdir = sysconfig.get_config_var("LIBDIR")
+    minor = f"{sys.version_info[0]}.{sys.version_info[1]}"
+    host = tmp_path / "linked_host"
+    build = subprocess.run(["cc", "-O1", "-o", str(host), str(HOST / "host.c"), "-Wl,--no-as-needed", f"-L{libdir}",
+                            f"-lpython{minor}", f"-Wl,-rpath,{libdir}", "-ldl", "-lm"], capture_output=True, text=True)
+    assert build.returncode == 0, build.stderr
+    assert f"libpython{minor}" in subprocess.run(["ldd", str(host)], capture_output=True, text=True).stdout
+    folder = tmp_path / "fmu"
+    with zipfile.ZipFile(standalone[2]) as z:
+        z.extractall(folder)
+    md = read_model_description(str(standalone[2]))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    run = subprocess.run([str(host), str(folder), MODEL[2], md.guid, "basic", *(str(refs[n]) for n in INPUTS + OUTPUTS)],
+                         capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"}, timeout=120)
+    assert run.returncode == 1 and "error fmi2Instantiate" in run.stdout, run.stdout + run.stderr  # no crash
+    assert "holds a Python library" in run.stdout and "not started" in run.stdout
 
 
 def _readelf_glibc_needs(folder: Path) -> str:

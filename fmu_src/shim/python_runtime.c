@@ -5,6 +5,7 @@
 
 #include <gnu/libc-version.h>
 
+#include <dirent.h>
 #include <dlfcn.h>
 #include <limits.h>
 #include <pthread.h>
@@ -189,7 +190,8 @@ static int check_glibc(const struct runtime_file *rt, char *err, size_t errsize)
     if (!*rt->glibc || compare_versions(have, rt->glibc) >= 0)
         return 0;
     message(err, errsize,
-            "this FMU needs glibc %s or newer (Linux x86-64, for example Debian 12, Ubuntu 22.04, RHEL 10 or newer); "
+            "this FMU needs glibc %s or newer (Linux x86-64, for example Debian 12, Ubuntu 22.04, RHEL 10 or newer, "
+            "with libstdc++ of GCC 12 or newer, as they have); "
             "this machine has glibc %s. Run it on a newer system, or ask for an FMU built on a system whose "
             "glibc is at most %s (build_fmu.py states the floor of each FMU it builds).",
             rt->glibc, have, have);
@@ -202,6 +204,49 @@ static void set_flag(void *handle, const char *name, int value)
     int *flag = (int *)dlsym(handle, name);
     if (flag)
         *flag = value;
+}
+
+/* Python code that appends the runtime's folders to sys.path where they are missing: the
+ * standard library, its extension modules and site-packages (<home>/lib/pythonX.Y/...). Returns
+ * 0, or -1 where the path cannot be written into a Python string literal. */
+static int append_runtime_paths(const char *home, const char *minor, char *code, size_t size)
+{
+    if (strpbrk(home, "'\\\n"))
+        return -1;
+    snprintf(code, size,
+             "import sys\n"
+             "for p in ('%s/lib/python%s', '%s/lib/python%s/lib-dynload', '%s/lib/python%s/site-packages'):\n"
+             "    if p not in sys.path: sys.path.append(p)\n", home, minor, home, minor, home, minor);
+    return 0;
+}
+
+/* Load the libraries the runtime carries beside libpython (<home>/lib: libffi, libexpat...) by
+ * their path, before libpython and the extension modules that need them: those without a
+ * RUNPATH (a distribution's Python) find them then by their name among the loaded objects. A
+ * library the process already holds under that name is left as it is. Libraries that need
+ * another bundled one are retried until no more loads. */
+static void preload_libraries(const char *home)
+{
+    char folder[PATH_MAX + 8], path[2 * PATH_MAX];
+    snprintf(folder, sizeof folder, "%s/lib", home);
+    for (int progress = 1; progress;) {
+        progress = 0;
+        DIR *dir = opendir(folder);
+        if (!dir)
+            return;
+        struct dirent *entry;
+        while ((entry = readdir(dir)) != NULL) {
+            const char *name = entry->d_name;
+            if (strncmp(name, "lib", 3) || !strstr(name, ".so") || !strncmp(name, "libpython", 9))
+                continue;
+            if (dlopen(name, RTLD_NOW | RTLD_NOLOAD))
+                continue;  /* loaded already: by us, or by the host under that name */
+            snprintf(path, sizeof path, "%s/%s", folder, name);
+            if (dlopen(path, RTLD_NOW | RTLD_GLOBAL))
+                progress = 1;
+        }
+        closedir(dir);
+    }
 }
 
 /* The Python the FMU carries (runtime=standalone): <binary_dir>/<folder>, a Python prefix with
@@ -224,10 +269,11 @@ static int load_standalone(const char *binary_dir, const struct runtime_file *rt
                 exists(library) ? stdlib : library);
         return -1;
     }
+    preload_libraries(home);
     void *handle = dlopen(library, RTLD_NOW | RTLD_GLOBAL);
     if (!handle) {
         message(err, errsize, "cannot load the FMU's Python library %s: %s (the FMU needs Linux x86-64 with "
-                "glibc %s or newer).", library, dlerror(), rt->glibc);
+                "glibc %s or newer and libstdc++ of GCC 12 or newer).", library, dlerror(), rt->glibc);
         return -1;
     }
     void (*set_home)(const wchar_t *) = (void (*)(const wchar_t *))dlsym(handle, "Py_SetPythonHome");
@@ -242,36 +288,40 @@ static int load_standalone(const char *binary_dir, const struct runtime_file *rt
     }
     set_flag(handle, "Py_IgnoreEnvironmentFlag", 1);   /* no PYTHONPATH, PYTHONHOME... of the host */
     set_flag(handle, "Py_NoUserSiteDirectory", 1);     /* no ~/.local/lib/pythonX.Y/site-packages */
-    set_home(decode(home, NULL));                      /* kept: Python keeps the pointers */
+    set_flag(handle, "Py_UTF8Mode", 1);                /* an FMU folder with non-ASCII names in a C locale */
+    set_home(decode(home, NULL));                      /* Python copies it (the copy of 400 bytes is kept) */
     snprintf(program, sizeof program, "%s/bin/python%s", home, minor);
     if (set_program)
         set_program(decode(program, NULL));            /* sys.executable: none of the host's Pythons */
     initialize(0);                                     /* no signal handlers: the host keeps Ctrl-C */
+    /* site-packages named whatever the building Python's site module adds (Debian's: dist-packages) */
+    int (*run)(const char *, void *) = (int (*)(const char *, void *))dlsym(handle, "PyRun_SimpleStringFlags");
+    char code[4 * PATH_MAX + 256];
+    if (run && append_runtime_paths(home, minor, code, sizeof code) == 0)
+        run(code, NULL);
     save_thread();                                     /* the GIL released for pythonfmu's PyGILState calls */
     return 0;
 }
 
 /* In a process whose Python was started by someone else (a Python host, or another FMU of ours
  * that carries other packages, such as a drive FMU without numba beside a bearing FMU with it):
- * where that Python is of the version this FMU carries, append this FMU's site-packages to
- * sys.path. Packages already imported (numpy) stay the first ones; what the process lacks
- * (numba, or numpy in a Python host without it) comes from this FMU. Appended, never put first:
- * the host's own packages win. */
+ * where that Python is of the version this FMU carries, append this FMU's standard library and
+ * site-packages to sys.path. Modules already imported (numpy) stay the first ones; what the
+ * process lacks (numba, numpy in a Python host without it, or a standard-library module whose
+ * first FMU's folder the host has deleted) comes from this FMU. Appended, never put first: the
+ * host's own packages win. */
 static void offer_packages(const char *binary_dir, const struct runtime_file *rt)
 {
     const char *(*get_version)(void) = (const char *(*)(void))dlsym(RTLD_DEFAULT, "Py_GetVersion");
     int (*ensure)(void) = (int (*)(void))dlsym(RTLD_DEFAULT, "PyGILState_Ensure");
     void (*release)(int) = (void (*)(int))dlsym(RTLD_DEFAULT, "PyGILState_Release");
     int (*run)(const char *, void *) = (int (*)(const char *, void *))dlsym(RTLD_DEFAULT, "PyRun_SimpleStringFlags");
-    char running[16], carried[16], code[2 * PATH_MAX + 256];
+    char running[16], carried[16], home[PATH_MAX], code[4 * PATH_MAX + 256];
+    snprintf(home, sizeof home, "%s/%s", binary_dir, rt->folder);
     if (!get_version || !ensure || !release || !run || !minor_version(get_version(), running, sizeof running)
         || !minor_version(rt->version, carried, sizeof carried) || strcmp(running, carried)
-        || strpbrk(binary_dir, "'\\\n") || strpbrk(rt->folder, "'\\\n"))
+        || append_runtime_paths(home, carried, code, sizeof code) != 0)
         return;
-    snprintf(code, sizeof code,
-             "import sys\n"
-             "p = '%s/%s/lib/python%s/site-packages'\n"
-             "if p not in sys.path: sys.path.append(p)\n", binary_dir, rt->folder, carried);
     int state = ensure();
     run(code, NULL);
     release(state);
@@ -285,7 +335,16 @@ static int load_locked(const char *binary_dir, char *err, size_t errsize)
     read_runtime_file(binary_dir, &rt);
     if (check_glibc(&rt, err, errsize) != 0)
         return -1;
-    if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
+    int (*is_initialized)(void) = (int (*)(void))dlsym(RTLD_DEFAULT, "Py_IsInitialized");
+    if (is_initialized && !is_initialized()) {
+        /* a host linked to libpython that has not started it: a second libpython cannot be loaded
+         * beside it, and starting the host's own is the host's business */
+        message(err, errsize, "this process holds a Python library (%s) that is not started: the FMU cannot start "
+                "its own Python beside it. Start Python in the host first (Py_Initialize), or run the FMU in a host "
+                "that is not linked to libpython.", "libpython");
+        return -1;
+    }
+    if (is_initialized) {
         /* a Python host (fmpy...), a host linked to libpython, or another FMU of ours that
          * started its Python in this process: one process holds one CPython, so use it */
         if (!strcmp(rt.runtime, "standalone"))
