@@ -9,7 +9,8 @@
  *    its home set; when that Python is missing, fmi2Instantiate says so through the host's
  *    logger and returns NULL. The host needs no LD_PRELOAD and no Python on its PATH.
  *
- * 2. Status. pythonfmu maps a refused step (do_step returning False) to fmi2Discard and then
+ * 2. Status. A message logged as Warning leaves the call's status OK (fmusim ends a run on
+ *    fmi2Warning). pythonfmu maps a refused step (do_step returning False) to fmi2Discard and then
  *    reports fmi2Terminated = true for the rest of the run, so every master stops. Here the
  *    status of each call is the worst status the slave logged during it (the slave logs a
  *    refused step as Discard, an instance that cannot continue as Error), and fmi2Terminated
@@ -217,6 +218,9 @@ static fmi2Status finish(Instance *in, fmi2Status status, int discard_allowed)
     fmi2Status logged = in->logged;
     if (logged == fmi2Discard && !discard_allowed)
         logged = fmi2Warning;
+    else if (logged == fmi2Warning)
+        logged = fmi2OK;  /* a warning (safety factor, edge loading) is for the log: the call went well, and
+                           * hosts such as fmusim end the run on a call's fmi2Warning */
     if (logged > status && status != fmi2Pending)
         status = logged;
     if (status == fmi2Error || status == fmi2Fatal)
