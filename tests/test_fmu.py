@@ -171,7 +171,9 @@ def test_a_static_safety_factor_below_one_is_logged_as_a_warning_when_it_starts(
     fmu, refs, messages = slave
     factors = []
     for k, fz in enumerate([1e5, 3e6, 3e6, 1e5, 3e6]):
-        _step(fmu, refs, k * 0.01, Fz=fz)
+        fmu.setReal([refs["Fz"]], [fz])
+        # the step's status stays fmi2OK: the warning is for the log (hosts such as fmusim end on fmi2Warning)
+        assert fmu.fmi2DoStep(fmu.component, k * 0.01, 0.01, 1) == 0
         factors.append(fmu.getReal([refs["static_safety_factor"]])[0])
     assert factors[0] > 1 and factors[1] < 1 and factors[3] > 1
     warned = [m for m in messages if "static safety factor" in m and "is below 1" in m]
