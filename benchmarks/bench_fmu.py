@@ -64,8 +64,9 @@ def rss_mb() -> float:
         return int(fh.read().split()[1]) * resource.getpagesize() / 1e6
 
 
-def worker(fmu_path: str, case_name: str, steps: int) -> None:
-    """Instantiate the FMU, then answer lines ``first count`` on stdin with the step times (JSON)."""
+def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = None, outputs=OUTPUTS) -> None:
+    """Instantiate the FMU (the case's integer parameters, then ``integers``), then answer lines
+    ``first count`` on stdin with the step times and the last ``outputs`` (JSON)."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
@@ -78,12 +79,12 @@ def worker(fmu_path: str, case_name: str, steps: int) -> None:
                     instanceName="bench")
     fmu.instantiate()
     fmu.setupExperiment(startTime=0.0)
-    for name, value in case.parameters.items():
+    for name, value in {**case.parameters, **(integers or {})}.items():
         fmu.setInteger([refs[name]], [value])
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
     instantiate = time.perf_counter() - start
-    inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in OUTPUTS]
+    inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in outputs]
     compiled = "numba" in sys.modules
     print(json.dumps({"instantiate": instantiate, "compiled": compiled}), flush=True)
     for line in sys.stdin:
@@ -94,9 +95,9 @@ def worker(fmu_path: str, case_name: str, steps: int) -> None:
             t0 = time.perf_counter()
             fmu.setReal(inputs, values)
             fmu.doStep(k * DT, DT)                      # fmpy raises on a status other than OK
-            fmu.getReal(outputs)
+            last = fmu.getReal(outputs)
             times.append(time.perf_counter() - t0)
-        print(json.dumps({"times": times, "rss_mb": rss_mb()}), flush=True)
+        print(json.dumps({"times": times, "rss_mb": rss_mb(), "last": last}), flush=True)
     fmu.terminate()
     fmu.freeInstance()
     shutil.rmtree(unzipped, ignore_errors=True)
@@ -105,8 +106,10 @@ def worker(fmu_path: str, case_name: str, steps: int) -> None:
 class Worker:
     """The parent's handle on a worker process."""
 
-    def __init__(self, fmu_path: Path, case_name: str, steps: int, without_numba: bool):
-        command = [sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps)]
+    def __init__(self, fmu_path: Path, case_name: str, steps: int, without_numba: bool = False,
+                 integers: dict | None = None, outputs=OUTPUTS):
+        command = [sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps),
+                   "--worker-options", json.dumps({"integers": integers or {}, "outputs": list(outputs)})]
         if without_numba:
             command.append("--without-numba")
         self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
@@ -164,11 +167,12 @@ def main() -> None:
     parser.add_argument("--without-numba", action="store_true",
                         help="make numba unimportable in the workers: the current FMU runs its numpy fallback")
     parser.add_argument("--worker", nargs=3, metavar=("FMU", "CASE", "STEPS"), help=argparse.SUPPRESS)
+    parser.add_argument("--worker-options", default="{}", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
         if args.without_numba:
             sys.meta_path.insert(0, _NoNumba())
-        worker(args.worker[0], args.worker[1], int(args.worker[2]))
+        worker(args.worker[0], args.worker[1], int(args.worker[2]), **json.loads(args.worker_options))
         return
 
     with tempfile.TemporaryDirectory(prefix="bench_fmu_") as tmp:

@@ -12,82 +12,20 @@ Run: .venv/bin/python benchmarks/bench_life.py [--steps 1000] [--runs 3] [--case
 from __future__ import annotations
 
 import argparse
-import json
-import shutil
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_fmu import OUTPUTS, Worker  # noqa: E402  (one FMU instance in a worker process of its own)
 from cases import CASES, DT  # noqa: E402
 from timing import print_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
-OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
+LIFE_OUTPUTS = ("life_damage", "life_travel_ratio")
 WARM = 20
-
-
-def worker(fmu_path: str, case_name: str, steps: int, life: int) -> None:
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-
-    case = CASES[case_name](steps)
-    md = read_model_description(fmu_path)
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    unzipped = extract(fmu_path)
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName="bench")
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    for name, value in {**case.parameters, "life": life}.items():
-        fmu.setInteger([refs[name]], [value])
-    fmu.enterInitializationMode()
-    fmu.exitInitializationMode()
-    names = OUTPUTS + (("life_damage", "life_travel_ratio") if life else ())
-    inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in names]
-    print(json.dumps({"ready": True}), flush=True)
-    last = None
-    for line in sys.stdin:
-        first, count = map(int, line.split())
-        times = []
-        for k in range(first, first + count):
-            values = [*map(float, case.loads[k]), float(case.psi[k]), float(case.omega[k])]
-            t0 = time.perf_counter()
-            fmu.setReal(inputs, values)
-            fmu.doStep(k * DT, DT)
-            last = fmu.getReal(outputs)
-            times.append(time.perf_counter() - t0)
-        print(json.dumps({"times": times, "last": last}), flush=True)
-    fmu.terminate()
-    fmu.freeInstance()
-    shutil.rmtree(unzipped, ignore_errors=True)
-
-
-class Worker:
-    def __init__(self, fmu_path, case_name, steps, life):
-        self.process = subprocess.Popen([sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps),
-                                         str(life)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-        self.answer()
-
-    def answer(self):
-        line = self.process.stdout.readline()
-        if not line:
-            raise RuntimeError(f"benchmark worker ended (exit {self.process.wait()})")
-        return json.loads(line)
-
-    def run(self, first, count):
-        self.process.stdin.write(f"{first} {count}\n")
-        self.process.stdin.flush()
-        return self.answer()
-
-    def close(self):
-        self.process.stdin.close()
-        self.process.wait()
 
 
 def main() -> None:
@@ -95,11 +33,7 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=1000)
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--case", default="pitch")
-    parser.add_argument("--worker", nargs=4, help=argparse.SUPPRESS)
     args = parser.parse_args()
-    if args.worker:
-        worker(args.worker[0], args.worker[1], int(args.worker[2]), int(args.worker[3]))
-        return
     sys.path.insert(0, str(ROOT))
     from build_fmu import build_fmu
 
@@ -107,7 +41,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="bench_life_") as tmp:
         fmu = build_fmu(case.bearing, Path(tmp) / "bearing.fmu")
         total = WARM + args.steps * args.runs
-        workers = {life: Worker(fmu, args.case, total, life) for life in (0, 1)}
+        workers = {life: Worker(fmu, args.case, total, integers={"life": life},
+                                outputs=OUTPUTS + (LIFE_OUTPUTS if life else ())) for life in (0, 1)}
         for w in workers.values():
             w.run(0, WARM)
         times, last = {0: [], 1: []}, {}
