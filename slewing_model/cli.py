@@ -20,6 +20,7 @@ from . import __version__
 from .bime import LOAD_FIELDS, Loads, NoEquilibriumError, solve
 from .friction import catalogue_torque, friction_torque
 from .geometry import BearingDefinitionError, load_bearing
+from .ring_stiffness import DEFAULT_MESH, MESH_HELP
 
 
 def _finite_float(text: str) -> float:
@@ -32,11 +33,6 @@ def _finite_float(text: str) -> float:
     return value
 
 
-#: the one default superelement mesh of every command (``slewing superelement``, ``solve``, ``plot``,
-#: a study's ``[simulation] mesh``), and what each mesh is worth (docs/superelement.md, Convergence)
-DEFAULT_MESH = "coarse"
-MESH_HELP = ("superelement cross-section mesh: coarse (quick: compliances within 1.2 %%, stiffness entries "
-             "within 15 %% of finer), fine (within 0.5 %% of finer, about 4x the build time), finer")
 
 
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):

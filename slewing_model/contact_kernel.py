@@ -39,7 +39,7 @@ import math
 import numpy as np
 
 from .contact import _E_TABLE, _F_TABLE, _LOG_KAPPA, effective_modulus
-from .friction_kernel import compile_loop, loop_factory
+from .compiled import compile_loop, loop_factory
 from .reduced_operator import OperatorArithmetic
 
 _TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "

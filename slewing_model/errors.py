@@ -30,7 +30,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .geometry import BEARING_TABLES, RING_CONTACTS, BearingDefinitionError, check_known_keys
+from .conventions import BEARING_TABLES, RING_CONTACTS, BearingDefinitionError, check_known_keys
 
 _UM = 1e-6
 #: the keys of ``[errors.synthetic]``

@@ -65,7 +65,6 @@ from .ellipse_quadrature import (  # noqa: F401
     DEFAULT_QUADRATURE, DEFAULT_SOLVE_QUADRATURE, EllipseQuadrature, as_quadrature, ellipse_quadrature,
 )
 from .friction_kernel import use_compiled
-from .friction_studies import preload_sweep, torque_ripple  # noqa: F401
 from .geometry import Bearing
 
 #: Default speed scale of the regularised Coulomb law near omega = 0, rad/s

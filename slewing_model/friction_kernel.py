@@ -24,38 +24,13 @@ a fraction of a second after the first time, and ``build_fmu.py`` ships that cac
 """
 from __future__ import annotations
 
-import functools
-import importlib.util
 import math
 
 import numpy as np
 
+from . import contact_kernel
+from .compiled import AVAILABLE, KERNEL_CHOICES, compile_loop, loop_factory, use_compiled  # noqa: F401
 
-def _numba_installed() -> bool:
-    try:
-        return importlib.util.find_spec("numba") is not None
-    except (ImportError, ValueError):
-        return False
-
-
-#: numba can be imported here (it is imported, and the loop compiled, only when first asked for:
-#: importing numba also imports scipy, which the run-time part does not otherwise need)
-AVAILABLE = _numba_installed()
-
-#: how the friction model may run its loops (``kernel`` of ``friction_torque``)
-KERNEL_CHOICES = ("auto", "numpy", "compiled")
-
-
-def use_compiled(kernel: str, name: str = "kernel") -> bool:
-    """Whether ``kernel`` (one of :data:`KERNEL_CHOICES`) runs the compiled loops here:
-    "compiled", or "auto" where numba is installed. ValueError naming ``name`` for another
-    value, or for "compiled" where numba is not installed."""
-    if kernel not in KERNEL_CHOICES:
-        raise ValueError(f"{name} = {kernel!r}: must be 'auto', 'numpy' or 'compiled'")
-    if kernel == "compiled" and not AVAILABLE:
-        raise ValueError(f"{name} = 'compiled' needs numba, which is not installed in this Python "
-                         "(pip install numba, or use 'auto' or 'numpy')")
-    return AVAILABLE and kernel != "numpy"
 
 _SIGNATURE = ("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
               "f8[:, :], i8[:], i8, f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :, :], "
@@ -442,24 +417,6 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
             results[1], results[2], results[3], results[4], results[5], results[6])
 
 
-def compile_loop(function, signature: str, helpers: tuple = (), error_model: str = "python"):
-    """``function`` compiled by numba for ``signature`` (eager, numba's on-disk cache), after the
-    ``helpers`` it calls (names in its module).
-
-    numba takes the functions a compiled function calls from the module's globals when it
-    compiles it: they must be compiled functions by then, so each helper is compiled in place
-    of its Python definition, once. The Python definitions are used by nothing else (the numpy
-    paths are the library's own code). ``error_model`` "numpy": a division by zero gives inf or
-    NaN as numpy does, instead of raising."""
-    import numba
-
-    module = function.__globals__
-    for name in helpers:
-        if not hasattr(module[name], "py_func"):          # not compiled yet
-            module[name] = numba.njit(cache=True, nogil=True, error_model=error_model)(module[name])
-    return numba.njit(signature, cache=True, nogil=True, error_model=error_model)(function)
-
-
 #: the helpers the friction's loops call
 _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
             "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results")
@@ -644,21 +601,6 @@ def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, len
     return g10, g12, h1, s0, s1, hs, arm1, arm2
 
 
-def loop_factory(registry: list, compile_function, function, signature: str):
-    """The factory of ``function`` compiled by ``compile_function`` for ``signature``: its first call
-    compiles the loop (or loads it from numba's on-disk cache), later calls return it. Entered in
-    ``registry`` (a module's :data:`KERNELS`), from which :func:`compile_all` compiles them all
-    when a simulator is built, so that compiling lands in an FMU's instantiation and never in a
-    step, and ``build_fmu.py`` ships their cache."""
-    @functools.lru_cache(maxsize=1)
-    def factory():
-        return compile_function(function, signature)
-
-    factory.__doc__ = f"The compiled :func:`{function.__name__}` (numba, eager signature, numba's on-disk cache)."
-    registry.append((factory, function))
-    return factory
-
-
 #: (factory, Python function) of each compiled loop of the friction model
 KERNELS: list = []
 compiled_evaluate_points = loop_factory(KERNELS, _compile, _evaluate_points, _SIGNATURE)
@@ -673,8 +615,6 @@ compiled_friction_step = loop_factory(KERNELS, _compile, _friction_step, _FRICTI
 def all_kernels(friction: bool = True, contact: bool = True) -> tuple:
     """The compiled loops of a step, the friction's and the load distribution's
     (:mod:`slewing_model.contact_kernel`): (factory, Python function) pairs."""
-    from . import contact_kernel
-
     return tuple(KERNELS if friction else ()) + tuple(contact_kernel.KERNELS if contact else ())
 
 

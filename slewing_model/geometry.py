@@ -25,46 +25,14 @@ from typing import Any, Mapping
 
 import numpy as np
 
-#: contact numbers in array order: column ``i`` of every (B, 4) array is contact ``i + 1``
-CONTACTS = (1, 2, 3, 4)
-#: the two diagonals as (outer-ring contact, inner-ring contact), 1-based
-DIAGONALS = ((1, 3), (4, 2))
-#: contacts owned by each ring, in the order of the ring's superelement DOFs
-RING_CONTACTS = {"outer": (1, 4), "inner": (2, 3)}
+from .conventions import (BEARING_TABLES, CONTACTS, DIAGONALS, RING_CONTACTS,  # noqa: F401  (the conventions
+                          BearingDefinitionError, check_known_keys, fail as _fail)  # belong to this interface)
+from .errors import ManufacturingErrors, errors_from_table
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
     array.setflags(write=False)
     return array
-
-
-class BearingDefinitionError(ValueError):
-    """A bearing definition value breaks a rule. The message names the key,
-    the value and the rule."""
-
-
-def _fail(key: str, value: Any, rule: str):
-    raise BearingDefinitionError(f"{key} = {value!r}: {rule}")
-
-
-#: the tables of a bearing definition file and the keys each one knows (names are case-sensitive)
-BEARING_TABLES = {
-    "bearing": ("name", "pitch_diameter_mm", "ball_diameter_mm", "groove_radius_mm", "contact_angle_deg",
-                "ball_count", "preload_um", "first_ball_angle_deg", "moving_ring"),
-    "material": ("youngs_modulus_gpa", "poisson_ratio"),
-    "rings": ("gap_mm", "outer_ring_outer_diameter_mm", "inner_ring_bore_diameter_mm", "outer_ring_height_mm",
-              "inner_ring_height_mm", "outer_ring_bolted_face", "inner_ring_bolted_face"),
-    "errors": ("outer_ring_csv", "inner_ring_csv", "ball_diameters_csv", "synthetic"),
-}
-
-
-def check_known_keys(table: Mapping[str, Any], name: str, known) -> None:
-    """Refuse a key of the table ``[name]`` that is not in ``known``, naming the table, the key, its
-    value and the known keys (a misspelt key would otherwise be ignored and its default used)."""
-    for key in table:
-        if key not in known:
-            _fail(f"{name}.{key}", table[key],
-                  f"unknown key in table [{name}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
 
 
 def _subtable(data: Mapping[str, Any], name: str) -> Mapping[str, Any]:
@@ -219,8 +187,6 @@ class Bearing:
     @classmethod
     def from_si_dict(cls, d: Mapping[str, Any]) -> "Bearing":
         """Inverse of :meth:`to_dict` (no unit conversion; validated again)."""
-        from .errors import ManufacturingErrors
-
         errors = ManufacturingErrors.from_dict(d["errors"]) if d.get("errors") else None
         b = cls(
             name=d["name"],
@@ -406,8 +372,6 @@ def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
 
     errors = None
     if "errors" in data:
-        from .errors import errors_from_table
-
         errors = errors_from_table(_subtable(data, "errors"), base_dir=base_dir, ball_count=n)
 
     bearing = Bearing(

@@ -46,6 +46,12 @@ RING_FIELDS = ("pitch_diameter", "ball_diameter", "groove_radius", "contact_angl
 #: master DOF labels of one ball, per ring (paper eq 14)
 DOF_LABELS = {"outer": ("R1", "z1", "R4", "z4"), "inner": ("R2", "z2", "R3", "z3")}
 
+#: the one default superelement mesh of every command (``slewing superelement``, ``solve``, ``plot``,
+#: a study's ``[simulation] mesh``), and what each mesh is worth (docs/superelement.md, Convergence)
+DEFAULT_MESH = "coarse"
+MESH_HELP = ("superelement cross-section mesh: coarse (quick: compliances within 1.2 %%, stiffness entries "
+             "within 15 %% of finer), fine (within 0.5 %% of finer, about 4x the build time), finer")
+
 
 class SuperelementMismatchError(ValueError):
     """A stored superelement does not belong to the bearing it is used with."""

@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 
+from ..ring_stiffness import DEFAULT_MESH, MESH_HELP
 from .section import MESH_PRESETS
 from .supports import BOUNDARY_CONDITIONS
 
@@ -21,8 +22,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of the ``superelement`` sub-command."""
     parser.add_argument("bearing", help="bearing definition (TOML, see examples/bearings)")
     parser.add_argument("-o", "--output", required=True, help="output file (.npz)")
-    from ..cli import DEFAULT_MESH, MESH_HELP
-
     parser.add_argument("--mesh", choices=list(MESH_PRESETS), default=DEFAULT_MESH, help=MESH_HELP)
     parser.add_argument("--bc", choices=BOUNDARY_CONDITIONS, default="free",
                         help="boundary condition of both rings (free: the paper's idling model)")
