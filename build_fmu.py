@@ -69,7 +69,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     from pythonfmu import FmuBuilder
 
     from slewing_model import load_bearing
-    from slewing_model.superelement import build_superelement
+    from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(bearing_file)
     superelement = build_superelement(bearing, mesh=mesh, bc=bc, progress=progress)
@@ -117,7 +117,7 @@ def resolve_numba(runtime: str, numba=None) -> bool:
     not installed."""
     if runtime not in RUNTIMES:
         raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
-    from slewing_model import friction_kernel
+    from slewing_model.friction import kernel as friction_kernel
 
     if numba is None:
         return friction_kernel.AVAILABLE
@@ -130,46 +130,50 @@ def resolve_numba(runtime: str, numba=None) -> bool:
 def ship_compiled_kernels(fmu) -> list[Path]:
     """Add numba's cache of the compiled loops (friction, contacts) to the FMU's copy of ``slewing_model``.
 
-    An instance compiles the loops when it starts (:func:`slewing_model.friction_kernel.compile_all`),
+    An instance compiles the loops when it starts (:func:`slewing_model.friction.kernel.compile_all`),
     about a minute, unless numba's cache beside the source holds them for this CPU: numba keys
     that cache by the source's content (not its path or time), numba's version and the CPU. The
-    loops are compiled (or loaded) here twice, in ``slewing_model/__pycache__``: for this machine's
+    loops are compiled (or loaded) here twice, in the ``__pycache__`` beside each kernel: for this machine's
     CPU, and in a child process with ``NUMBA_CPU_NAME=generic`` for any x86-64 CPU; the FMU takes
     the generic ones on another CPU (``fmu_src/bearing_variables.kernels_of``, which reads this
     CPU's name and features from ``resources/numba_target.txt``, written here). The entry points'
-    files are added to ``resources/slewing_model/__pycache__`` (pythonfmu leaves ``__pycache__``
+    files are added to the same folders below ``resources/slewing_model`` (pythonfmu leaves ``__pycache__``
     folders out), with this machine's paths in their error texts overwritten. Nothing when numba
     is not installed (the FMU then runs its numpy code). Returns the files added."""
-    from slewing_model import friction_kernel
+    from slewing_model.friction import kernel as friction_kernel
 
     if not friction_kernel.AVAILABLE:
         return []
     import llvmlite.binding as llvm
 
     friction_kernel.compile_all()
-    generic = subprocess.run([sys.executable, "-c", "from slewing_model import friction_kernel; "
-                              "friction_kernel.compile_all()"], env={**os.environ, "NUMBA_CPU_NAME": "generic"},
+    generic = subprocess.run([sys.executable, "-c", "from slewing_model.friction import kernel; "
+                              "kernel.compile_all()"], env={**os.environ, "NUMBA_CPU_NAME": "generic"},
                              cwd=ROOT, capture_output=True, text=True)
     if generic.returncode != 0:
         raise RuntimeError(f"compiling the loops for a generic x86-64 CPU failed:\n{generic.stderr[-3000:]}")
-    cache = Path(friction_kernel.__file__).parent / "__pycache__"
     tag = f"py{sys.version_info.major}{sys.version_info.minor}"      # numba adds the ABI flags (py311t)
+    package = Path(friction_kernel.__file__).parents[1]                # slewing_model/
+    caches = sorted({Path(function.__code__.co_filename).parent / "__pycache__"
+                     for _, function in friction_kernel.all_kernels()})
     files = [f for _, function in friction_kernel.all_kernels()
-             for f in cache.glob(f"{function.__module__.rsplit('.', 1)[-1]}.{function.__name__}-"
-                                 f"{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
+             for f in (Path(function.__code__.co_filename).parent / "__pycache__").glob(
+                 f"{function.__module__.rsplit('.', 1)[-1]}.{function.__name__}-"
+                 f"{function.__code__.co_firstlineno}.{tag}*.nb[ic]")]
     if not files:
-        warnings.warn(f"numba's cache of the compiled loops is not in {cache} (NUMBA_CACHE_DIR set, or the folder not "
-                      "writable): the FMU will compile them when instantiated (about a minute)")
+        warnings.warn(f"numba's cache of the compiled loops is not in {', '.join(map(str, caches))} (NUMBA_CACHE_DIR "
+                      "set, or the folder not writable): the FMU will compile them when instantiated (about a minute)")
     paths = building_machine_paths()
     with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive, \
             tempfile.TemporaryDirectory(prefix="slewing_cache_") as tmp:
         for f in files:
             # the compiled code's error texts name the sources it was compiled from: overwritten with
             # '/' (numba checks the source's hash, numba's version and the CPU, not these texts)
-            copy = Path(tmp) / f.name
+            inside = f.relative_to(package).as_posix()       # friction/__pycache__/kernel....nbi
+            copy = Path(tmp) / inside.replace("/", "_")
             shutil.copy2(f, copy)
             scrub_paths(copy, paths)
-            archive.write(copy, f"resources/slewing_model/__pycache__/{f.name}")
+            archive.write(copy, f"resources/slewing_model/{inside}")
         archive.writestr(f"resources/{NUMBA_TARGET_FILE}",
                          f"{llvm.get_host_cpu_name()} {llvm.get_host_cpu_features().flatten()}\n")
     return files

@@ -15,8 +15,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import median_time, print_table  # noqa: E402
 
 from slewing_model import BimeSolver, Loads, load_bearing  # noqa: E402
-from slewing_model.bime import solve_dense_newton  # noqa: E402
-from slewing_model.superelement import build_superelement  # noqa: E402
+from slewing_model.distribution.bime import solve_dense_newton  # noqa: E402
+from slewing_model.rings.superelement import build_superelement  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -102,7 +102,7 @@ def main() -> None:
     from fmpy import read_model_description
 
     from slewing_model import load_bearing
-    from slewing_model.superelement import build_superelement
+    from slewing_model.rings.superelement import build_superelement
 
     case = CASES["pitch"](args.steps)
     build_superelement(load_bearing(case.bearing), mesh="fine", bc="free")     # cached: not in the build times

@@ -3,7 +3,7 @@
 A fresh operator ``W^-1 = (A^-1 + M)_aa^-1`` is what sets the tail of a co-simulation step
 (`docs/speed.md`). This takes the operators ``W`` the simulator forms while stepping the
 benchmark cases (`benchmarks/cases.py`: the pitch and yaw bearings, fine superelement) and
-inverts each by :func:`slewing_model.reduced_operator.spd_inverse` (Schur complements,
+inverts each by :func:`slewing_model.rings.reduced_operator.spd_inverse` (Schur complements,
 matrix products) and by ``np.linalg.inv`` (LU, then triangular solves), alternately, on one
 BLAS thread as in a step; it prints the median and tail of each, their ratio, and the
 residual ``|X W - I|`` of both.
@@ -23,11 +23,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cases import CASES  # noqa: E402
 from timing import print_table  # noqa: E402
 
-import slewing_model.reduced_operator as reduced_operator  # noqa: E402
+import slewing_model.rings.reduced_operator as reduced_operator  # noqa: E402
 from slewing_model import Loads, load_bearing  # noqa: E402
-from slewing_model.blas import blas_threads  # noqa: E402
-from slewing_model.simulator import BearingSimulator, SimulatorSettings  # noqa: E402
-from slewing_model.superelement import build_superelement  # noqa: E402
+from slewing_model.numerics.blas import blas_threads  # noqa: E402
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings  # noqa: E402
+from slewing_model.rings.superelement import build_superelement  # noqa: E402
 
 
 def formed_operators(case_name: str, steps: int) -> list[np.ndarray]:

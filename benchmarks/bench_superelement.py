@@ -33,8 +33,8 @@ def child(mesh: str) -> None:
     """One build in this process; prints JSON (time, peak memory, figures)."""
     import resource
 
-    from slewing_model.geometry import load_bearing
-    from slewing_model.superelement import build_superelement
+    from slewing_model.bearing.geometry import load_bearing
+    from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(TABLE1)
     t0 = time.perf_counter()
@@ -56,8 +56,8 @@ def run_child(mesh: str) -> dict:
 def cache_hit_seconds() -> float:
     import tempfile
 
-    from slewing_model.geometry import load_bearing
-    from slewing_model.superelement import build_superelement
+    from slewing_model.bearing.geometry import load_bearing
+    from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(TABLE1)
     with tempfile.TemporaryDirectory() as d:
@@ -128,9 +128,9 @@ def _row(label, entries, ref=None):
 
 
 def study() -> None:
-    from slewing_model.geometry import load_bearing
-    from slewing_model.superelement.build import DEFAULT_OPTIONS, auto_harmonics, condense_ring, ring_harmonics
-    from slewing_model.superelement.section import MESH_PRESETS
+    from slewing_model.bearing.geometry import load_bearing
+    from slewing_model.rings.superelement.build import DEFAULT_OPTIONS, auto_harmonics, condense_ring, ring_harmonics
+    from slewing_model.rings.superelement.section import MESH_PRESETS
 
     bearing = load_bearing(TABLE1)
     ring, B = "outer", bearing.ball_count

@@ -54,7 +54,7 @@ def table(title, header, rows):
 def flexible_superelement(bearing):
     """The flexible model's superelement, or the reason it is not available."""
     try:
-        from slewing_model.superelement import build_superelement
+        from slewing_model.rings.superelement import build_superelement
 
         return build_superelement(bearing, mesh="coarse", bc="free"), None
     except Exception as exc:  # the flexible model is optional here

@@ -20,7 +20,7 @@ import numpy as np
 
 from slewing_model import Loads, load_bearing, solve
 from slewing_model.plots import plot_axial_stiffness, plot_distribution
-from slewing_model.superelement import build_superelement
+from slewing_model.rings.superelement import build_superelement
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,6 +1,6 @@
 """FMI 2.0 co-simulation slave of a four-point contact slewing bearing (pythonfmu).
 
-A thin wrapper: it maps FMI variables onto :class:`slewing_model.simulator.BearingSimulator`
+A thin wrapper: it maps FMI variables onto :class:`slewing_model.simulation.simulator.BearingSimulator`
 and holds no physics. ``build_fmu.py`` packages it with the run-time part of
 ``slewing_model``, the bearing definition (``bearing.json``) and the ring
 superelement (``superelement.npz``) in the FMU's resources.
@@ -90,7 +90,7 @@ from pythonfmu.default_experiment import DefaultExperiment
 
 
 from slewing_model import Bearing
-from slewing_model.simulator import BearingSimulator, decode_state, encode_state
+from slewing_model.simulation.simulator import BearingSimulator, decode_state, encode_state
 
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
     BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,

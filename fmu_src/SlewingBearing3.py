@@ -11,7 +11,7 @@ with the per-ball results as FMI 3.0 arrays instead of 6 B scalars:
 Arrays are serialised row-major (the last index varies fastest), as FMI 3.0
 says: ``contact_load[b, c]`` is element ``4 b + c``.
 
-A thin wrapper over :class:`slewing_model.simulator.BearingSimulator`, holding
+A thin wrapper over :class:`slewing_model.simulation.simulator.BearingSimulator`, holding
 no physics. What pythonfmu3 0.3.4 does not do, this slave does itself:
 
 * ``ModelStructure``: pythonfmu3 writes ``Output`` and ``InitialUnknown``
@@ -25,7 +25,7 @@ no physics. What pythonfmu3 0.3.4 does not do, this slave does itself:
   The arrays here are registered with their own getter and setter (reshape
   without the keyword), and the FMU state is captured by this slave.
 * FMU state: the registered variables, the arrays and the solver's warm start
-  (numpy arrays, serialised exactly: :func:`slewing_model.simulator.encode_state`).
+  (numpy arrays, serialised exactly: :func:`slewing_model.simulation.simulator.encode_state`).
 """
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ from bearing_variables import (BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAME
                                UNITS, build_simulator, choice_description, integer_default, kernels_of,
                                scalar_outputs, step_or_refuse)
 from slewing_model import Bearing
-from slewing_model.simulator import BearingSimulator, decode_state, encode_state
+from slewing_model.simulation.simulator import BearingSimulator, decode_state, encode_state
 
 
 class SlewingBearing3(Fmi3Slave):

@@ -197,8 +197,8 @@ def numba_target() -> str:
 def build_simulator(slave, error) -> bool:
     """Create ``slave.simulator`` from the slave's parameters (attributes by name), its ``bearing``
     and ``superelement_path``; log why not (status ``error``) and return False."""
-    from slewing_model.ring_stiffness import Superelement
-    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.rings.stiffness import Superelement
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 
     slave.simulator = None
     try:
@@ -210,7 +210,7 @@ def build_simulator(slave, error) -> bool:
         if settings.ring_model == "flexible":
             superelement = Superelement.load(slave.superelement_path, slave.bearing)
         slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
-        from slewing_model.friction_kernel import use_compiled
+        from slewing_model.numerics.compiled import use_compiled
 
         slave.log(f"{slave.instance_name}: loops " + (f"compiled by numba for {numba_target()}" if use_compiled(kernels)
                                                       else "run by numpy"))
@@ -224,7 +224,7 @@ def build_simulator(slave, error) -> bool:
 
 def step_or_refuse(slave, current_time, discard, error, warning=None):
     """Step ``slave.simulator`` with the slave's inputs and tunable parameters (attributes by
-    name); the :class:`~slewing_model.simulator.StepResult`, or None after logging why not.
+    name); the :class:`~slewing_model.simulation.simulator.StepResult`, or None after logging why not.
 
     A bad input or a load the bearing cannot carry refuses the step: logged with the status
     ``discard``, the simulator as before the step (it restores itself), so the master may

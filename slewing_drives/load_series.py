@@ -11,7 +11,7 @@ pitching moment of a blade, aerodynamic yaw moment), N m: positive when it
 opposes a positive rotation, the sign :class:`slewing_drives.drive.ElectricDrive`
 takes as ``load_torque``. ``psi`` (rad) and ``omega`` (rad/s), optional, are
 the recorded motion of the moving ring (the pitch or yaw angle and its rate of
-an aero-elastic run, :func:`slewing_model.aeroelastic.bearing_loads`). Values
+an aero-elastic run, :func:`slewing_model.loads.aeroelastic.bearing_loads`). Values
 are interpolated linearly in time. Lines starting with ``#`` are comments; a
 comment ``# load_frame = fixed`` (or ``rotating``) states the frame of the
 loads and is read back into :attr:`LoadSeries.load_frame`.
@@ -48,7 +48,7 @@ class LoadSeries:
         Recorded speed of the moving ring.
     load_frame : {"fixed", "rotating"} or None
         Frame of ``Fx..My``: the fixed ring's, or the moving ring's (turned by
-        ``psi``; the FMU's and :class:`slewing_model.simulator.SimulatorSettings`'
+        ``psi``; the FMU's and :class:`slewing_model.simulation.simulator.SimulatorSettings`'
         ``load_frame``). None: not stated.
     """
 

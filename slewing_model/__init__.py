@@ -8,23 +8,29 @@ superelement (Flexible-BIME), and an analytical friction torque fed by the load
 distribution.
 
 The run-time part of this package imports numpy only; building a superelement
-(:mod:`slewing_model.superelement`) needs scipy and scikit-fem.
+(:mod:`slewing_model.rings.superelement`) needs scipy and scikit-fem.
 """
-from .geometry import Bearing, BearingDefinitionError, RingSection, load_bearing, bearing_from_dict
-from .errors import ManufacturingErrors, RingErrorMap, synthetic_errors
-from .bime import BimeSolver, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError, solve
-from .friction import FrictionTorque, catalogue_torque, friction_torque
+from .bearing.geometry import Bearing, BearingDefinitionError, RingSection, load_bearing, bearing_from_dict
+from .bearing.manufacturing import ManufacturingErrors, RingErrorMap, synthetic_errors
+from .distribution.bime import BimeSolver, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError, solve
+from .friction.torque import FrictionTorque, catalogue_torque, friction_torque
 
 __version__ = "0.1.0"
 
 #: the run-time part of the package (numpy and the standard library): the modules an FMU carries
-#: (paths below slewing_model/, without .py)
-RUNTIME_MODULES = ("__init__", "geometry", "errors", "contact", "contact_kernel", "assembly", "distribution",
-                   "ring_stiffness", "ring_compliance", "reduced_operator", "bime", "blas", "ellipse_quadrature",
-                   "contact_friction", "ball_kinematics", "friction_kernel", "catalogue", "friction_studies",
-                   "friction", "simulator",
-                   # the life subpackage's run-time modules (build_fmu copies them into the FMU's
-                   # slewing_model/life; rainflow is imported only by the post-processing)
+#: (paths below slewing_model/, without .py; build_fmu.py keeps each subpackage's folder). Not in it:
+#: rings/superelement (scikit-fem, build time), study, loads, cli, plots and life/command (host side)
+RUNTIME_MODULES = ("__init__",
+                   "bearing/__init__", "bearing/conventions", "bearing/geometry", "bearing/manufacturing",
+                   "bearing/contact",
+                   "rings/__init__", "rings/stiffness", "rings/compliance", "rings/reduced_operator",
+                   "distribution/__init__", "distribution/results", "distribution/assembly", "distribution/kernel",
+                   "distribution/bime",
+                   "friction/__init__", "friction/ellipse_quadrature", "friction/contact", "friction/ball_kinematics",
+                   "friction/kernel", "friction/catalogue", "friction/torque", "friction/studies",
+                   "numerics/__init__", "numerics/compiled", "numerics/blas",
+                   "simulation/__init__", "simulation/simulator",
+                   # rainflow is imported only by the life post-processing
                    "life/__init__", "life/rating", "life/oscillation", "life/raceway_map", "life/wear", "life/dg03",
                    "life/duty")
 

@@ -17,10 +17,10 @@ import sys
 import numpy as np
 
 from . import __version__
-from .bime import LOAD_FIELDS, Loads, NoEquilibriumError, solve
-from .friction import catalogue_torque, friction_torque
-from .geometry import BearingDefinitionError, load_bearing
-from .ring_stiffness import DEFAULT_MESH, MESH_HELP
+from .distribution.bime import LOAD_FIELDS, Loads, NoEquilibriumError, solve
+from .friction.torque import catalogue_torque, friction_torque
+from .bearing.geometry import BearingDefinitionError, load_bearing
+from .rings.stiffness import DEFAULT_MESH, MESH_HELP
 
 
 def _finite_float(text: str) -> float:
@@ -89,7 +89,7 @@ def _superelement(args, bearing):
     """The superelement of ``--superelement`` (checked against the bearing), or None."""
     if args.superelement is None:
         return None
-    from .ring_stiffness import Superelement
+    from .rings.stiffness import Superelement
 
     return Superelement.load(args.superelement, bearing)
 
@@ -171,7 +171,7 @@ def _add_superelement(sub, wanted: bool) -> None:
         sub.add_parser("superelement", help=help_text, add_help=False)
         return
     try:
-        from .superelement import command
+        from .rings.superelement import command
     except ImportError as exc:  # build-time dependencies missing
         reason = f"slewing superelement needs scipy and scikit-fem: {exc}"
         p = sub.add_parser("superelement", help=help_text)
@@ -202,8 +202,8 @@ def _add_loads(sub) -> None:
 
 
 def _run_loads(args) -> int:
-    from .aeroelastic import bearing_channels, bearing_loads
-    from .openfast import read_output
+    from .loads.aeroelastic import bearing_channels, bearing_loads
+    from .loads.openfast import read_output
 
     output = read_output(args.file)
     series = bearing_loads(output, args.bearing, args.blade, args.mounting, args.start, args.end,

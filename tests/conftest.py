@@ -56,9 +56,9 @@ def table3_fmu3(tmp_path_factory):
 def table3_numba_fmu(tmp_path_factory):
     """table3_fmu's bearing as build_fmu.py builds it by default where numba is installed: standalone,
     with numba and its compiled loops (for this CPU and a generic x86-64)."""
-    from slewing_model import friction_kernel
+    from slewing_model.numerics import compiled
 
-    if not friction_kernel.AVAILABLE:
+    if not compiled.AVAILABLE:
         pytest.skip("numba is not installed here")
     return _build_table3(tmp_path_factory, "SlewingBearing_table3_numba.fmu")
 
@@ -79,8 +79,8 @@ def simulators_per_kernel(name: str, steps: int, setting: str):
     sys.path.insert(0, str(ROOT / "benchmarks"))
     from cases import CASES
     from slewing_model import load_bearing
-    from slewing_model.simulator import BearingSimulator, SimulatorSettings
-    from slewing_model.superelement import build_superelement
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.rings.superelement import build_superelement
 
     case = CASES[name](steps)
     bearing = load_bearing(case.bearing)

@@ -1,6 +1,6 @@
 """Writers of OpenFAST / FAST output files for the tests, written from the NWTC
 Library's ``WrBinFAST`` (binary) and FAST's text layout, independently of the
-reader in ``slewing_model.openfast``.
+reader in ``slewing_model.loads.openfast``.
 
 ``write_binary`` packs as ``WrBinFAST`` does: per channel a float32 slope
 ``65535 / (max - min)`` (``65535 / sqrt(eps32)`` for a constant channel) and

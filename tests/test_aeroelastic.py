@@ -9,8 +9,8 @@ import pytest
 from openfast_files import write_binary, write_text
 from slewing_drives.load_series import LoadSeries
 from slewing_model import Loads, load_bearing, solve
-from slewing_model.aeroelastic import UnitError, bearing_channels, bearing_loads, to_si
-from slewing_model.openfast import MissingChannelError, OpenFastFormatError, OutputFile, read_output
+from slewing_model.loads.aeroelastic import UnitError, bearing_channels, bearing_loads, to_si
+from slewing_model.loads.openfast import MissingChannelError, OpenFastFormatError, OutputFile, read_output
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "openfast"

@@ -1,9 +1,9 @@
-"""slewing_model.blas: the BLAS threads of a step are set for the step and restored after it."""
+"""slewing_model.numerics.blas: the BLAS threads of a step are set for the step and restored after it."""
 import numpy as np
 import pytest
 
-from slewing_model.blas import _openblas_threads, blas_thread_control, blas_threads
-from slewing_model.simulator import SimulatorSettings
+from slewing_model.numerics.blas import _openblas_threads, blas_thread_control, blas_threads
+from slewing_model.simulation.simulator import SimulatorSettings
 
 
 @pytest.mark.skipif(not blas_thread_control(), reason="numpy's BLAS is not an OpenBLAS found in /proc/self/maps")

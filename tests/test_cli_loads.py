@@ -10,7 +10,7 @@ import pytest
 from openfast_files import write_binary
 from slewing_drives.load_series import LoadSeries
 from slewing_model import Loads, load_bearing, solve
-from slewing_model.aeroelastic import bearing_loads
+from slewing_model.loads.aeroelastic import bearing_loads
 from slewing_model.cli import _attach_negative_numbers
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -6,7 +6,7 @@ import pytest
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
-from slewing_model.contact import (contact_load, diagonal_stiffness, elliptic_integrals, hertz_ellipse,
+from slewing_model.bearing.contact import (contact_load, diagonal_stiffness, elliptic_integrals, hertz_ellipse,
                                    houpert_stiffness)
 
 

@@ -1,4 +1,4 @@
-"""The load distribution's compiled loops (:mod:`slewing_model.contact_kernel`) against its numpy code.
+"""The load distribution's compiled loops (:mod:`slewing_model.distribution.kernel`) against its numpy code.
 
 Each compiled loop (a new rotation's grooves and Jacobian, a trial point and its springs, the
 modified Newton step, the ring compliance's product, the reduced operator formed, coupled, turned
@@ -14,8 +14,8 @@ import pytest
 
 from slewing_model import BimeSolver, Loads, load_bearing
 from slewing_model.distribution import LoadCapacityError
-from slewing_model.friction_kernel import AVAILABLE
-from slewing_model.superelement import build_superelement
+from slewing_model.friction.kernel import AVAILABLE
+from slewing_model.rings.superelement import build_superelement
 
 from conftest import BEARINGS, simulators_per_kernel, symmetric_block_circulant
 
@@ -32,7 +32,7 @@ def _table3_with_measured_radii(table3):
     """table3 whose balls each see other grooves, their radii measured too: every ball's and
     diagonal's stiffness and natural length differ."""
     from slewing_model import synthetic_errors
-    from slewing_model.errors import ManufacturingErrors, RingErrorMap
+    from slewing_model.bearing.manufacturing import ManufacturingErrors, RingErrorMap
 
     synthetic = synthetic_errors(table3.ball_count, seed=7)
     outer = synthetic.outer
@@ -136,8 +136,8 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
     """The modified Newton step with a kept operator, formed or bordered by contacts that closed (whose
     inverse is symmetric to round-off only), at an iterate away from the operator's own; and the
     operator's matrix and coupling formed by the compiled loops."""
-    from slewing_model.contact_kernel import newton_step as compiled_step
-    from slewing_model.reduced_operator import assemble_operator, newton_step, update_operator
+    from slewing_model.distribution.kernel import newton_step as compiled_step
+    from slewing_model.rings.reduced_operator import assemble_operator, newton_step, update_operator
 
     bearing, superelement = pitch
     loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
@@ -156,14 +156,14 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
     assert not np.array_equal(bordered.inverse, bordered.inverse.T)          # symmetric to round-off only
     off = solver._evaluate(1.01 * state[:5], 0.98 * state[5:], f_scaled)
     # a new operator's W and springs' compliance, formed by the compiled loop: the same bit for bit
-    from slewing_model.contact_kernel import operator_matrix as compiled_matrix
-    from slewing_model.reduced_operator import operator_matrix
+    from slewing_model.distribution.kernel import operator_matrix as compiled_matrix
+    from slewing_model.rings.reduced_operator import operator_matrix
 
     for want, got in zip(operator_matrix(*args, masks[0]), compiled_matrix(*args, masks[0])):
         assert np.array_equal(want, got)
     # ... and its coupling to the ring's motions, W^-1 J_a and the Schur complement's inverse
-    from slewing_model.contact_kernel import operator_coupling as compiled_coupling
-    from slewing_model.reduced_operator import operator_coupling
+    from slewing_model.distribution.kernel import operator_coupling as compiled_coupling
+    from slewing_model.rings.reduced_operator import operator_coupling
 
     ja = solver.jacobian.reshape(-1, 5)[bordered.rows]
     for want, got in zip(operator_coupling(bordered.inverse, ja, mu), compiled_coupling(bordered.inverse, ja, mu)):
@@ -181,8 +181,8 @@ def test_compiled_column_turn_equals_the_numpy_turn(pitch, table3):
     finds none where numpy finds none (grooves with errors turning with the ring), unless both are
     given a tolerance, within which they agree on the nearly turned operator."""
     from slewing_model import synthetic_errors
-    from slewing_model.contact_kernel import column_turn as compiled_turn
-    from slewing_model.reduced_operator import column_turn
+    from slewing_model.distribution.kernel import column_turn as compiled_turn
+    from slewing_model.rings.reduced_operator import column_turn
 
     bearing, superelement = pitch
     solver = BimeSolver(bearing, superelement, psi=0.2)
@@ -221,7 +221,7 @@ def test_compiled_error_tables_equal_numpy_interp(table3):
     groove radii and without, at angles past a turn and negative, assembled anew and from the last
     rotation (as a co-simulation step does)."""
     from slewing_model import synthetic_errors
-    from slewing_model.assembly import assemble
+    from slewing_model.distribution.assembly import assemble
 
     for bearing in (table3.with_errors(synthetic_errors(table3.ball_count, seed=3)),
                     _table3_with_measured_radii(table3)):
@@ -241,8 +241,8 @@ def test_compiled_ring_product_equals_the_dense_product(balls):
     """The ring compliance's product in the compiled iterations (``contact_kernel._ring_times``), a
     real DFT by tables (even and odd numbers of balls: the harmonic B/2 is real or absent), against
     the dense product, also for a vector with the zero rows of those off the reduced operator."""
-    from slewing_model.contact_kernel import compiled_ring_times
-    from slewing_model.ring_compliance import BlockCirculant, product_operands
+    from slewing_model.distribution.kernel import compiled_ring_times
+    from slewing_model.rings.compliance import BlockCirculant, product_operands
 
     dense = symmetric_block_circulant(balls, seed=balls)
     operands = product_operands(BlockCirculant(dense, 4))
@@ -259,9 +259,9 @@ def test_iterations_in_one_loop_equal_them_one_by_one(name, monkeypatch):
     same iterations run one by one by ``BimeSolver.solve`` (the loop switched off): the same
     iterations and states to round-off over the steps of a case, and, where the solver runs out of
     iterations inside the loop, the same refusal."""
-    from slewing_model.bime import BimeSolver
+    from slewing_model.distribution.bime import BimeSolver
     from slewing_model.distribution import NoEquilibriumError
-    from slewing_model.simulator import BearingSimulator
+    from slewing_model.simulation.simulator import BearingSimulator
 
     case, sims = simulators_per_kernel(name, 20, "contact_kernel")
     looped = sims["compiled"]
@@ -293,7 +293,7 @@ def test_steps_with_compiled_contacts_equal_the_numpy_steps(name, monkeypatch):
     """Whole steps with the compiled loops (most iterations in one loop with the kept operator,
     ``contact_kernel._kept_iterations``) against the numpy path: the same iterations, loads and
     torques to round-off."""
-    from slewing_model.bime import BimeSolver
+    from slewing_model.distribution.bime import BimeSolver
 
     kept = []
     run_kept = BimeSolver._kept_iterations

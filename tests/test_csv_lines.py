@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from slewing_model.errors import read_ball_csv, read_ring_csv
+from slewing_model.bearing.manufacturing import read_ball_csv, read_ring_csv
 from slewing_model.study.series import read_csv
 from slewing_drives.load_series import LoadSeries
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from slewing_model import BearingDefinitionError, bearing_from_dict, load_bearing
-from slewing_model.geometry import Bearing
+from slewing_model.bearing.geometry import Bearing
 
 GOOD = {
     "bearing": {"name": "t", "pitch_diameter_mm": 541.0, "ball_diameter_mm": 25.0, "groove_radius_mm": 13.25,

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from slewing_model import BearingDefinitionError, Loads, bearing_from_dict, load_bearing, solve, synthetic_errors
-from slewing_model.assembly import assemble, cage_ratio
-from slewing_model.errors import (ManufacturingErrors, RingErrorMap, read_ball_csv, read_ring_csv,
+from slewing_model.distribution.assembly import assemble, cage_ratio
+from slewing_model.bearing.manufacturing import (ManufacturingErrors, RingErrorMap, read_ball_csv, read_ring_csv,
                                   write_ring_csv)
 
 

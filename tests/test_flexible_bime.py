@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from slewing_model import BimeSolver, Loads, load_bearing, solve
-from slewing_model.superelement import build_superelement
+from slewing_model.rings.superelement import build_superelement
 
 from conftest import BEARINGS
 from statics import load_on_moving_ring
@@ -121,7 +121,7 @@ def test_warm_started_solver_follows_rotation(table3_errors, table3_free):
 def test_structured_solver_equals_dense_newton_on_fe_rings(table3_errors, bc):
     # the dense Newton on all 5 + 8B unknowns of eq 20 (free rings: deformation kept orthogonal to
     # the rigid-body modes, the ring's rigid motion being q) is an independent check of the reduction
-    from slewing_model.bime import solve_dense_newton
+    from slewing_model.distribution.bime import solve_dense_newton
 
     se = build_superelement(table3_errors, mesh="coarse", bc=bc)
     bearing = table3_errors.with_preload(10e-6)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from slewing_model import BimeSolver, Loads, solve
-from slewing_model.bime import solve_dense_newton
+from slewing_model.distribution.bime import solve_dense_newton
 from conftest import symmetric_block_circulant
 from synthetic_rings import synthetic_superelement
 
@@ -110,7 +110,7 @@ def test_simulator_extrapolated_start_reaches_the_cold_solution(bearing):
     # the simulator starts each solve from the last two states extrapolated: every step must
     # still be the equilibrium of its own inputs, whatever the history
     from slewing_model import synthetic_errors
-    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 
     with_errors = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=4))
     se = synthetic_superelement(bearing.ball_count)
@@ -129,7 +129,7 @@ def test_refused_step_leaves_the_simulator_as_it_was(bearing):
     # operator by then) must not change what the following steps answer: bit for bit the
     # steps of a simulator that never saw it
     from slewing_model import LoadCapacityError
-    from slewing_model.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 
     se = synthetic_superelement(bearing.ball_count)
     settings = SimulatorSettings(ring_model="flexible", friction_coefficient=0.0)
@@ -151,7 +151,7 @@ def test_block_circulant_product_by_harmonics_equals_the_dense_product(balls):
     """The ring compliance's product by FFT (from FFT_FROM_BALLS balls on) against the
     dense matrix-vector product, on a random symmetric block-circulant matrix: block
     (b, c) = C_(c-b mod B), C_(-k) = C_k^T."""
-    from slewing_model.ring_compliance import FFT_FROM_BALLS, BlockCirculant
+    from slewing_model.rings.compliance import FFT_FROM_BALLS, BlockCirculant
 
     dense = symmetric_block_circulant(balls, seed=balls)
     assert np.array_equal(dense, dense.T)
@@ -169,9 +169,9 @@ def test_inverse_by_halves_is_as_exact_as_lapack():
     free rings' rigid motions) plus small contact compliances on the diagonal. Without the
     symmetrisation at each level this one gives a residual of order 1e3, not 1e-10."""
     from slewing_model import load_bearing
-    from slewing_model.reduced_operator import LEAF, spd_inverse
-    from slewing_model.ring_compliance import contact_compliance, ring_compliances
-    from slewing_model.superelement import build_superelement
+    from slewing_model.rings.reduced_operator import LEAF, spd_inverse
+    from slewing_model.rings.compliance import contact_compliance, ring_compliances
+    from slewing_model.rings.superelement import build_superelement
 
     from conftest import BEARINGS
 
@@ -194,10 +194,10 @@ def test_inverse_spread_over_two_steps_equals_the_inverse_at_once():
 
     from conftest import BEARINGS
     from slewing_model import load_bearing
-    from slewing_model.reduced_operator import PendingOperator, advance_operator, spd_inverse
-    from slewing_model.ring_compliance import contact_compliance, ring_compliances
-    from slewing_model.simulator import decode_state, encode_state
-    from slewing_model.superelement import build_superelement
+    from slewing_model.rings.reduced_operator import PendingOperator, advance_operator, spd_inverse
+    from slewing_model.rings.compliance import contact_compliance, ring_compliances
+    from slewing_model.simulation.simulator import decode_state, encode_state
+    from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(BEARINGS / "pitch_bearing.toml")
     rings = np.asarray(contact_compliance(ring_compliances(build_superelement(bearing, mesh="coarse", bc="free"))))
@@ -236,14 +236,14 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
     give the inverse, coupling and Schur complement that forming and inverting the operator on
     the same contacts gives, at the same iterate, with the rows in another order; the bordering's
     blocks by numpy or by the compiled loop (``contact_kernel.bordered_inverse``)."""
-    from slewing_model.friction_kernel import AVAILABLE
-    from slewing_model.reduced_operator import assemble_operator, newton_step, update_operator
+    from slewing_model.friction.kernel import AVAILABLE
+    from slewing_model.rings.reduced_operator import assemble_operator, newton_step, update_operator
 
     if kernel == "compiled" and not AVAILABLE:
         pytest.skip("numba is not installed: only the numpy path exists here")
     arithmetic = None
     if kernel == "compiled":
-        from slewing_model.contact_kernel import COMPILED_ARITHMETIC as arithmetic
+        from slewing_model.distribution.kernel import COMPILED_ARITHMETIC as arithmetic
 
     loads = LOADS[1]
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
@@ -326,8 +326,8 @@ def test_operator_after_a_turn_equals_one_formed_anew(bearing, with_errors):
     (manufacturing errors move the groove centres with the ring) formed anew; either way as
     forming it from the new Jacobian. With errors and a tolerance, turned all the same: then an
     operator for the turned old Jacobian, which is that close to the new one."""
-    from slewing_model.errors import synthetic_errors
-    from slewing_model.reduced_operator import APPROXIMATE_TURN, reduced_operator, turned_operator
+    from slewing_model.bearing.manufacturing import synthetic_errors
+    from slewing_model.rings.reduced_operator import APPROXIMATE_TURN, reduced_operator, turned_operator
 
     if with_errors:
         bearing = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=2))
@@ -357,8 +357,8 @@ def test_nearly_turned_operator_bordered_stays_one_operator(bearing):
     """A kept operator nearly turned (grooves with errors, :data:`APPROXIMATE_TURN`) stands for the
     turned old Jacobian; bordered by a contact that closes, its rows keep that Jacobian, so that
     its coupling is still ``W^-1 J`` of the Jacobian it holds."""
-    from slewing_model.errors import synthetic_errors
-    from slewing_model.reduced_operator import APPROXIMATE_TURN, assemble_operator, turned_operator, update_operator
+    from slewing_model.bearing.manufacturing import synthetic_errors
+    from slewing_model.rings.reduced_operator import APPROXIMATE_TURN, assemble_operator, turned_operator, update_operator
 
     bearing = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=2))
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
@@ -382,7 +382,7 @@ def test_nearly_turned_operator_bordered_stays_one_operator(bearing):
 def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
     """On one or two loaded diagonals the Jacobian has rank below 5 and no column turn can be
     fitted: the coupling is then formed anew, without error (found by a review: a singular solve)."""
-    from slewing_model.reduced_operator import assemble_operator, reduced_operator, turned_operator
+    from slewing_model.rings.reduced_operator import assemble_operator, reduced_operator, turned_operator
 
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
     loads = LOADS[1]
@@ -404,7 +404,7 @@ def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
 
 @pytest.mark.parametrize("where", ["solver", "settings"])
 def test_unknown_contact_kernel_is_refused(bearing, where):
-    from slewing_model.simulator import SimulatorSettings
+    from slewing_model.simulation.simulator import SimulatorSettings
 
     with pytest.raises(ValueError, match="kernel = 'fortran': must be 'auto', 'numpy' or 'compiled'"):
         BimeSolver(bearing, kernel="fortran") if where == "solver" else SimulatorSettings(contact_kernel="fortran")

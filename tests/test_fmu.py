@@ -14,7 +14,7 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
 from slewing_model import Loads, load_bearing
-from slewing_model.simulator import BearingSimulator, SimulatorSettings
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 
 ROOT = Path(__file__).resolve().parents[1]
 BEARING = ROOT / "examples" / "bearings" / "table3_errors.toml"
@@ -60,7 +60,7 @@ LOADS = {"Fx": 8e3, "Fy": -3e3, "Fz": 3e4, "Mx": 1.5e3, "My": -2.5e3, "psi": 0.4
 
 def _library_steps(loads, psi, omega, steps, **settings):
     """The library used as the FMU uses it: ``steps`` warm-started steps with these inputs."""
-    from slewing_model.superelement import build_superelement
+    from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(BEARING)
     se = build_superelement(bearing, mesh="coarse", bc="free")

@@ -305,8 +305,8 @@ def test_the_host_fmu_holds_no_path_of_the_building_machine_outside_its_python_f
             # numba's cache of the compiled loops (build_fmu.ship_compiled_kernels) is compiled code
             # whose pickled debug records name the sources it was compiled from, as text for error
             # messages; numba takes the code where its source, numba and the CPU match, else compiles
-            if name == runtime or (name.startswith(("resources/slewing_model/__pycache__/friction_kernel.",
-                                                    "resources/slewing_model/__pycache__/contact_kernel."))
+            if name == runtime or (name.startswith(("resources/slewing_model/friction/__pycache__/kernel.",
+                                                    "resources/slewing_model/distribution/__pycache__/kernel."))
                                    and name.endswith(".nbc")):
                 continue
             data = z.read(name)

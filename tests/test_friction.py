@@ -422,7 +422,7 @@ def test_result_serialises(axial):
 def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
     # internals of the ball equilibrium: the analytic gradient and Hessian of the regularised power
     # match central differences, and M = H + (M - H) majorises the power (Weiszfeld step is safe)
-    from slewing_model.ball_kinematics import ContactPoints, ContactSet
+    from slewing_model.friction.ball_kinematics import ContactPoints, ContactSet
 
     bearing, dist = combined
     geo = ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
@@ -452,7 +452,7 @@ def test_solver_gradient_hessian_and_majorant_are_consistent(combined):
 
 def test_subset_of_balls_evaluates_as_the_whole(combined):
     # the last iterations of a few balls run on their own contacts: same power, gradient, Hessians
-    from slewing_model.ball_kinematics import ContactPoints, ContactSet
+    from slewing_model.friction.ball_kinematics import ContactPoints, ContactSet
 
     bearing, dist = combined
     geo = ContactSet(bearing, dist, 0.1, 1.0, 1e-3)

@@ -1,6 +1,6 @@
 """The compiled friction loop (numba) and its numpy fallback give the same results.
 
-The compiled loop (:mod:`slewing_model.friction_kernel`) is optional: the FMU runs where
+The compiled loop (:mod:`slewing_model.friction.kernel`) is optional: the FMU runs where
 numba is not installed, with the numpy code. These tests compare both paths term by term
 (the points' coefficients; power, gradient, Hessian, Weiszfeld majorant; each contact's power
 and torque), on whole friction torques, cold and warm-started, and over co-simulation steps
@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 from slewing_model import Loads, friction_torque, load_bearing, solve
-from slewing_model.ball_kinematics import ContactPoints, ContactSet
-from slewing_model.ellipse_quadrature import ellipse_quadrature
-from slewing_model.friction_kernel import AVAILABLE
+from slewing_model.friction.ball_kinematics import ContactPoints, ContactSet
+from slewing_model.friction.ellipse_quadrature import ellipse_quadrature
+from slewing_model.friction.kernel import AVAILABLE
 
 from conftest import BEARINGS, ROOT, simulators_per_kernel
 
@@ -101,7 +101,7 @@ def test_compiled_contact_set_equals_the_numpy_one(case):
         assert want.shape == got.shape and np.allclose(got, want, rtol=1e-15, atol=0.0), name
     assert np.array_equal(sets[True].inactive, np.flatnonzero(unloaded))
     # what the torque reports of the balls' motions, from the same motions and contact powers
-    from slewing_model.ball_kinematics import ball_results
+    from slewing_model.friction.ball_kinematics import ball_results
 
     rng = np.random.default_rng(case)
     u = rng.standard_normal((sets[False].active.size, 3))
@@ -172,7 +172,7 @@ def test_warm_torque_in_one_call_equals_the_loops_one_by_one(case, solve_quadrat
     (``friction_kernel._friction_step``): bit for bit what the loops give called one by one from
     Python, also with unloaded balls (a bearing with clearance under a tilting moment); a ball
     without a warm start (a cold start) and no loaded contact take the general path."""
-    import slewing_model.friction as friction
+    import slewing_model.friction.torque as friction
 
     if case < 3:
         bearing, distribution = _distributions()[case]
@@ -246,7 +246,7 @@ def test_library_without_numba_gives_the_same_torque():
     there = _run("""
 import json
 from slewing_model import Loads, friction_torque, load_bearing, solve
-from slewing_model.friction_kernel import AVAILABLE
+from slewing_model.friction.kernel import AVAILABLE
 b = load_bearing("examples/bearings/table3_errors.toml").with_preload(10e-6)
 d = solve(b, Loads(Fx=2e4, Fz=5e4, Mx=4e3), psi=0.3)
 try:
@@ -275,7 +275,7 @@ folder = extract({str(table3_fmu)!r})
 fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
                 instanceName="cache")
 fmu.instantiate()
-kernel = sys.modules["slewing_model.friction_kernel"]
+kernel = sys.modules["slewing_model.friction.kernel"]
 stats = [f().stats for f, _ in kernel.all_kernels()]
 print(json.dumps({{"inside": kernel.__file__.startswith(str(folder)), "hits": [sum(s.cache_hits.values()) for s in stats],
                    "misses": [sum(s.cache_misses.values()) for s in stats]}}))
@@ -299,7 +299,7 @@ def test_fmu_without_numba_gives_the_same_outputs(table3_numba_fmu):
 import json
 from fmpy import simulate_fmu
 r = simulate_fmu({str(table3_fmu)!r}, stop_time=0.05, step_size=0.01, start_values={start!r}, output={names!r})
-import slewing_model.friction_kernel as k
+import slewing_model.friction.kernel as k
 print(json.dumps({{"available": k.AVAILABLE, **{{n: float(r[n][-1]) for n in {names!r}}}}}))
 """)
     assert there.pop("available") is False

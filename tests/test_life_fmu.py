@@ -11,7 +11,7 @@ from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi2 import FMU2Slave  # noqa: E402
 
 from slewing_model import Loads, load_bearing  # noqa: E402
-from slewing_model.simulator import BearingSimulator, SimulatorSettings  # noqa: E402
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 BEARING = ROOT / "examples" / "bearings" / "table3_errors.toml"
@@ -52,7 +52,7 @@ def step(fmu, refs, k):
 def test_fmu_life_outputs_equal_the_library(slave):
     """The library stepped as the FMU steps (an initial solve at zero inputs, then each step) gives the
     same worst-track damage and x/2b of the last completed half-cycle."""
-    from slewing_model.superelement import build_superelement
+    from slewing_model.rings.superelement import build_superelement
 
     fmu, refs = slave
     bearing = load_bearing(BEARING)

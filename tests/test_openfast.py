@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from openfast_files import packing, write_binary, write_text
-from slewing_model.openfast import MissingChannelError, OpenFastFormatError, OutputFile, read_output
+from slewing_model.loads.openfast import MissingChannelError, OpenFastFormatError, OutputFile, read_output
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "openfast"
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"the real OpenFAST files are not here: {DATA} is absent")

@@ -8,7 +8,7 @@ from slewing_model import BimeSolver, LoadCapacityError, Loads, NoEquilibriumErr
 
 
 def _diagonal_stiffness_n_mm(dw_mm, rc_mm):
-    # paper eqs 10-11 written out in N and mm, independent of slewing_model.contact
+    # paper eqs 10-11 written out in N and mm, independent of slewing_model.bearing.contact
     s = dw_mm / (2 * rc_mm)
     k = 88220 * dw_mm**0.5 / (1 - s) ** 0.3621
     return (2 * k ** (-2 / 3)) ** -1.5 * 1e3**1.5  # two equal contacts in series, N/m^1.5

@@ -1,4 +1,4 @@
-"""Run-time superelement container (slewing_model.ring_stiffness): numpy only, block-circulant
+"""Run-time superelement container (slewing_model.rings.stiffness): numpy only, block-circulant
 algebra, storage, and the check that a file belongs to the bearing it is used with."""
 import dataclasses
 import json
@@ -8,8 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from slewing_model.geometry import RingSection
-from slewing_model.ring_stiffness import (RingStiffness, Superelement, SuperelementMismatchError, bearing_hash,
+from slewing_model.bearing.geometry import RingSection
+from slewing_model.rings.stiffness import (RingStiffness, Superelement, SuperelementMismatchError, bearing_hash,
                                           ring_fields)
 
 
@@ -28,7 +28,7 @@ def random_first_row(B, seed=0, free=False):
 
 
 def test_runtime_module_imports_numpy_only():
-    code = ("import sys; import slewing_model.ring_stiffness; "
+    code = ("import sys; import slewing_model.rings.stiffness; "
             "bad = [m for m in ('scipy', 'skfem', 'tqdm') if m in sys.modules]; print(bad); assert not bad")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stdout + out.stderr

@@ -353,7 +353,8 @@ def numba_fmu(table3_numba_fmu):
 
 
 def _cache_files(system, inside):
-    return sorted(p.name for p in (system / inside.lstrip("/") / "resources/slewing_model/__pycache__").glob("*.nb*"))
+    package = system / inside.lstrip("/") / "resources/slewing_model"
+    return sorted(p.relative_to(package).as_posix() for p in package.glob("*/__pycache__/*.nb*"))
 
 
 def test_the_default_build_carries_numba_and_runs_its_compiled_loops_in_a_bare_system(hosts, numba_fmu):

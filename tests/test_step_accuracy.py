@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from slewing_model import Loads, load_bearing
-from slewing_model.assembly import assemble
-from slewing_model.simulator import BearingSimulator, SimulatorSettings
-from slewing_model.superelement import build_superelement
+from slewing_model.distribution.assembly import assemble
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+from slewing_model.rings.superelement import build_superelement
 
 from conftest import ROOT
 from statics import load_on_moving_ring
@@ -87,7 +87,7 @@ def test_state_taken_while_a_new_operator_is_pending_repeats_the_steps():
     or serialised as the FMU does, repeats the next steps to the last bit."""
     import json
 
-    from slewing_model.simulator import decode_state, encode_state
+    from slewing_model.simulation.simulator import decode_state, encode_state
 
     case = CASES["pitch"](STEPS)
     bearing = load_bearing(case.bearing)

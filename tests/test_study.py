@@ -255,7 +255,7 @@ def test_killed_worker_cases_complete(tmp_path):
 
 @pytest.mark.skipif(not OPENFAST.is_dir(), reason=f"{OPENFAST} (real OpenFAST files) is absent")
 def test_openfast_pitch_case_steps_the_recorded_pitch_angle(tmp_path, cluster):
-    pytest.importorskip("slewing_model.aeroelastic", reason="the OpenFAST channel mapping is not there yet")
+    pytest.importorskip("slewing_model.loads.aeroelastic", reason="the OpenFAST channel mapping is not there yet")
     fast = OPENFAST / "NREL5MW_Land_FASTv8_CertTest18_turb12mps_60s.outb"
     text = (f'[[loads]]\nopenfast = "{fast.as_posix()}"\nbearing = "pitch"\nblades = [1]\nt_start_s = 30.0\n'
             f't_end_s = 31.0\nevery = 4\n\n[bearings]\nfiles = ["{(ROOT / "examples/bearings/pitch_bearing.toml").as_posix()}"]\n')
@@ -267,7 +267,7 @@ def test_openfast_pitch_case_steps_the_recorded_pitch_angle(tmp_path, cluster):
     ts = np.loadtxt(tmp_path / "out" / "cases" / row["case"] / "timeseries.csv", delimiter=",", skiprows=1)
     assert ts[0, 0] == pytest.approx(30.0, abs=0.01) and ts[-1, 0] == pytest.approx(31.0, abs=0.03)
     assert ts.shape[0] == pytest.approx(1.0 / 0.00625 / 4, abs=2)
-    pitch = -np.degrees(ts[:, 1])                    # psi = -BldPitch1 (mounting "tip", slewing_model.aeroelastic)
+    pitch = -np.degrees(ts[:, 1])                    # psi = -BldPitch1 (mounting "tip", slewing_model.loads.aeroelastic)
     assert np.all((pitch > -0.1) & (pitch < 8.0)) and np.ptp(pitch) > 0.01          # BldPitch1: -0.02..7.85 deg
     assert float(row["min_static_safety_factor"]) > 1.0
 

@@ -21,12 +21,12 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementTriP1, Functional, MeshTri, asm
 
-from slewing_model.ring_stiffness import Superelement, SuperelementMismatchError
-from slewing_model.superelement import build_superelement
-from slewing_model.superelement import coupling as cp
-from slewing_model.superelement.command import main as command_main
-from slewing_model.superelement.harmonic import HarmonicRingModel
-from slewing_model.superelement.section import mesh_section, rectangle_mesh, ring_profile
+from slewing_model.rings.stiffness import Superelement, SuperelementMismatchError
+from slewing_model.rings.superelement import build_superelement
+from slewing_model.rings.superelement import coupling as cp
+from slewing_model.rings.superelement.command import main as command_main
+from slewing_model.rings.superelement.harmonic import HarmonicRingModel
+from slewing_model.rings.superelement.section import mesh_section, rectangle_mesh, ring_profile
 
 E, NU = 200e9, 0.3
 G = E / (2 * (1 + NU))
@@ -176,7 +176,7 @@ def test_harmonic_sum_of_the_halfspace_compliance_is_the_self_compliance(table1)
     the ball harmonics of the aliasing sums of coupling.halfspace_harmonic (1-D integrals per
     harmonic) is the ball's own compliance, the 2-D integral of coupling.halfspace_self. This
     checks the harmonic normalisation (1/(2 pi), B/(2 pi), h_n) of the condensation."""
-    from slewing_model.superelement import condense as cd
+    from slewing_model.rings.superelement import condense as cd
 
     patch = cp.ring_patches(table1, "outer", [cp.patch_size(table1, 1)] * 2)[0]
     rows = cd.halfspace_periodic(patch, table1.ball_count, E, NU)
@@ -187,8 +187,8 @@ def test_harmonic_sum_of_the_halfspace_compliance_is_the_self_compliance(table1)
 
 def _normal_compliance(bearing, scale, n, subtract):
     """Per-harmonic compliance of contact 1 along its contact normal, coarse mesh."""
-    from slewing_model.superelement import condense as cd
-    from slewing_model.superelement.supports import Support
+    from slewing_model.rings.superelement import condense as cd
+    from slewing_model.rings.superelement.supports import Support
 
     sizes = [tuple(scale * x for x in cp.patch_size(bearing, c)) for c in (1, 4)]
     sm = mesh_section(ring_profile(bearing, "outer"), [s[0] for s in sizes], "coarse")
@@ -318,7 +318,7 @@ def test_condensed_ovalisation_matches_curved_beam_of_the_grooved_section(free_s
 # ---- storage, cache, metadata, command ------------------------------------------------------
 
 def test_metadata_states_the_inputs_and_the_removed_modes(free_se, table3):
-    from slewing_model.ring_stiffness import bearing_hash
+    from slewing_model.rings.stiffness import bearing_hash
 
     m = free_se.metadata
     assert m["bearing_hash"] == bearing_hash(table3)

@@ -1,6 +1,6 @@
 """``slewing life LOADS.csv BEARING.toml``: life and wear of one load series (table and figures).
 
-Steps the bearing through the series (:class:`slewing_model.simulator.BearingSimulator`,
+Steps the bearing through the series (:class:`slewing_model.simulation.simulator.BearingSimulator`,
 friction off: it does not change the load distribution), records the life accumulator, and
 prints the ISO/TS 16281 life with the oscillation rule, the raceway map's life, DG03's life and
 the wear indicators; with ``-o DIR`` it writes ``life_summary.json``, ``raceway_damage.csv``,
@@ -30,9 +30,9 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    from ..geometry import load_bearing
-    from ..distribution import Loads
-    from ..simulator import BearingSimulator, SimulatorSettings
+    from ..bearing.geometry import load_bearing
+    from ..distribution.results import Loads
+    from ..simulation.simulator import BearingSimulator, SimulatorSettings
     from ..study.series import read_csv
     from .duty import LifeAccumulator, LifeModel, LifeSettings, analyse_run
     from .raceway_map import DEFAULT_SLICES
@@ -41,7 +41,7 @@ def run(args) -> int:
     series = read_csv(args.loads, load_frame=args.load_frame)
     superelement = None
     if args.ring_model == "flexible":
-        from ..superelement import build_superelement
+        from ..rings.superelement import build_superelement
 
         superelement = build_superelement(bearing, mesh="coarse", bc="free")
     sim = BearingSimulator(bearing, superelement, SimulatorSettings(

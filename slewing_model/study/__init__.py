@@ -1,7 +1,7 @@
 """Studies of many cases: load series x bearing variants, run on Dask distributed.
 
 Not part of the FMU's run time (it imports dask); it runs the same
-:class:`slewing_model.simulator.BearingSimulator` the FMU runs, once per case.
+:class:`slewing_model.simulation.simulator.BearingSimulator` the FMU runs, once per case.
 
 * :mod:`.definition` -- the study file (TOML): validation, expansion into cases, case keys;
 * :mod:`.series` -- load series with the ring's motion (our CSV, OpenFAST files, constant);

@@ -3,7 +3,7 @@
 :func:`run_case` is what a Dask worker runs. It takes everything it needs in its
 argument (the bearing, its superelement, the load series: no files, so a worker
 on another machine needs only the package), steps
-:class:`slewing_model.simulator.BearingSimulator` -- the simulator the FMU runs --
+:class:`slewing_model.simulation.simulator.BearingSimulator` -- the simulator the FMU runs --
 through the series with the recorded motion, and returns the time series, the
 statistics and the per-ball load spectrum. A case that cannot be computed (a load
 beyond the bearing's capacity, no equilibrium, a bad input) comes back with its
@@ -45,9 +45,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..bime import Loads
+from ..distribution.bime import Loads
 from ..life import LifeAccumulator, LifeModel, analyse_run
-from ..simulator import BearingSimulator, SimulatorSettings
+from ..simulation.simulator import BearingSimulator, SimulatorSettings
 from .series import MotionSeries
 
 #: the columns of a case's time series
@@ -131,7 +131,7 @@ def case_bearing(bearing, variant: dict):
     seed = variant.get("error_seed")
     if seed is None:
         return bearing
-    from ..errors import errors_from_table
+    from ..bearing.manufacturing import errors_from_table
 
     params = variant.get("synthetic_errors")
     if params is None:

@@ -44,12 +44,12 @@ bearing variants::
 Each load entry may also give ``name``, ``load_frame`` (``"fixed"`` or
 ``"rotating"``: the frame the loads are given in, turning with ``psi`` or not).
 OpenFAST loads are turned into the frame asked for by
-:func:`slewing_model.aeroelastic.bearing_loads` (default ``"rotating"``: the
+:func:`slewing_model.loads.aeroelastic.bearing_loads` (default ``"rotating"``: the
 blade's frame for a pitch bearing, the nacelle's for a yaw bearing). A CSV file
 may state its frame in a ``# load_frame = ...`` comment (a study frame that
 contradicts it is refused); default ``"fixed"``. OpenFAST entries may also give
 ``mounting`` (which way the bearing's +z points: ``"tip"``/``"hub"`` for pitch,
-``"up"``/``"down"`` for yaw; see :mod:`slewing_model.aeroelastic`).
+``"up"``/``"down"`` for yaw; see :mod:`slewing_model.loads.aeroelastic`).
 
 Every case has a key: the SHA-256 of its canonical description (the load and
 bearing files by content, not by path), so that a rerun recognises the cases
@@ -471,7 +471,7 @@ def _simulation(table: Mapping) -> dict:
         if value is not None and value >= 1e-2:
             _fail(w + key, value, "must lie in (0, 0.01)")
         if value is None:   # the simulator's own default, written into the case (and its key)
-            from ..simulator import SimulatorSettings
+            from ..simulation.simulator import SimulatorSettings
 
             value = getattr(SimulatorSettings(), key)
         s[key] = value

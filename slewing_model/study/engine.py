@@ -3,7 +3,7 @@
 :func:`run_study` expands the study into cases, skips those already finished in
 the output directory (keyed by the case hash), reads every load series and bearing
 once, builds each flexible bearing's superelement once (on the client, through the
-on-disk cache of :func:`slewing_model.superelement.build_superelement`), and submits
+on-disk cache of :func:`slewing_model.rings.superelement.build_superelement`), and submits
 one task per case to a Dask cluster: by default an embedded ``LocalCluster`` of
 worker processes (one per core), or an existing cluster given by its scheduler
 address. Each task carries its bearing, superelement and load series, so workers
@@ -286,14 +286,14 @@ class _Prepared:
         return self._once(self._series, json.dumps(load, sort_keys=True), lambda: load_series(load))
 
     def bearing(self, path: str):
-        from ..geometry import load_bearing
+        from ..bearing.geometry import load_bearing
 
         return self._once(self._bearings, path, lambda: load_bearing(path))
 
     def superelement(self, path: str):
         def build():
             try:
-                from ..superelement import build_superelement
+                from ..rings.superelement import build_superelement
             except ImportError as exc:
                 raise ValueError(f"flexible rings need the superelement builder (scipy, scikit-fem): {exc}") from None
             return build_superelement(self.bearing(path), mesh=self.simulation["mesh"], bc=self.simulation["bc"])

@@ -4,8 +4,8 @@ Three sources (the ``[[loads]]`` entries of a study file):
 
 * our CSV, SI units, header ``time,Fx,Fy,Fz,Mx,My,Mz,psi,omega`` (what ``slewing loads``
   writes), or the older ``time,Fx,Fy,Fz,Mx,My[,Mz]`` without the motion;
-* an OpenFAST / FAST output file, through :func:`slewing_model.openfast.read_output` and
-  :func:`slewing_model.aeroelastic.bearing_loads` (pitch angle or nacelle yaw as ``psi``);
+* an OpenFAST / FAST output file, through :func:`slewing_model.loads.openfast.read_output` and
+  :func:`slewing_model.loads.aeroelastic.bearing_loads` (pitch angle or nacelle yaw as ``psi``);
 * constant loads with a steady rotation.
 
 Without a recorded motion, ``psi = omega_rad_s * (t - t0)`` (default: the ring stands
@@ -168,16 +168,16 @@ def from_openfast(path: str, *, bearing: str, blade: int = 1, mounting: str | No
                   load_frame: str | None = None) -> MotionSeries:
     """Bearing loads and motion from an OpenFAST / FAST output file (``.out``, ``.outb``).
 
-    Uses :func:`slewing_model.openfast.read_output` and
-    :func:`slewing_model.aeroelastic.bearing_loads` (which turns the loads into the
+    Uses :func:`slewing_model.loads.openfast.read_output` and
+    :func:`slewing_model.loads.aeroelastic.bearing_loads` (which turns the loads into the
     ``load_frame`` asked for, default ``"rotating"``: the blade's or the nacelle's frame);
     ``psi`` and ``omega`` are the recorded pitch (or yaw) angle and rate.
     """
     try:
-        from .. import aeroelastic, openfast
+        from ..loads import aeroelastic, openfast
     except ImportError as exc:
-        raise ValueError(f"{path}: reading OpenFAST files needs slewing_model.openfast and "
-                         f"slewing_model.aeroelastic ({exc})") from None
+        raise ValueError(f"{path}: reading OpenFAST files needs slewing_model.loads.openfast and "
+                         f"slewing_model.loads.aeroelastic ({exc})") from None
     output = openfast.read_output(path)
     options = {} if mounting is None else {"mounting": mounting}
     frame = load_frame or "rotating"

@@ -1,0 +1,403 @@
+"""The reduced Newton operator of the flexible model: the Newton system on the loaded contacts.
+
+For flexible rings the rings are linear, so each Newton step of the energy (paper eq 20)
+eliminates their displacements exactly through their compliance ``M`` at the contacts
+(:mod:`slewing_model.rings.compliance`) and is solved on the *active* (loaded) diagonals
+only (:mod:`slewing_model.distribution.bime` derives it):
+
+    ``[(A^-1 + M)_aa  -S J_a] [y_a]   [A_a^-1 f_a + (M y)_a]``
+    ``[-S J_a^T          0  ] [dq ] = [-F                  ]``
+
+with ``A`` the 2x2 stiffness blocks of the Hertz springs (eqs 8-11) at an iterate, ``J``
+the Jacobian of the contacts' relative vectors on the moving ring's five motions (eq 23)
+and ``y`` the contact forces after the step. :class:`ReducedOperator` keeps
+``W^-1 = (A^-1 + M)_aa^-1`` and what follows from it for the five motions (its Schur
+complement). It is reused between iterations and between warm-started steps (a modified
+Newton step, still a descent direction), bordered by the contacts that close
+(:func:`update_operator`; contacts that open keep their rows until a fresh operator), and
+rebuilt when convergence slows (:func:`assemble_operator`).
+
+Run-time module: numpy.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class ReducedOperator:
+    """``W^-1`` of the active contacts and its coupling to the moving ring's motions.
+
+    Attributes
+    ----------
+    rows : ndarray (n,) of int
+        Rows of the operator's contacts among the 4B contact rows (ball, diagonal, (r, z)), two a
+        diagonal, in the order they entered (:func:`update_operator`): the diagonals loaded when it
+        was formed, then those that closed since.
+    active : ndarray (2B,) of bool
+        The operator's diagonals (``rows[::2] // 2``) as a mask.
+    contact_compliance : ndarray (n/2, 2, 2)
+        ``A^-1`` of the operator's diagonals, in its order, when each entered.
+    inverse : ndarray (n, n)
+        ``W^-1 = (A^-1 + M)_aa^-1``.
+    jacobian : ndarray (n, 5)
+        ``J_a`` (scaled rotations) when the coupling was formed.
+    coupling : ndarray (n, 5)
+        ``W^-1 J_a``.
+    schur_inverse : ndarray (5, 5)
+        ``(J_a^T W^-1 J_a + mu I)^-1``.
+    """
+
+    rows: np.ndarray
+    active: np.ndarray
+    contact_compliance: np.ndarray
+    inverse: np.ndarray
+    jacobian: np.ndarray
+    coupling: np.ndarray
+    schur_inverse: np.ndarray
+
+    def as_tuple(self) -> tuple:
+        """The arrays, not copied (a solver state to keep or serialise)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+    @classmethod
+    def from_tuple(cls, values) -> "ReducedOperator":
+        return cls(*(np.asarray(v) for v in values))
+
+
+def contact_compliance_blocks(point, stiffness: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """``A^-1`` (n_active, 2, 2): compliance of the active diagonals' Hertz springs at an iterate.
+
+    ``point`` has per diagonal the unit vector ``n``, the elongation ``delta``, the length
+    ``length`` and the load ``q`` of the spring (eqs 7-8); ``stiffness`` is ``K_tot`` (B, 2):
+    normal compliance ``1 / (1.5 K sqrt(delta))``, and ``length / q`` across."""
+    n = point.n.reshape(-1, 2)[active]
+    nn = n[:, :, None] * n[:, None, :]
+    delta = point.delta.ravel()[active]
+    k_normal = 1.5 * stiffness.ravel()[active] * np.sqrt(delta)
+    return nn / k_normal[:, None, None] + (point.length.ravel()[active] / point.q.ravel()[active])[:, None, None] * (
+        np.eye(2) - nn)
+
+
+def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.ndarray, mu: float,
+                     arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
+    """The operator from ``W^-1``: its coupling to the motions through the Jacobian (4B, 5) and the
+    Schur complement's inverse (:func:`operator_coupling`)."""
+    ja = jacobian.reshape(-1, 5)[rows]
+    coupling, schur_inverse = _arithmetic(arithmetic).couple(inverse, ja, mu)
+    return ReducedOperator(rows, active, contact_compliance, inverse, ja, coupling, schur_inverse)
+
+
+def operator_coupling(inverse: np.ndarray, ja: np.ndarray, mu: float):
+    """``W^-1 J_a`` and ``(J_a^T W^-1 J_a + mu I)^-1``."""
+    coupling = inverse @ ja
+    return coupling, np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
+
+
+#: how far a turned Jacobian may be off the ring's own where errors move the grooves with it
+#: (relative to its largest entry): the kept operator then stands for ``J_old T`` instead of
+#: ``J_new``, a modified Newton operator like any kept one (its springs' stiffnesses are those of
+#: an earlier iterate, percents off before a refresh); table3 with errors: 4e-8 a step, at most
+#: 2e-5 after a turn of one radian
+APPROXIMATE_TURN = 1e-4
+
+
+def turned_operator(op: ReducedOperator, jacobian: np.ndarray, mu, tolerance: float = 0.0,
+                    arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
+    """The kept operator after the ring turned (:meth:`slewing_model.distribution.bime.BimeSolver.set_rotation`).
+
+    ``W^-1`` holds (the rings are axisymmetric and the balls keep their spacing); the coupling
+    ``W^-1 J_a`` follows the Jacobian. Where every ball keeps its groove centres (no
+    manufacturing errors) turning the balls by an angle only mixes the Jacobian's columns,
+    ``J_new = J_old T`` (``T``: the turn in the X, Y and rx, ry pairs, eq 23), and then
+    ``W^-1 J_new = (W^-1 J_old) T`` costs ``O(n)`` instead of a pass over ``W^-1``
+    (:func:`column_turn`). Where errors move the groove centres with the ring, ``J_old T`` is
+    off ``J_new`` by the errors' share: within ``tolerance`` (the caller's, e.g.
+    :data:`APPROXIMATE_TURN`) the operator is turned all the same and stands for ``J_old T``;
+    otherwise the coupling is formed anew. The operator itself when the Jacobian did not
+    change."""
+    ja = jacobian.reshape(-1, 5)[op.rows]
+    if op.jacobian.shape == ja.shape and (op.jacobian == ja).all():
+        return op
+    arithmetic = _arithmetic(arithmetic)
+    turned = None
+    if op.jacobian.shape == ja.shape:
+        turned = arithmetic.turn(op.jacobian, ja, op.coupling, mu, tolerance)
+    if turned is None:
+        return reduced_operator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian, mu, arithmetic)
+    coupling, schur_inverse, turned_jacobian = turned
+    return ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, turned_jacobian, coupling,
+                           schur_inverse)
+
+
+def column_turn(old: np.ndarray, new: np.ndarray, coupling: np.ndarray, mu: float, tolerance: float = 0.0):
+    """The coupling ``coupling T``, the Schur complement's inverse ``(J^T coupling T + mu I)^-1`` and
+    the Jacobian ``J`` they are for, where ``old T`` (``T`` fitted to ``new`` by least squares)
+    reproduces ``new`` to 1e-12 (``J = new``: then ``coupling T = W^-1 old T = W^-1 new``) or to
+    ``tolerance`` (``J = old T``); or None (no ``T`` does: errors move the grooves with the ring;
+    or the fit's normal equations are singular)."""
+    try:
+        turn = np.linalg.solve(old.T @ old, old.T @ new)
+    except np.linalg.LinAlgError:      # J_a of rank < 5 (fewer than three loaded diagonals)
+        return None
+    fitted = old @ turn
+    misfit = np.abs(fitted - new).max()
+    if not misfit <= max(tolerance, 1e-12) * np.abs(new).max():
+        return None
+    jacobian = new if misfit <= 1e-12 * np.abs(new).max() else fitted
+    coupling = coupling @ turn
+    return coupling, np.linalg.inv(jacobian.T @ coupling + mu * np.eye(5)), jacobian
+
+
+def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
+    """Add the 2x2 ``blocks`` (k, 2, 2) on the diagonal of ``matrix`` (2k, 2k), in place."""
+    first = np.arange(0, 2 * blocks.shape[0], 2)
+    for r in range(2):
+        for c in range(2):
+            matrix[first + r, first + c] += blocks[:, r, c]
+
+
+#: below this size :func:`spd_inverse` calls LAPACK's inverse
+LEAF = 64
+
+
+def spd_inverse(w: np.ndarray) -> np.ndarray:
+    """Inverse of a symmetric positive definite matrix by its halves (Schur complement).
+
+    With ``w = [[A, B], [B^T, D]]``, ``X = A^-1 B`` and ``S = D - B^T X`` (positive definite
+    too, so no pivoting is needed),
+    ``w^-1 = [[A^-1 + X S^-1 X^T, -X S^-1], [-S^-1 X^T, S^-1]]``, with ``A^-1`` and ``S^-1``
+    by the same rule down to :data:`LEAF` rows, each made exactly symmetric: the formula takes
+    ``(A^-1 B)^T`` for ``B^T A^-1``, and the round-off asymmetry of an inverse, multiplied by
+    ``S^-1``, otherwise grows from level to level (measured: residual ``|w^-1 w - I|`` 1e-6
+    instead of 1e-11 on the 592 rows of the pitch bearing's cold start; symmetric, as
+    ``np.linalg.inv``'s). The flops are matrix products, which BLAS
+    runs near the machine's peak; ``np.linalg.inv`` (LU, then ``n`` triangular solves) is
+    twice as slow on one thread at 380 rows (``docs/speed.md``).
+
+    The top level is three stages (:data:`HALVES`), which :class:`PendingOperator` spreads
+    over two steps."""
+    if w.shape[0] <= LEAF:
+        inverse = np.linalg.inv(w)
+        return 0.5 * (inverse + inverse.T)
+    parts = ()
+    for stage in HALVES:
+        parts = stage(w, *parts)
+    return parts[0]
+
+
+def _first_half(w):
+    """``A^-1`` and ``X = A^-1 B`` (5/12 of the flops)."""
+    h = w.shape[0] // 2
+    a_inv = spd_inverse(w[:h, :h])
+    return a_inv, a_inv @ w[:h, h:]
+
+
+def _second_half(w, a_inv, x):
+    """... and ``S^-1``, ``S = D - B^T X`` (5/12)."""
+    h = w.shape[0] // 2
+    schur = w[h:, h:] - w[:h, h:].T @ x
+    return a_inv, x, spd_inverse(0.5 * (schur + schur.T))
+
+
+def _joined(w, a_inv, x, s_inv):
+    """... and ``w^-1`` from them (6/12)."""
+    h = w.shape[0] // 2
+    y = x @ s_inv
+    out = np.empty_like(w)
+    corner = a_inv + y @ x.T
+    out[:h, :h] = 0.5 * (corner + corner.T)
+    out[:h, h:] = -y
+    out[h:, :h] = -y.T
+    out[h:, h:] = s_inv
+    return (out,)
+
+
+#: the stages of :func:`spd_inverse`'s top level, each taking ``w`` and the last one's results
+HALVES = (_first_half, _second_half, _joined)
+#: the same as the steps of a :class:`PendingOperator`: ``A^-1 B`` on the step that forms ``W``
+#: (with ``W``'s gathering, about half the work), the rest on the next (measured against three
+#: steps and against the split 10/12 | 6/12: docs/speed.md)
+SPREAD_STAGES = ((_first_half,), (_second_half, _joined))
+
+
+@dataclass(frozen=True)
+class PendingOperator:
+    """A new reduced operator formed at an iterate and inverted over two steps.
+
+    Inverting ``W`` is about 2.5 ms on the pitch bearing, more than a whole step: made at
+    once, it is what the slowest steps of a co-simulation spend (the 95th and 99th
+    percentiles). :func:`start_operator` forms ``W`` and runs the first of
+    :data:`SPREAD_STAGES`, :func:`advance_operator` the next; meanwhile the solver goes on
+    with the operator it has (a modified Newton step: slower, as exact). ``parts`` are the
+    last stage's results (see :data:`HALVES`)."""
+
+    rows: np.ndarray
+    active: np.ndarray
+    contact_compliance: np.ndarray
+    matrix: np.ndarray
+    stage: int
+    parts: tuple
+
+    def as_tuple(self) -> tuple:
+        """The arrays (not copied) and the stage: a solver state to keep or serialise."""
+        return (self.rows, self.active, self.contact_compliance, self.matrix, self.stage, *self.parts)
+
+    @classmethod
+    def from_tuple(cls, values) -> "PendingOperator":
+        rows, active, a_inv, matrix, stage, *parts = values
+        return cls(*(np.asarray(v) for v in (rows, active, a_inv, matrix)), int(stage),
+                   tuple(np.asarray(v) for v in parts))
+
+
+def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None
+                   ) -> PendingOperator:
+    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
+    and run the first stage of its inverse."""
+    rows, a_inv, w_mat = _arithmetic(arithmetic).form(point, compliance, stiffness, active)
+    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
+
+
+def operator_matrix(point, compliance, stiffness, active):
+    """The rows of the ``active`` diagonals, the springs' compliance ``A^-1`` there (k, 2, 2) at an
+    iterate (:func:`contact_compliance_blocks`) and ``W = (A^-1 + M)_aa`` (``M`` the rings';
+    symmetric positive definite)."""
+    rows = np.flatnonzero(np.repeat(active, 2))
+    a_inv = contact_compliance_blocks(point, stiffness, active)
+    w_mat = np.asarray(compliance).take(rows, axis=0).take(rows, axis=1)   # M_aa (3x faster than np.ix_)
+    _add_blocks(w_mat, a_inv)
+    return rows, a_inv, w_mat
+
+
+def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
+                     ) -> "PendingOperator | ReducedOperator":
+    """The next of :data:`SPREAD_STAGES`; after the last, the operator with its coupling to the
+    Jacobian (4B, 5) of now (``jacobian`` None: the pending operator, inverted). A small ``W``
+    is inverted in one stage."""
+    if pending.stage < len(SPREAD_STAGES):
+        if pending.matrix.shape[0] <= LEAF:
+            pending = replace(pending, stage=len(SPREAD_STAGES), parts=(spd_inverse(pending.matrix),))
+        else:
+            parts = pending.parts
+            for stage in SPREAD_STAGES[pending.stage]:
+                parts = stage(pending.matrix, *parts)
+            pending = replace(pending, stage=pending.stage + 1, parts=parts)
+    if pending.stage < len(SPREAD_STAGES) or jacobian is None:
+        return pending
+    return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
+                            arithmetic)
+
+
+def complete_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
+                      ) -> ReducedOperator:
+    """The remaining stages at once."""
+    while isinstance(pending, PendingOperator):
+        pending = advance_operator(pending, jacobian, mu, arithmetic)
+    return pending
+
+
+def assemble_operator(point, compliance, stiffness, jacobian, active, mu,
+                      arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator:
+    """Form and invert ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate: O(n^3)."""
+    return complete_operator(start_operator(point, compliance, stiffness, active, arithmetic), jacobian, mu,
+                             arithmetic)
+
+
+def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian, active, mu,
+                    arithmetic: "OperatorArithmetic | None" = None) -> ReducedOperator | None:
+    """Follow contacts that closed by bordering the kept ``W^-1``; contacts that opened stay.
+
+    A diagonal that opened keeps its row in the operator with the stiffness it had when the
+    operator was formed, until the next fresh one: a modified Newton step whose fixed point is
+    the same, since the step's row of that contact, ``A^-1 (y_new - f) + (M dy) - J dq = 0``,
+    holds at the equilibrium with ``y = f = 0``. Its stiffness is that of when the operator
+    was formed, maybe some steps earlier: where it slows the iteration, the solve's refresh
+    rule forms a new operator. Dropping it would cost a pass over ``W^-1`` that, as the ring
+    turns, a contact closing again soon after would undo (measured on the pitch bearing's
+    steps: updates 0.93 -> 0.28 a step, docs/speed.md).
+
+    A diagonal that closed must enter: its force is zero outside the operator's rows. With
+    ``B = M`` (kept rows, new rows), ``C = (A^-1 + M)`` on the new rows, ``X = W^-1 B`` and
+    ``S = (C - B^T X)^-1``, ``W_new^-1 = [[W^-1 + X S X^T, -X S], [-S X^T, S]]``: O(n^2 r) for
+    ``r`` new rows instead of O(n^3). The new rows come after the kept ones (the operator's
+    rows are in the order they entered), and the coupling follows by the same blocks:
+    ``W_new^-1 J_new = [W^-1 J - X S d, S d]``, ``d = J_r - X^T J``, with ``op`` turned to
+    ``jacobian`` first (:func:`turned_operator`; where it was turned nearly, the kept rows keep the
+    Jacobian their coupling is for). Returns None (form anew) when more than a quarter of the rows
+    would be new. The blocks are :func:`bordered_inverse`'s."""
+    closed = active & ~op.active
+    new_rows = np.flatnonzero(np.repeat(closed, 2))
+    if new_rows.size > 0.25 * op.rows.size:
+        return None
+    rows = np.concatenate([op.rows, new_rows])
+    new_a_inv = contact_compliance_blocks(point, stiffness, closed)
+    b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
+    c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
+    _add_blocks(c_mat, new_a_inv)
+    new_jacobian = jacobian.reshape(-1, 5)[new_rows]
+    inverse, coupling, schur_inverse = _arithmetic(arithmetic).border(
+        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, new_jacobian, mu)
+    # the kept rows keep the Jacobian their coupling is for (a nearly turned one: turned_operator)
+    return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
+                           np.concatenate([op.jacobian, new_jacobian]), coupling, schur_inverse)
+
+
+def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
+    """``W^-1`` (n, n) bordered by ``r`` rows (:func:`update_operator`): with ``X = W^-1 B`` (``b_mat``
+    (n, r)) and ``S = (C - B^T X)^-1`` (``c_mat`` (r, r)), the new inverse
+    ``[[W^-1 + X S X^T, -X S], [-S X^T, S]]``, its coupling ``[W^-1 J - X S d, S d]`` with
+    ``d = J_r - X^T J`` (``coupling = W^-1 J`` (n, 5), ``jacobian = J``, ``new_jacobian = J_r``
+    (r, 5)) and the new Schur complement's inverse ``(J_new^T W_new^-1 J_new + mu I)^-1``."""
+    x_mat = inverse @ b_mat
+    schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
+    schur = 0.5 * (schur + schur.T)
+    xs = x_mat @ schur
+    n, r = b_mat.shape
+    bordered = np.empty((n + r, n + r))
+    np.add(inverse, xs @ x_mat.T, out=bordered[:n, :n])
+    bordered[:n, n:] = -xs
+    bordered[n:, :n] = -xs.T
+    bordered[n:, n:] = schur
+    d = new_jacobian - x_mat.T @ jacobian
+    new_coupling = np.concatenate([coupling - xs @ d, schur @ d])
+    ja = np.concatenate([jacobian, new_jacobian])
+    return bordered, new_coupling, np.linalg.inv(ja.T @ new_coupling + mu * np.eye(5))
+
+
+def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
+    """The (modified) Newton step with the kept operator: ``dq`` (5,) and the contact forces
+    after the step ``y`` (4B,), zero on the open contacts.
+
+    ``point`` has the spring forces ``force`` (B, 2, 2), the forces felt by the rings ``y``
+    and their motion ``ring_motion = M y``."""
+    rhs = (op.contact_compliance @ point.force.reshape(-1, 2)[op.rows[::2] // 2][..., None]).ravel() \
+        + point.ring_motion[op.rows]
+    w_vec = op.inverse @ rhs
+    dq = op.schur_inverse @ (f_scaled - op.jacobian.T @ w_vec)
+    y_new = np.zeros_like(point.y)
+    y_new[op.rows] = w_vec + op.coupling @ dq
+    return dq, y_new
+
+
+@dataclass(frozen=True)
+class OperatorArithmetic:
+    """Who does the reduced operator's arithmetic: this module's numpy functions
+    (:data:`NUMPY_ARITHMETIC`), or the same as compiled loops
+    (:data:`slewing_model.distribution.kernel.COMPILED_ARITHMETIC`); the functions above take it as
+    ``arithmetic`` (default numpy)."""
+
+    form: object        # operator_matrix
+    couple: object      # operator_coupling
+    turn: object        # column_turn
+    border: object      # bordered_inverse
+    step: object        # newton_step
+
+
+#: this module's numpy functions
+NUMPY_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
+
+
+def _arithmetic(arithmetic: OperatorArithmetic | None) -> OperatorArithmetic:
+    return NUMPY_ARITHMETIC if arithmetic is None else arithmetic

@@ -1,0 +1,301 @@
+"""Time stepping of one bearing: what a co-simulation step asks of the library.
+
+:class:`BearingSimulator` holds a bearing, its (optional) superelement and the
+solver's warm start, and answers each step with the load distribution and the
+friction torque for the loads, the rotation ``psi`` and the speed ``omega`` of
+the moving ring. It knows nothing of FMI: the FMU in ``fmu_src/`` maps its
+variables onto this class, and scripts can use it directly.
+
+Its whole state is :meth:`BearingSimulator.get_state` (plain JSON data), so a
+step can be rolled back and repeated exactly.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..distribution.bime import BimeSolver, LoadDistribution, Loads
+from ..numerics.blas import blas_threads
+from ..friction.torque import friction_torque, regularised_torque
+from ..friction.kernel import compile_all, use_compiled
+from ..bearing.geometry import Bearing
+from ..rings.reduced_operator import PendingOperator, ReducedOperator
+
+RING_MODELS = ("rigid", "flexible")
+LOAD_FRAMES = ("fixed", "rotating")
+
+
+@dataclass(frozen=True)
+class SimulatorSettings:
+    """Options of a :class:`BearingSimulator` (SI units).
+
+    Attributes
+    ----------
+    ring_model : {"rigid", "flexible"}
+    moving_ring : {"inner", "outer"}
+    load_frame : {"fixed", "rotating"}
+        Frame the loads are given in: the fixed ring's, or the moving ring's
+        (turned by ``psi``; e.g. blade root loads of a pitch bearing).
+    preload : float or None, m
+        Ball preload overriding the bearing definition.
+    friction_coefficient : float
+        Coulomb coefficient ``mu`` of the raceway contacts; 0 switches the
+        contact friction off.
+    seal_torque : float, N m
+        Load-independent friction torque (seals, grease).
+    tolerance : float
+        Relative tolerance of the load distribution solver: the force and moment residuals on
+        the moving ring (and the contact forces the rings feel) below ``tolerance`` times the
+        load scale. 1e-7 is tied to what the outputs need: ten times below the 1e-6 balance
+        of forces the co-simulation promises, and it leaves ``z``, ``rx``, ``ry`` and the
+        ball loads within 2e-5 of a solve at the round-off floor in the benchmark cases
+        (``tests/test_step_accuracy.py``); each decade tighter costs about one Newton
+        iteration per step.
+    omega_regularisation : float, rad/s
+        Speed over which the signed friction torque goes from 0 to its
+        full-sliding level (:func:`slewing_model.friction.regularised_torque`);
+        choose at least ``magnitude * step / inertia`` for an explicit coupling
+        (:func:`slewing_model.friction.omega_regularisation_for_step`).
+    friction_tolerance : float
+        Relative accuracy of the ball equilibrium behind each step's friction
+        torque (``tol`` of :func:`slewing_model.friction.friction_torque`; the
+        torque error it leaves is below it). The library's 1e-5: with 1e-4 (the
+        default before) the yaw bearing's torque was off by up to 1.8e-4 at some steps,
+        where a four-contact ball stopped on a flat stretch of its power
+        (``tests/test_step_accuracy.py``).
+    blas_threads : int or None
+        Threads of numpy's BLAS during a step (:func:`slewing_model.numerics.blas.blas_threads`;
+        restored after it); None leaves them as the process has them. Default 1: the
+        step's matrices have a few hundred rows, and a second thread that spins while
+        other processes share the cores makes steps several times slower.
+    friction_kernel : {"auto", "numpy", "compiled"}
+        How the friction model runs its loops over points and balls (``kernel`` of
+        :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loops
+        where numba is installed, numpy otherwise; the results are the same to round-off.
+    contact_kernel : {"auto", "numpy", "compiled"}
+        The same for the load distribution's loops (its per-contact work and the reduced ring
+        operator's: ``kernel`` of :class:`slewing_model.distribution.bime.BimeSolver`).
+    life : bool
+        Accumulate the raceway life and wear step by step (:class:`slewing_model.life.LifeAccumulator`
+        as ``BearingSimulator.life``, default :class:`slewing_model.life.LifeSettings`): the
+        raceway damage map and the half-cycles of ``psi``; part of the simulator's state.
+    """
+
+    ring_model: str = "flexible"
+    moving_ring: str = "inner"
+    load_frame: str = "fixed"
+    preload: float | None = None
+    friction_coefficient: float = 0.1
+    seal_torque: float = 0.0
+    tolerance: float = 1e-7
+    omega_regularisation: float = 1e-4
+    friction_tolerance: float = 1e-5
+    blas_threads: int | None = 1
+    friction_kernel: str = "auto"
+    contact_kernel: str = "auto"
+    life: bool = False
+
+    def __post_init__(self):
+        _choice("ring_model", self.ring_model, RING_MODELS)
+        _choice("moving_ring", self.moving_ring, ("inner", "outer"))
+        _choice("load_frame", self.load_frame, LOAD_FRAMES)
+        use_compiled(self.friction_kernel, "friction_kernel")
+        use_compiled(self.contact_kernel, "contact_kernel")
+        for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation", "friction_tolerance"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ValueError(f"{name} = {value!r}: must be a finite number >= 0")
+        for name in ("tolerance", "friction_tolerance"):
+            if not 0 < getattr(self, name) < 1e-2:
+                raise ValueError(f"{name} = {getattr(self, name)!r}: must lie in (0, 0.01)")
+        if self.blas_threads is not None and (isinstance(self.blas_threads, bool) or not isinstance(
+                self.blas_threads, int) or self.blas_threads < 1):
+            raise ValueError(f"blas_threads = {self.blas_threads!r}: must be a whole number >= 1, or None")
+        if self.preload is not None and not math.isfinite(self.preload):
+            raise ValueError(f"preload = {self.preload!r}: must be finite")
+
+
+def _choice(name, value, allowed):
+    if value not in allowed:
+        raise ValueError(f"{name} = {value!r}: must be one of {', '.join(map(repr, allowed))}")
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What one step answers (SI units).
+
+    Attributes
+    ----------
+    distribution : LoadDistribution
+    friction_torque : float, N m
+        Signed: opposes ``omega`` (torque of the bearing on the moving ring).
+    friction_torque_magnitude : float, N m
+        At full sliding, whatever ``omega``.
+    """
+
+    distribution: LoadDistribution
+    friction_torque: float
+    friction_torque_magnitude: float
+
+
+@dataclass
+class BearingSimulator:
+    """Load distribution and friction torque, step after step, warm-started.
+
+    Parameters
+    ----------
+    bearing : Bearing
+    superelement : Superelement, optional
+        Needed for ``settings.ring_model == "flexible"``.
+    settings : SimulatorSettings
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing, Loads
+    >>> from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+    >>> sim = BearingSimulator(load_bearing("examples/bearings/table3.toml"),
+    ...                        settings=SimulatorSettings(ring_model="rigid", friction_coefficient=0.0))
+    >>> r = sim.step(Loads(Fz=5e4), psi=0.0, omega=0.1)
+    >>> r.distribution.displacement[2] > 0
+    True
+    """
+
+    bearing: Bearing
+    superelement: object = None
+    settings: SimulatorSettings = field(default_factory=SimulatorSettings)
+
+    def __post_init__(self):
+        s = self.settings
+        if s.ring_model == "flexible" and self.superelement is None:
+            raise ValueError("ring_model = 'flexible' needs a superelement")
+        bearing = replace(self.bearing, moving_ring=s.moving_ring)
+        if s.preload is not None:
+            bearing = bearing.with_preload(s.preload)
+        self.bearing = bearing
+        self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
+                                 rtol=s.tolerance, kernel=s.contact_kernel)
+        friction, contact = use_compiled(s.friction_kernel, "friction_kernel"), use_compiled(s.contact_kernel,
+                                                                                             "contact_kernel")
+        if friction or contact:
+            compile_all(friction, contact)     # compiled (or loaded from numba's cache) now, not in a step
+        self._warm: np.ndarray | None = None
+        self._previous: np.ndarray | None = None      # the state one step before _warm
+        self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
+        self._psi = 0.0
+        self.last: StepResult | None = None
+        self.life = None
+        if s.life:
+            from ..life import LifeAccumulator, LifeModel
+
+            self.life = LifeAccumulator(LifeModel(bearing, s.moving_ring, s.load_frame))
+
+    def tune(self, **changes) -> None:
+        """Change the tunable settings (``friction_coefficient``, ``seal_torque``,
+        ``omega_regularisation``) between steps; the others need a new simulator."""
+        for name in changes:
+            if name not in ("friction_coefficient", "seal_torque", "omega_regularisation"):
+                raise ValueError(f"{name} is not tunable: build a new simulator")
+        self.settings = replace(self.settings, **changes)
+
+    def step(self, loads: Loads, psi: float, omega: float) -> StepResult:
+        """Solve the step: load distribution at rotation ``psi`` (warm-started
+        from the previous step), then the friction torque at speed ``omega``.
+
+        Raises
+        ------
+        ValueError
+            A non-finite input, naming it.
+        NoEquilibriumError, LoadCapacityError
+            The load cannot be carried. The simulator is then as it was before the
+            step (the solver's rotation and kept operator restored): the next step
+            goes on as if this one had not been asked for.
+        """
+        for name, value in (("psi", psi), ("omega", omega)):
+            if not math.isfinite(value):
+                raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
+        if self.settings.load_frame == "rotating":
+            loads = loads.rotated(psi)
+        before = self.get_state()
+        try:
+            return self._step(loads, psi, omega)
+        except Exception:
+            self.set_state(before)
+            raise
+
+    def _step(self, loads: Loads, psi: float, omega: float) -> StepResult:
+        with blas_threads(self.settings.blas_threads):
+            if psi != self._psi or self._warm is None:
+                self.solver.set_rotation(psi)
+            distribution = self.solver.solve(loads, initial=self._predicted())
+            magnitude = self.settings.seal_torque
+            if self.settings.friction_coefficient > 0.0:
+                friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                           omega=1.0, seal_torque=self.settings.seal_torque,
+                                           initial=self._friction_warm, tol=self.settings.friction_tolerance,
+                                           kernel=self.settings.friction_kernel)
+                magnitude = friction.magnitude
+                self._friction_warm = friction.state
+        signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
+        if self.life is not None:
+            self.life.step(None, psi, distribution)
+        self._previous, self._warm = self._warm, distribution.state
+        self._psi = psi
+        self.last = StepResult(distribution, signed, magnitude)
+        return self.last
+
+    def _predicted(self) -> np.ndarray | None:
+        """Warm start of the next solve: the last state extrapolated linearly from
+        the one before (steps of slowly varying inputs: the start error is then of
+        second order in the step; measured, it halves the Newton iterations)."""
+        if self._previous is None or self._warm is None or self._previous.shape != self._warm.shape:
+            return self._warm
+        return 2.0 * self._warm - self._previous
+
+    # ---- state -------------------------------------------------------------------
+    def get_state(self) -> dict:
+        """Everything that affects the next step: the warm start, the rotation and
+        the solver's reused Newton operator (numpy arrays, not copied: they are
+        never changed in place). :func:`encode_state` makes it JSON data."""
+        operator, pending = self.solver.operator, self.solver.pending_operator
+        return {"warm": self._warm, "previous": self._previous, "psi": self._psi,
+                "operator": None if operator is None else operator.as_tuple(),
+                "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm,
+                "life": None if self.life is None else self.life.get_state()}
+
+    def set_state(self, state: dict) -> None:
+        """Restore :meth:`get_state` (or its :func:`decode_state`)."""
+        self._warm = None if state["warm"] is None else np.asarray(state["warm"], dtype=float)
+        self._previous = None if state.get("previous") is None else np.asarray(state["previous"], dtype=float)
+        self._psi = float(state["psi"])
+        self.solver.set_rotation(self._psi)
+        self.solver.operator = None if state["operator"] is None else ReducedOperator.from_tuple(state["operator"])
+        pending = state.get("pending")
+        self.solver.pending_operator = None if pending is None else PendingOperator.from_tuple(pending)
+        self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
+        if self.life is not None and state.get("life") is not None:
+            self.life.set_state(state["life"])
+
+
+def encode_state(value):
+    """JSON-ready copy of a state: numpy arrays become ``{"__array__": dtype, "shape", "data": hex}``
+    (exact, unlike decimal text)."""
+    if isinstance(value, np.ndarray):
+        return {"__array__": value.dtype.str, "shape": list(value.shape), "data": value.tobytes().hex()}
+    if isinstance(value, dict):
+        return {k: encode_state(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [encode_state(v) for v in value]
+    return value
+
+
+def decode_state(value):
+    """Inverse of :func:`encode_state`."""
+    if isinstance(value, dict):
+        if "__array__" in value:
+            return np.frombuffer(bytes.fromhex(value["data"]), dtype=value["__array__"]).reshape(value["shape"]).copy()
+        return {k: decode_state(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [decode_state(v) for v in value]
+    return value
