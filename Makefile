@@ -33,7 +33,7 @@ demo: $(STAMP)
 	$(PY) examples/demo.py
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q --durations=15
 
 # speed figures of the README (several minutes: the FMU memory run takes 100 000 steps)
 bench: $(STAMP)

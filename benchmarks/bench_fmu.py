@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cases import CASES, DT  # noqa: E402
+from cases import CASES, DT, load_case  # noqa: E402
 from timing import print_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -70,7 +70,7 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    case = CASES[case_name](steps)
+    case = load_case(case_name, steps)
     md = read_model_description(fmu_path)
     refs = {v.name: v.valueReference for v in md.modelVariables}
     unzipped = extract(fmu_path)
@@ -141,14 +141,14 @@ def build_current(out: Path) -> dict[str, Path]:
             for name in BEARINGS}
 
 
-def build_baseline(revision: str, out: Path) -> dict[str, Path]:
-    """The FMUs of ``revision``, built by that revision's own build_fmu.py from a git worktree."""
+def build_baseline(revision: str, out: Path, bearings=BEARINGS) -> dict[str, Path]:
+    """The FMUs of ``revision`` (of ``bearings``), built by that revision's own build_fmu.py from a git worktree."""
     tree = out / "baseline_tree"
     subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), revision], check=True,
                    capture_output=True)
     try:
         fmus = {}
-        for name in BEARINGS:
+        for name in bearings:
             fmus[name] = out / f"baseline_{name}.fmu"
             subprocess.run([sys.executable, "build_fmu.py", f"examples/bearings/{name}.toml", "-o", str(fmus[name])],
                            cwd=tree, check=True, capture_output=True)

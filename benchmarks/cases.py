@@ -115,5 +115,32 @@ def table3_light(steps: int) -> Case:
                 {"ring_model": 2, "load_frame": 1}, loads, 0.5 * t, np.full_like(t, 0.5))
 
 
+def saved(path, steps: int | None = None) -> Case:
+    """A case written by :func:`save` (``.npz``): the FMU workers read scenarios made by a parent
+    that may import ``slewing_model`` (an FMU's host process must not: the FMU brings its own)."""
+    import json
+
+    with np.load(path) as data:
+        meta = json.loads(str(data["meta"]))
+        n = len(data["psi"]) if steps is None else min(steps, len(data["psi"]))
+        return Case(meta["name"], meta["description"], Path(meta["bearing"]), meta["parameters"],
+                    data["loads"][:n], data["psi"][:n], data["omega"][:n])
+
+
+def save(case: Case, path) -> Path:
+    """Write ``case`` for :func:`saved`."""
+    import json
+
+    meta = {"name": case.name, "description": case.description, "bearing": str(case.bearing),
+            "parameters": case.parameters}
+    np.savez(path, meta=json.dumps(meta), loads=case.loads, psi=case.psi, omega=case.omega)
+    return Path(path)
+
+
+def load_case(name: str, steps: int) -> Case:
+    """A case of :data:`CASES` by name, or one saved to ``name`` (``.npz``)."""
+    return saved(name, steps) if name.endswith(".npz") else CASES[name](steps)
+
+
 CASES = {"pitch": pitch, "pitch_rigid": lambda n: pitch(n, rigid=True), "yaw": yaw,
          "table3_heavy": table3_heavy, "table3_light": table3_light}

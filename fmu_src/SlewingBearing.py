@@ -84,6 +84,8 @@ def _find_numpy() -> None:
 _find_numpy()
 from xml.etree.ElementTree import Element, SubElement
 
+import numpy as np
+
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Initial, Fmi2Status
 from pythonfmu.default_experiment import DefaultExperiment
@@ -95,6 +97,15 @@ from slewing_model.simulation.simulator import BearingSimulator, decode_state, e
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
     BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
     UNITS, build_simulator, choice_description, integer_default, kernels_of, scalar_outputs, step_or_refuse)
+
+
+def _ball_description(array: str, ball: int, column: int, label: str) -> str:
+    """Description of the scalar output ``ball[ball].label`` (column ``column`` of ``array``)."""
+    if array == "contact_load":
+        return f"contact load of ball {ball}, contact {column + 1}"
+    if array == "contact_angle":
+        return f"loaded contact angle of ball {ball}, diagonal {label[-2]}-{label[-1]}"
+    return f"interference of ball {ball}, diagonal {label[-2]}-{label[-1]} (< 0: gap)"
 
 
 class SlewingBearing(Fmi2Slave):
@@ -135,25 +146,15 @@ class SlewingBearing(Fmi2Slave):
         self.register_variable(Integer(COUNT_OUTPUT[0], causality=Fmi2Causality.output,
                                        variability=Fmi2Variability.discrete, initial=Fmi2Initial.calculated,
                                        description=COUNT_OUTPUT[1]), nested=False)
-        self._q = [[0.0] * 4 for _ in range(n)]
-        self._alpha = [[0.0, 0.0] for _ in range(n)]
-        self._d = [[0.0, 0.0] for _ in range(n)]
-        _, _, q_columns, _, _ = BALL_ARRAYS[0]
+        # per-ball outputs: the result's arrays themselves (replaced each step, never changed in
+        # place), read one value at a time by the host's getReal
+        self._arrays = {name: np.zeros((n, len(columns))) for name, _, columns, _, _ in BALL_ARRAYS}
         for i in range(1, n + 1):
-            for c, label in enumerate(q_columns):
-                self._real(f"ball[{i}].{label}", "N", f"contact load of ball {i}, contact {c + 1}",
-                           Fmi2Causality.output, Fmi2Variability.continuous,
-                           getter=lambda i=i, c=c: self._q[i - 1][c])
-            for k, label in enumerate(BALL_ARRAYS[1][2]):
-                self._real(f"ball[{i}].{label}", "rad",
-                           f"loaded contact angle of ball {i}, diagonal {label[-2]}-{label[-1]}",
-                           Fmi2Causality.output, Fmi2Variability.continuous,
-                           getter=lambda i=i, k=k: self._alpha[i - 1][k])
-            for k, label in enumerate(BALL_ARRAYS[2][2]):
-                self._real(f"ball[{i}].{label}", "m",
-                           f"interference of ball {i}, diagonal {label[-2]}-{label[-1]} (< 0: gap)",
-                           Fmi2Causality.output, Fmi2Variability.continuous,
-                           getter=lambda i=i, k=k: self._d[i - 1][k])
+            for name, unit, columns, _, _ in BALL_ARRAYS:
+                for c, label in enumerate(columns):
+                    self._real(f"ball[{i}].{label}", unit, _ball_description(name, i, c, label),
+                               Fmi2Causality.output, Fmi2Variability.continuous,
+                               getter=lambda name=name, i=i, c=c: float(self._arrays[name][i - 1, c]))
         self.simulator: BearingSimulator | None = None
         self._refused = None  # (time, inputs, tunables) of the last refused step
 
@@ -228,21 +229,20 @@ class SlewingBearing(Fmi2Slave):
         for name, value in scalar_outputs(result, self.simulator).items():
             setattr(self, name, value)
         d = result.distribution
-        self._q = d.contact_load.tolist()
-        self._alpha = d.contact_angle[:, :2].tolist()
-        self._d = d.interference.tolist()
+        for name, _, columns, _, attribute in BALL_ARRAYS:
+            self._arrays[name] = getattr(d, attribute)[:, :len(columns)]
         return True
 
     # ---- FMU state -------------------------------------------------------------------
     def _get_fmu_state(self):
         state = {v.name: v.getter() for v in self.vars.values() if not v.name.startswith("ball[")}
-        state["_q"], state["_alpha"], state["_d"] = self._q, self._alpha, self._d
+        state["_arrays"] = dict(self._arrays)  # the arrays are replaced, never changed in place
         state["_simulator"] = None if self.simulator is None else self.simulator.get_state()
         return state
 
     def _set_fmu_state(self, state):
         state = dict(state)
-        self._q, self._alpha, self._d = state.pop("_q"), state.pop("_alpha"), state.pop("_d")
+        self._arrays = {k: np.asarray(v, dtype=float) for k, v in state.pop("_arrays").items()}
         simulator = state.pop("_simulator")
         self._refused = None
         for v in self.vars.values():

@@ -1,0 +1,142 @@
+"""The pitch bearing FMU against a real-time clock: median, tail and slowest step under the loads
+that make a step slow (issue 31).
+
+Five scenarios, each on the pitch bearing (`examples/bearings/pitch_bearing.toml`, flexible rings,
+friction and life on: the FMU's defaults) with its loads in the blade-root frame (``load_frame`` 2):
+
+1. ``nrel``: the NREL 5MW FAST v8 blade-1 series (`../shared/data/openfast`, 60 s, ψ = −BldPitch1),
+   resampled to the 10 ms step;
+2. ``reversal``: that series' mean load with the tilting moment (Mx, My) reversed in one step every 2 s;
+3. ``jump``: its mean load and 1.5 times it, switched every 2 s;
+4. ``feather``: an emergency feather at 8 deg/s for 4 s and back, under the mean load;
+5. ``turbulence``: the mean load varying by ±30 % at 0.6 Hz plus ±10 % at 3 Hz (every component).
+
+Each FMU (this tree's and a baseline revision's, built by that revision's own build_fmu.py) runs
+in a worker process of its own through fmpy (``bench_fmu.Worker``); their runs of each scenario
+alternate in blocks, so both see the same machine load. A step is ``setReal`` of the 7 inputs,
+``doStep`` (10 ms) and ``getReal`` of 5 outputs. "first step" is the first ``doStep`` after
+instantiation (the FMU solved its start values, zero loads, when leaving initialization).
+
+Goals of issue 31, printed beside the figures: median at most 0.45 of the baseline's, the slowest
+step at most 4 times the NREL median, the first step at most 10 times the median.
+
+Run: .venv/bin/python benchmarks/bench_realtime.py [--baseline REV|none] [--blocks 4]
+     [--scenarios nrel reversal ...]
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_fmu import OUTPUTS, Worker, build_baseline  # noqa: E402
+from cases import DT, Case, save  # noqa: E402
+from timing import print_table  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+OPENFAST = ROOT.parent / "shared/data/openfast/NREL5MW_Land_FASTv8_CertTest18_turb12mps_60s.outb"
+BEARING = ROOT / "examples/bearings/pitch_bearing.toml"
+PARAMETERS = {"ring_model": 2, "load_frame": 2}
+#: the revision before issue 31's work (main at the start of that turn)
+DEFAULT_BASELINE = "f1ef800"
+SCENARIOS = ("nrel", "reversal", "jump", "feather", "turbulence")
+
+
+def nrel_series() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Loads (n, 5), ψ and ω of the NREL 5MW blade 1 at the 10 ms step."""
+    from slewing_model.study.series import from_openfast
+
+    series = from_openfast(str(OPENFAST), bearing="pitch", blade=1)
+    time = np.arange(series.time[0], series.time[-1], DT)
+    loads = np.stack([np.interp(time, series.time, series.loads[:, k]) for k in range(5)], axis=1)
+    return loads, np.interp(time, series.time, series.psi), np.interp(time, series.time, series.omega)
+
+
+def scenario(name: str, duration: float = 20.0) -> Case:
+    """The scenario ``name`` (:data:`SCENARIOS`) as a case of ``duration`` seconds (nrel: the file's 60 s)."""
+    loads, psi, omega = nrel_series()
+    mean, psi0 = loads.mean(axis=0), float(psi.mean())
+    t = np.arange(round(duration / DT)) * DT
+    n = t.size
+    period = np.floor(t / 2.0) % 2 == 1                          # every other 2 s
+    held = np.full(n, psi0), np.zeros(n)
+    if name == "nrel":
+        return Case(name, "NREL 5MW FAST v8 blade 1, 60 s", BEARING, PARAMETERS, loads, psi, omega)
+    if name == "reversal":
+        series = np.tile(mean, (n, 1))
+        series[period, 3:5] *= -1.0
+        return Case(name, "mean load, the moment reversed in one step every 2 s", BEARING, PARAMETERS, series, *held)
+    if name == "jump":
+        series = np.tile(mean, (n, 1)) * np.where(period, 1.5, 1.0)[:, None]
+        return Case(name, "mean load and 1.5 times it, switched every 2 s", BEARING, PARAMETERS, series, *held)
+    if name == "feather":
+        rate = math.radians(8.0)
+        # psi = -pitch: feathering (pitch up) turns psi down for 4 s, then back; 2 s held before, between, after
+        stage = np.clip(t - 2.0, 0.0, 4.0) - np.clip(t - 8.0, 0.0, 4.0)
+        speed = np.where((t >= 2.0) & (t < 6.0), -rate, np.where((t >= 8.0) & (t < 12.0), rate, 0.0))
+        return Case(name, "emergency feather at 8 deg/s for 4 s and back, mean load", BEARING, PARAMETERS,
+                    np.tile(mean, (n, 1)), psi0 - rate * stage, speed)
+    if name == "turbulence":
+        factor = 1.0 + 0.3 * np.sin(2 * np.pi * 0.6 * t) + 0.1 * np.sin(2 * np.pi * 3.0 * t)
+        return Case(name, "mean load +-30 % at 0.6 Hz and +-10 % at 3 Hz", BEARING, PARAMETERS,
+                    mean * factor[:, None], *held)
+    raise ValueError(f"scenario {name!r}: must be one of {', '.join(SCENARIOS)}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--baseline", default=DEFAULT_BASELINE, help="git revision of the baseline FMU, or 'none'")
+    parser.add_argument("--blocks", type=int, default=4, help="alternating blocks per scenario and FMU")
+    parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
+    args = parser.parse_args()
+    if not OPENFAST.exists():
+        sys.exit(f"the NREL 5MW file is not here: {OPENFAST} (../shared/data/openfast, see its README)")
+    sys.path.insert(0, str(ROOT))
+    from build_fmu import build_fmu
+
+    with tempfile.TemporaryDirectory(prefix="bench_realtime_") as tmp:
+        tmp = Path(tmp)
+        fmus = {"current": Path(build_fmu(BEARING, tmp / "current.fmu"))}
+        if args.baseline != "none":
+            fmus["baseline"] = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",))["pitch_bearing"]
+        rows, medians = [], {}
+        for name in args.scenarios:
+            case = scenario(name)
+            path = save(case, tmp / f"{name}.npz")
+            block = case.steps // args.blocks
+            workers = {v: Worker(fmu, str(path), case.steps, outputs=OUTPUTS) for v, fmu in fmus.items()}
+            times = {v: [] for v in fmus}
+            first = {}
+            for b in range(args.blocks):
+                for v, w in workers.items():
+                    t = w.run(b * block, block)["times"]
+                    if b == 0:
+                        first[v] = t[0]
+                        t = t[1:]
+                    times[v] += t
+            for v, w in workers.items():
+                w.close()
+                t = np.array(times[v]) * 1e3
+                medians[name, v] = float(np.median(t))
+                rows.append([name, v, f"{first[v] * 1e3:.1f}", f"{np.median(t):.2f}", f"{np.percentile(t, 99):.2f}",
+                             f"{t.max():.1f}", f"{first[v] * 1e3 / np.median(t):.0f}"])
+            print(f"  {name}: {case.description} ({case.steps} steps)", flush=True)
+        for row in rows:
+            name, v = row[0], row[1]
+            ratio = medians[name, v] / medians[name, "baseline"] if "baseline" in fmus else math.nan
+            slowest = float(row[5]) / medians.get(("nrel", v), math.nan)
+            row += [f"{ratio:.2f}", f"{slowest:.1f}"]
+        print_table("Pitch bearing FMU through fmpy (flexible rings, friction and life on), one step = setReal + "
+                    f"doStep ({DT * 1e3:.0f} ms) + getReal; {args.blocks} alternating blocks per scenario; "
+                    f"baseline {args.baseline}",
+                    ["scenario", "version", "first step [ms]", "median [ms]", "p99 [ms]", "slowest [ms]",
+                     "first / median", "median / baseline's", "slowest / NREL median"], rows)
+
+
+if __name__ == "__main__":
+    main()
