@@ -37,6 +37,7 @@ with that error but not marked finished, so a rerun tries it again.
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import logging
@@ -334,11 +335,51 @@ def _client(workers: int | None, scheduler: str | None):
     # threshold: every temporary of 128 KiB or more (the ring operator's) is then mapped and
     # unmapped, and its page faults made each step 1.6 times slower (measured on the pitch
     # bearing: 12.3 ms against 8.1 ms per step). None unsets it for our workers.
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}), \
+            _sigint_blocked():
+        # no dashboard; the scheduler's HTTP server (health and metrics routes, always started)
+        # on a free port of this machine, not Dask's default 8787, which another Dask may hold:
+        # "Port 8787 is already in use" at every run otherwise
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR)
-    client = Client(cluster)
+                               scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, silence_logs=logging.ERROR)
+        try:
+            client = Client(cluster)
+        except BaseException:
+            cluster.close()
+            raise
     return client, [client, cluster], f"embedded LocalCluster, {n} worker process{'es' if n > 1 else ''}"
+
+
+@contextlib.contextmanager
+def _sigint_blocked():
+    """SIGINT held back (blocked, not lost) in this thread while the embedded cluster starts.
+
+    A terminal's Ctrl-C goes to the whole process group, Dask's worker processes included, and
+    each of them then dies with a traceback. A blocked signal mask is inherited by new threads
+    and, through fork and exec, by new processes: the cluster's event-loop thread, started in
+    here, and every worker process it spawns (also one restarted later, after a worker died)
+    keep SIGINT blocked for good, so Ctrl-C reaches the parent alone, which stops the run and
+    closes the cluster. A Ctrl-C pressed while the cluster starts stays pending here and is
+    delivered (KeyboardInterrupt) when the block is lifted. Where the platform has no signal
+    masks (Windows), nothing changes."""
+    import signal
+    import threading
+
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    # multiprocessing starts its resource tracker at the first spawn, with SIGINT blocked around
+    # it and then unblocked (bpo-33613): that would lift this block in the event-loop thread
+    # before the workers are spawned. Started here first, it is not started again.
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    previous = block(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        block(signal.SIG_SETMASK, previous)
 
 
 def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, workers: int | None = None,
