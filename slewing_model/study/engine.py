@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, one_line, run_case
-from .definition import Case, Study, load_study
+from .definition import Case, Study, StudyDefinitionError, load_study
 from .series import load_series
 
 REQUIRED_COLUMNS = ("case", "status", "friction_torque_mean", "friction_torque_max", "max_ball_load",
@@ -426,6 +426,7 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     if not isinstance(study, Study):
         study = load_study(study)
     out_dir = os.fspath(out_dir)
+    check_files(study)
     cases = study.cases()
     other = _foreign_study(out_dir, study, cases)
     if other is not None:
@@ -466,6 +467,39 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
 
             report.figures = study_figures(out_dir, cases, report.rows)
     return report
+
+
+def check_files(study: Study) -> None:
+    """Every file the study names, checked before anything is run or written: each bearing file
+    read and validated (:func:`~slewing_model.bearing.geometry.load_bearing`), each load file
+    readable. A file that fails would fail every case that uses it, each with the same message.
+
+    Raises
+    ------
+    StudyDefinitionError
+        Naming the study file, the key, each file and what is wrong with it (all of them).
+    """
+    from ..bearing.geometry import BearingDefinitionError, load_bearing
+
+    problems = []
+    for path in dict.fromkeys(v["file"] for v in study.variants):
+        try:
+            load_bearing(path)
+        except OSError as exc:
+            problems.append(f"bearings.files = {path!r}: cannot read the bearing file: {exc.strerror}")
+        except BearingDefinitionError as exc:   # names the file, the key, the value and the rule
+            problems.append(f"bearings.files: {exc}")
+    for kind, path in dict.fromkeys((load["kind"], load["path"]) for load in study.loads if "path" in load):
+        try:
+            with open(path, "rb"):
+                pass
+        except OSError as exc:
+            problems.append(f"loads.{kind} = {path!r}: cannot read the load series: {exc.strerror}")
+    if len(problems) == 1:
+        raise StudyDefinitionError(f"{study.path}: {problems[0]} (nothing was run or written)")
+    if problems:   # one message, a line per file
+        raise StudyDefinitionError(f"{study.path}: {len(problems)} files cannot be used (nothing was run or "
+                                   f"written):\n  " + "\n  ".join(problems))
 
 
 def _finish(out_dir: str, cases: list, records: dict, lost: dict, report: StudyReport) -> None:
