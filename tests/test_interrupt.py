@@ -147,6 +147,43 @@ def test_ctrl_c_to_the_process_group_ends_the_workers_quietly(tmp_path):
     assert f"{len(ok)} already finished" in again.stdout
 
 
+EARLY = """import os, signal, sys
+if __name__ == "__main__":                      # Dask spawns its workers: they import this file
+    import distributed
+
+    class Cluster(distributed.LocalCluster):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            os.killpg(os.getpgid(0), signal.SIGINT)    # Ctrl-C while the cluster is starting
+    distributed.LocalCluster = Cluster
+    from slewing_model.cli import main
+    sys.exit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process group from /proc (Linux)")
+def test_ctrl_c_while_the_cluster_starts_is_kept_and_ends_the_run_quietly(tmp_path):
+    """A Ctrl-C to the process group just as the embedded cluster has started (its workers up,
+    before the first case): held back until the cluster is ours to close, then the same one line
+    and exit 130, and nothing of the cluster left running."""
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY)
+    script = tmp_path / "early.py"
+    script.write_text(EARLY)
+    p = subprocess.Popen([sys.executable, str(script), "batch", str(study), "-o", str(tmp_path / "out"), "--workers",
+                          "2", "--quiet", "--no-figures"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         cwd=ROOT, start_new_session=True, preexec_fn=_default_sigint)
+    out, err = p.communicate(timeout=300)
+    assert p.returncode == 130, err
+    assert [line for line in (out + err).splitlines() if line.strip()] == [
+        f"slewing batch: interrupted; 0 of 40 cases finished, summary: {tmp_path / 'out' / 'summary.csv'} "
+        f"(the same command resumes)"], out + err
+    deadline = time.monotonic() + 30
+    while _group_members(p.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _group_members(p.pid)
+
+
 def _group_members(group):
     """The live (not zombie) processes of a process group, from /proc."""
     members = []

@@ -317,15 +317,17 @@ class _Prepared:
 
 # ---- the run ------------------------------------------------------------------------------------
 
-def _client(workers: int | None, scheduler: str | None):
-    """A Dask client and what to close afterwards."""
+def _client(workers: int | None, scheduler: str | None, owned: list):
+    """A Dask client and what it runs on; what the caller closes afterwards is appended to
+    ``owned`` as it is made (the cluster before its client), so that a Ctrl-C pressed while the
+    cluster starts, delivered as this returns, leaves nothing open."""
     from distributed import Client, LocalCluster
 
     if scheduler:
         if workers is not None:
             raise ValueError(f"--workers {workers}: applies to the embedded cluster only, not with --scheduler")
-        client = Client(scheduler)
-        return client, [client], f"Dask cluster at {scheduler}"
+        owned.append(Client(scheduler))
+        return owned[-1], f"Dask cluster at {scheduler}"
     n = (os.cpu_count() or 1) if workers is None else workers
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ValueError(f"--workers {workers!r}: must be a whole number >= 1")
@@ -340,14 +342,11 @@ def _client(workers: int | None, scheduler: str | None):
         # no dashboard; the scheduler's HTTP server (health and metrics routes, always started)
         # on a free port of this machine, not Dask's default 8787, which another Dask may hold:
         # "Port 8787 is already in use" at every run otherwise
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, silence_logs=logging.ERROR)
-        try:
-            client = Client(cluster)
-        except BaseException:
-            cluster.close()
-            raise
-    return client, [client, cluster], f"embedded LocalCluster, {n} worker process{'es' if n > 1 else ''}"
+        owned.append(LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                                  silence_logs=logging.ERROR))
+        owned.append(Client(owned[-1]))
+    return owned[-1], f"embedded LocalCluster, {n} worker process{'es' if n > 1 else ''}"
 
 
 @contextlib.contextmanager
@@ -524,17 +523,17 @@ def _run_pending(out_dir, pending, study, records, lost, report, workers, schedu
     if tasks:
         from distributed import as_completed
 
-        owned = []
-        if client is None:
-            client, owned, report.cluster = _client(workers, scheduler)
-        else:
-            report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
+        owned = []    # what this run started, closed last made first (the client, then its cluster)
         bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
         try:
+            if client is None:
+                client, report.cluster = _client(workers, scheduler, owned)
+            else:
+                report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
+            if progress:
+                from tqdm import tqdm
+
+                bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
             by_key = {}
             start = time.perf_counter()
             futures = []
@@ -560,5 +559,5 @@ def _run_pending(out_dir, pending, study, records, lost, report, workers, schedu
         finally:
             if bar is not None:
                 bar.close()
-            for thing in owned:
+            for thing in reversed(owned):
                 thing.close()
