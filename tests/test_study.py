@@ -157,7 +157,8 @@ def test_case_statistics_agree_with_independent_computation(tmp_path):
 def cluster():
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as c:
         yield c
 
 
@@ -234,7 +235,8 @@ def test_killed_worker_cases_complete(tmp_path):
         os.kill(pid, signal.SIGKILL)
         killed.update(worker=worker, keys=[k.removeprefix("slewing-case-") for k in keys], pid=pid)
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
             Client(cluster) as client:
         report = run_study(path, tmp_path / "out", client=client, progress=False, figures=False,
                            on_result=kill_a_busy_worker)
