@@ -40,7 +40,7 @@ from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
-              runtime="standalone", numba=None) -> Path:
+              runtime="standalone", numba=None, stage=None) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -62,7 +62,11 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     numba : bool, optional
         Carry numba and the compiled loops (steps about 4 times faster, the FMU about 4 times
         larger: 87 MB against 22 MB for the pitch bearing). Default: where numba is installed here.
+    stage : callable, optional
+        Called with one line as each stage of the build begins (e.g. ``print``): the build is
+        silent for minutes otherwise on a fresh machine (the superelement, numba's compilation).
     """
+    say = stage or (lambda line: None)
     if fmi_version not in (2, 3):
         raise ValueError(f"fmi_version = {fmi_version!r}: must be 2 or 3")
     numba = resolve_numba(runtime, numba)
@@ -72,7 +76,10 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(bearing_file)
+    say(f"building the ring superelement of {Path(bearing_file).name} ({mesh} mesh, {bc} rings; "
+        f"read from the cache when built before) ...")
     superelement = build_superelement(bearing, mesh=mesh, bc=bc, progress=progress)
+    say(f"packaging the FMU (FMI {fmi_version}.0, pythonfmu{'3' if fmi_version == 3 else ''}) ...")
     stem = "SlewingBearing3" if fmi_version == 3 else "SlewingBearing"
     output = Path(output) if output else ROOT / "build" / f"{stem}_{Path(bearing_file).stem}.fmu"
     output.parent.mkdir(parents=True, exist_ok=True)
@@ -98,8 +105,10 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                 needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
             )
-    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba)
+    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, stage=say)
     if numba:
+        say("compiling the loops with numba for this CPU and for any x86-64 CPU (about two minutes the "
+            "first time on a machine, then read from numba's cache) ...")
         ship_compiled_kernels(built)
     return Path(built)
 
@@ -252,7 +261,8 @@ def python_runtime() -> dict[str, str]:
             "environment": sys.prefix}
 
 
-def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False) -> dict:
+def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False,
+                        stage=None) -> dict:
     """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
     for a standalone FMU the Python runtime beside it.
 
@@ -261,7 +271,9 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
     describes before it: the runtime the FMU carries (``binaries/<platform>/python``,
     :mod:`build_runtime`), or for ``runtime="host"`` the building Python. The file also states the
     FMU's glibc floor: the newest glibc version any of its Linux binaries needs. The Windows
-    binary is left as pythonfmu wrote it. Returns what the file says, as a dict."""
+    binary is left as pythonfmu wrote it. Returns what the file says, as a dict. ``stage``, where
+    given, is called with one line as each stage begins (as in :func:`build_fmu`)."""
+    say = stage or (lambda line: None)
     if runtime not in RUNTIMES:
         raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
     fmu = Path(fmu)
@@ -269,6 +281,7 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
     binary = f"{folder}/{model_identifier}.so"
     with tempfile.TemporaryDirectory(prefix="slewing_shim_") as tmp:
         tmp = Path(tmp)
+        say("compiling the FMU's Linux binary (C compiler) ...")
         shim = compile_shim(tmp / f"{model_identifier}.so", fmi_version)
         rewritten = tmp / "rewritten.fmu"
         with zipfile.ZipFile(fmu) as src:
@@ -280,6 +293,8 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
             if runtime == "standalone":
                 from build_runtime import runtime as bundled_runtime
 
+                say(f"staging the FMU's Python runtime (the interpreter, its standard library, numpy"
+                    f"{', numba' if numba else ''}; read from its cache when staged before) ...")
                 carried = bundled_runtime(folder, numba=numba)
                 shutil.copy2(carried.archive, rewritten)        # the runtime's entries, compressed once
                 described = {"runtime": "standalone", "folder": "python", "library": carried.library,
@@ -357,7 +372,8 @@ def main(argv=None) -> int:
     if args.bearing is None:
         parser.error("the bearing definition is required")
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
-                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba)
+                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba,
+                     stage=lambda line: print(line, flush=True))
     print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")
     print(describe_fmu(path))
     return 0

@@ -73,7 +73,7 @@ def run(study: Path, out: Path, workers: int) -> dict:
     # MALLOC_TRIM_THRESHOLD_, whose page faults make every step 1.6 times slower
     with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}), \
             LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                         silence_logs=40) as cluster, Client(cluster) as client:
+                         scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, silence_logs=40) as cluster, Client(cluster) as client:
         started = time.perf_counter() - start
         report = run_study(study, out, client=client, progress=False, figures=False)
     assert not report.failed, report.failed

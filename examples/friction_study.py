@@ -104,7 +104,7 @@ def preload_figure(out, quick):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "torque_vs_preload.png", dpi=130)
+    fig.savefig(out / "torque_vs_preload.png", dpi=130, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -113,7 +113,9 @@ def psi_figure(out, quick):
     bearing = bearing.with_errors(_errors(bearing, 1))
     psi = np.linspace(0.0, 2 * np.pi, 73 if quick else 361)
     superelement, why = flexible_superelement(bearing)
-    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6.3), sharex=True, layout="constrained")
+    # what both panels share, once above them (a title of its own per panel ran past the figure)
+    fig.suptitle(f"{bearing.name}, preload 10 um\n{ERRORS_TEXT} (seed 1)", fontsize=9)
     for ax, (label, loads) in zip(axes, (("idling", None), ("axial 100 kN", Loads(Fz=100e3)))):
         for model, colour in (("rigid", "tab:blue"), ("flexible", "tab:red")):
             if model == "flexible" and superelement is None:
@@ -124,12 +126,11 @@ def psi_figure(out, quick):
             ax.plot(np.degrees(psi), t, color=colour, lw=1,
                     label=f"{model}: mean {t.mean():.1f} N m, ripple {np.ptp(t) / t.mean() * 100:.0f} %")
         ax.set_ylabel("friction torque, N m")
-        ax.set_title(f"{label}, preload 10 um, {ERRORS_TEXT} (seed 1)", fontsize=8)
+        ax.set_title(label, fontsize=9)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     axes[-1].set_xlabel("rotation of the moving ring psi, deg (cage at the rolling ratio)")
-    fig.tight_layout()
-    fig.savefig(out / "torque_vs_psi.png", dpi=130)
+    fig.savefig(out / "torque_vs_psi.png", dpi=130, bbox_inches="tight")
     plt.close(fig)
 
 

@@ -29,15 +29,28 @@ def command(t: float) -> float:
     return math.radians(STEP_DEG) if T_ON <= t < T_OFF else 0.0
 
 
+def stage(line: str) -> None:
+    """One line as a stage begins (the FMU's build is silent for minutes on a fresh machine)."""
+    print(line, flush=True)
+
+
 def run(results: Path, *, ring_model: int = 2, progress: bool = True):
-    """Both manoeuvres (with and without bearing friction); returns the two results."""
-    fmu = build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", ROOT / "build/SlewingBearing_pitch_bearing.fmu")
+    """Both manoeuvres (with and without bearing friction); returns the two results. With
+    ``progress``, a line as each stage begins and a progress bar for each co-simulation."""
+    say = stage if progress else None
+    fmu = build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", ROOT / "build/SlewingBearing_pitch_bearing.fmu",
+                    stage=say)
     drive = DriveParameters.from_toml(ROOT / "examples/drives/pitch_drive.toml")
     loads = LoadSeries.read_csv(ROOT / "examples/loads/blade_root_loads.csv")
     # blade-root loads turn with the blade: load_frame = 2 (rotating)
     start = {"load_frame": 2, "ring_model": ring_model, "friction_coefficient": 0.1}
+    steps = round(T_END / DT)
+    if say:
+        say(f"co-simulating the pitch manoeuvre with the bearing's friction ({steps} steps of {DT * 1e3:g} ms) ...")
     with_friction = run_manoeuvre(fmu, drive, loads, command, t_end=T_END, dt=DT, start_values=start,
                                   progress=progress)
+    if say:
+        say(f"co-simulating it again with the friction off ({steps} steps) ...")
     without = run_manoeuvre(fmu, drive, loads, command, t_end=T_END, dt=DT, start_values=start, friction=False,
                             progress=progress)
     results.mkdir(parents=True, exist_ok=True)

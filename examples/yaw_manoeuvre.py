@@ -34,7 +34,8 @@ def main(argv=None) -> int:
     parser.add_argument("--results", default=str(ROOT / "results"))
     args = parser.parse_args(argv)
     results = Path(args.results)
-    fmu = build_fmu(ROOT / "examples/bearings/yaw_bearing.toml", ROOT / "build/SlewingBearing_yaw_bearing.fmu")
+    fmu = build_fmu(ROOT / "examples/bearings/yaw_bearing.toml", ROOT / "build/SlewingBearing_yaw_bearing.fmu",
+                    stage=lambda line: print(line, flush=True))     # a line as each stage of the build begins
     drive = DriveParameters.from_toml(ROOT / "examples/drives/yaw_drive.toml")
     loads = LoadSeries.read_csv(ROOT / "examples/loads/tower_top_loads.csv")
     # tower-top loads turn with the nacelle (the inner ring): load_frame = 2 (rotating)

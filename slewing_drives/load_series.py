@@ -141,8 +141,13 @@ class LoadSeries:
                 raise ValueError(f"{path}, line {n}: {len(header)} finite numbers expected")
             data.append(values)
         data = np.array(data)
-        if len(data) < 2 or np.any(np.diff(data[:, 0]) <= 0):
-            raise ValueError(f"{path}: at least two rows with strictly increasing time are needed")
+        if len(data) < 2:
+            raise ValueError(f"{path}: at least two rows with strictly increasing time are needed, found {len(data)}")
+        stop = np.flatnonzero(np.diff(data[:, 0]) <= 0)
+        if stop.size:        # the file's line where time stops increasing (comment and blank lines counted)
+            k = int(stop[0]) + 1
+            raise ValueError(f"{path}, line {numbers[k + 1]}: time = {data[k, 0]:.10g} s after {data[k - 1, 0]:.10g} s "
+                             f"on line {numbers[k]}: time must be strictly increasing (rows out of order, or repeated?)")
         loads = np.zeros((len(data), 6))
         n_loads = min(len(header), 7) - 1                       # 5 without Mz, else 6
         loads[:, :n_loads] = data[:, 1:1 + n_loads]

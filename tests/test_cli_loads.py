@@ -65,7 +65,7 @@ def test_loads_command_writes_the_series_of_the_library(tmp_path):
     names = ["Time", "RootFxb1", "RootFyb1", "RootFzb1", "RootMxb1", "RootMyb1", "RootMzb1", "BldPitch1"]
     units = ["s", "kN", "kN", "kN", "kN·m", "kN·m", "kN·m", "deg"]
     src = write_binary(tmp_path / "run.outb", t, names, units, np.column_stack([b, pitch]), 2)
-    csv = tmp_path / "loads.csv"
+    csv = tmp_path / "results" / "loads.csv"          # a folder not made yet, as results/ in a fresh clone
     out = _run("loads", str(src), "--bearing", "pitch", "--blade", "1", "--mounting", "hub", "--start", "1",
                "--end", "3", "-o", str(csv))
     assert out.returncode == 0, out.stderr

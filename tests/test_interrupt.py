@@ -3,7 +3,10 @@ stderr, exit status 130 (128 + SIGINT, as a shell reports a command it interrupt
 study a valid ``summary.csv`` of the cases finished so far, which a rerun resumes."""
 import csv
 import glob
+import os
+import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -37,9 +40,17 @@ waviness_orders = [2, 3]
 """
 
 
+def _default_sigint():
+    """In the child before exec: SIGINT's default action, as a shell gives a command it runs in a
+    terminal (a command started in the background of a script, as this suite may be, inherits
+    SIGINT ignored, and Python would then never see the Ctrl-C these tests send)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _interrupt_after(command, ready, timeout=120):
     """Start ``command``, send SIGINT once ``ready()`` holds; (rc, stdout, stderr)."""
-    p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+                         preexec_fn=_default_sigint)
     start = time.monotonic()
     while not ready():
         assert p.poll() is None, p.communicate()
@@ -73,12 +84,129 @@ def test_interrupted_batch_leaves_a_summary_of_the_finished_cases_and_resumes(tm
     assert f"{len(ok)} already finished" in again.stdout
 
 
+def _hold_port(port):
+    """A socket listening on ``port`` of this machine (None when another process holds it already):
+    the port is taken either way, as when another Dask runs beside the study."""
+    sock = socket.socket()
+    try:
+        sock.bind(("127.0.0.1", port))
+        sock.listen()
+    except OSError:
+        sock.close()
+        return None
+    return sock
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process group from /proc (Linux)")
+def test_ctrl_c_to_the_process_group_ends_the_workers_quietly(tmp_path):
+    """A terminal's Ctrl-C goes to the whole process group: the parent and Dask's worker processes.
+    The workers must end without a word (before: a traceback of each, 68-100 lines), the parent
+    prints its one line, exit 130, summary.csv of the finished cases, and no process of the group
+    is left behind. Dask's default dashboard port is held meanwhile, as when another Dask runs:
+    no "Port 8787 is already in use" warning either (issue 28)."""
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY)
+    out_dir = tmp_path / "out"
+    command = [SLEWING, "batch", str(study), "-o", str(out_dir), "--workers", "2", "--quiet", "--no-figures"]
+    finished = lambda: glob.glob(str(out_dir / "cases" / "*" / "result.json"))  # noqa: E731
+    port = _hold_port(8787)
+    try:
+        # its own session and process group, as a shell starts a command in a terminal
+        p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+                             start_new_session=True, preexec_fn=_default_sigint)
+        start = time.monotonic()
+        while len(finished()) < 3:                                  # the workers are running cases
+            assert p.poll() is None, p.communicate()
+            assert time.monotonic() - start < 180
+            time.sleep(0.05)
+        group = os.getpgid(p.pid)
+        assert group == p.pid
+        workers = [pid for pid in _group_members(group) if pid != p.pid]
+        assert len(workers) >= 2                                   # the worker processes are in the group
+        os.killpg(group, signal.SIGINT)
+        out, err = p.communicate(timeout=120)
+    finally:
+        if port is not None:
+            port.close()
+    assert p.returncode == 130, err
+    printed = (out + err).splitlines()
+    assert not [line for line in printed if re.search(r"Traceback|Exception ignored|Error|Warning|already in use",
+                                                         line)], out + err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("slewing batch: interrupted;"), err
+    with open(out_dir / "summary.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ok = {r["case"] for r in rows if r["status"] == "ok"}
+    assert len(rows) == 40 and ok == {Path(f).parent.name for f in finished()} and len(ok) >= 3
+    deadline = time.monotonic() + 30                                # and no worker outlives the run
+    while _group_members(group) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _group_members(group)
+    again = subprocess.run(command, capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"{len(ok)} already finished" in again.stdout
+
+
+EARLY = """import os, signal, sys
+if __name__ == "__main__":                      # Dask spawns its workers: they import this file
+    import distributed
+
+    class Cluster(distributed.LocalCluster):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            os.killpg(os.getpgid(0), signal.SIGINT)    # Ctrl-C while the cluster is starting
+    distributed.LocalCluster = Cluster
+    from slewing_model.cli import main
+    sys.exit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process group from /proc (Linux)")
+def test_ctrl_c_while_the_cluster_starts_is_kept_and_ends_the_run_quietly(tmp_path):
+    """A Ctrl-C to the process group just as the embedded cluster has started (its workers up,
+    before the first case): held back until the cluster is ours to close, then the same one line
+    and exit 130, and nothing of the cluster left running."""
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY)
+    script = tmp_path / "early.py"
+    script.write_text(EARLY)
+    p = subprocess.Popen([sys.executable, str(script), "batch", str(study), "-o", str(tmp_path / "out"), "--workers",
+                          "2", "--quiet", "--no-figures"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         cwd=ROOT, start_new_session=True, preexec_fn=_default_sigint)
+    out, err = p.communicate(timeout=300)
+    assert p.returncode == 130, err
+    assert [line for line in (out + err).splitlines() if line.strip()] == [
+        f"slewing batch: interrupted; 0 of 40 cases finished, summary: {tmp_path / 'out' / 'summary.csv'} "
+        f"(the same command resumes)"], out + err
+    deadline = time.monotonic() + 30
+    while _group_members(p.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _group_members(p.pid)
+
+
+def _group_members(group):
+    """The live (not zombie) processes of a process group, from /proc."""
+    members = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as fh:
+                fields = fh.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == group and fields[0] != "Z":            # state, ppid, pgrp
+            members.append(int(entry))
+    return members
+
+
 def test_interrupted_superelement_build_prints_one_line(tmp_path):
     # the fine mesh builds for several seconds: interrupted once the progress bar has started
     err_file = tmp_path / "err.txt"
     command = [SLEWING, "superelement", TABLE3, "--mesh", "fine", "--no-cache", "-o", str(tmp_path / "se.npz")]
     with open(err_file, "w") as err_fh:
-        p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=err_fh, text=True, cwd=ROOT)
+        p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=err_fh, text=True, cwd=ROOT,
+                             preexec_fn=_default_sigint)
         start = time.monotonic()
         while "%" not in err_file.read_text():                # tqdm's bar: the build has begun
             assert p.poll() is None, err_file.read_text()

@@ -157,7 +157,8 @@ def test_case_statistics_agree_with_independent_computation(tmp_path):
 def cluster():
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as c:
         yield c
 
 
@@ -180,22 +181,20 @@ def test_bad_cases_are_reported_and_the_others_finish(tmp_path, capsys):
 
     garbled = tmp_path / "garbled.csv"
     garbled.write_text("time,Fx,Fy,Fz,Mx,My\n0,0,0,1e4,0,0\n1,0,0,lots,0,0\n")
-    extra = (f'[[loads]]\ncsv = "{(tmp_path / "absent.csv").as_posix()}"\n'
-             f'[[loads]]\ncsv = "{garbled.as_posix()}"\n' + idling("crushing", 5, fz=5e8))
+    extra = f'[[loads]]\ncsv = "{garbled.as_posix()}"\n' + idling("crushing", 5, fz=5e8)
     path = write_study(tmp_path, idling("idle", 5), seeds=(1,), extra_loads=extra)
     code = main(["batch", str(path), "-o", str(tmp_path / "out"), "--workers", "2", "--quiet"])
     assert code == 1
     rows = {(r["load"], r["preload_um"]): r for r in summary(tmp_path / "out")}
-    assert len(rows) == 4 * 2
+    assert len(rows) == 3 * 2
     for preload in ("0.0", "20.0"):
         assert rows[("idle", preload)]["status"] == "ok"
-        assert "absent.csv" in rows[("absent", preload)]["status"] and "No such file" in rows[("absent", preload)]["status"]
         assert "line 3, column Fz = 'lots'" in rows[("garbled", preload)]["status"]
         assert rows[("crushing", preload)]["status"].startswith("LoadCapacityError at t = 0 s")
         assert rows[("crushing", preload)]["friction_torque_max"] == ""
     assert all("\n" not in r["status"] for r in rows.values())
     printed = capsys.readouterr()
-    assert "6 failed" in printed.out
+    assert "4 failed" in printed.out
     # each failure names the study file and the case (issue 25)
     assert f"{path}: case " in printed.err and "(garbled | table3" in printed.err
 
@@ -236,7 +235,8 @@ def test_killed_worker_cases_complete(tmp_path):
         os.kill(pid, signal.SIGKILL)
         killed.update(worker=worker, keys=[k.removeprefix("slewing-case-") for k in keys], pid=pid)
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
             Client(cluster) as client:
         report = run_study(path, tmp_path / "out", client=client, progress=False, figures=False,
                            on_result=kill_a_busy_worker)
@@ -284,3 +284,42 @@ def test_superelement_built_once_per_bearing_variant(tmp_path):
     assert len(flexible) == 8 and all(se is flexible[0] for se in flexible)
     assert all(t.superelement is None for t in tasks if t.variant["ring_model"] == "rigid")
     flexible[0].check(load_bearing(TABLE3))              # built for this bearing
+
+
+# ---- the files a study names are checked before anything runs (issue 28) ----------------------------
+
+def test_missing_bearing_file_is_refused_up_front_with_one_message(tmp_path, capsys):
+    """Before: each of the study's cases failed with the same ValueError (8 lines), exit 1, and
+    the output folder was left behind. Now: one message naming the key and the file, exit 2
+    (a bad study), and nothing written."""
+    from slewing_model.cli import main
+
+    absent = tmp_path / "no_such_bearing.toml"
+    path = write_study(tmp_path, idling("idle", 5) + idling("axial", 5, fz=3e4), seeds=(1, 2))
+    path.write_text(path.read_text().replace(f'files = ["{TABLE3.as_posix()}"]',
+                                             f'files = ["{TABLE3.as_posix()}", "{absent.as_posix()}"]'))
+    assert len(load_study(path).cases()) == 2 * 2 * 2 * 2                # loads x files x preloads x seeds
+    out_dir = tmp_path / "out"
+    assert main(["batch", str(path), "-o", str(out_dir), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.count("no_such_bearing.toml") == 1, err
+    assert f"bearings.files = '{absent}'" in err and "No such file or directory" in err
+    assert not out_dir.exists()
+
+
+def test_every_bad_file_of_a_study_is_named_in_one_message(tmp_path, capsys):
+    from slewing_model.cli import main
+
+    broken = tmp_path / "broken.toml"
+    broken.write_text(TABLE3.read_text().replace("ball_count = ", "ball_count = -"))
+    absent_loads = tmp_path / "absent.csv"
+    path = write_study(tmp_path, f'[[loads]]\ncsv = "{absent_loads.as_posix()}"\n' + idling("idle", 5), seeds=(1,))
+    path.write_text(path.read_text().replace(f'files = ["{TABLE3.as_posix()}"]', f'files = ["{broken.as_posix()}"]'))
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()                                                      # an existing folder stays untouched
+    assert main(["batch", str(path), "-o", str(out_dir), "--workers", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "2 files cannot be used" in err
+    assert f"loads.csv = '{absent_loads}': cannot read the load series: No such file or directory" in err
+    assert f"{broken}: bearing.ball_count = -" in err                  # the bearing file's own message
+    assert list(out_dir.iterdir()) == []

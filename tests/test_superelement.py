@@ -367,3 +367,22 @@ def test_command_writes_the_file_and_prints_a_summary(tmp_path, cache, capsys):
     assert "B = 67" in text and "X,Y,Z,rx,ry" in text and "time" in text
     assert Superelement.load(out).outer.ball_count == 67
     assert command_main([str(tmp_path / "missing.toml"), "-o", str(out), "--quiet"]) == 2
+
+
+def test_fine_section_mesh_is_built_without_scikit_fem_warnings(caplog):
+    """The yaw bearing's fine outer-ring mesh has over 1000 elements: scikit-fem logged
+    "Transforming over 1000 elements to C_CONTIGUOUS." for it (the yaw example's stray line,
+    issue 28) when given the element table transposed."""
+    import logging
+
+    from slewing_model import load_bearing
+
+    from pathlib import Path
+
+    bearing = load_bearing(Path(__file__).resolve().parents[1] / "examples" / "bearings" / "yaw_bearing.toml")
+    with caplog.at_level(logging.DEBUG, logger="skfem"):
+        meshes = [mesh_section(ring_profile(bearing, ring), [cp.patch_size(bearing, c)[0] for c in contacts], "fine")
+                  for ring, contacts in (("outer", (1, 4)), ("inner", (2, 3)))]
+    assert max(sm.mesh.t.shape[1] for sm in meshes) > 1000
+    assert [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING] == []
+    assert all(sm.mesh.t.flags["C_CONTIGUOUS"] and sm.mesh.p.flags["C_CONTIGUOUS"] for sm in meshes)

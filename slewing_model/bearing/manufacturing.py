@@ -188,9 +188,13 @@ def read_ring_csv(path: str | os.PathLike, ring: str) -> RingErrorMap:
             raise BearingDefinitionError(f"{path}, line {n}: {len(row)} values for {len(header)} columns")
         for col, text in zip(header, row):
             data[col].append(_float(path, n, col, text))
-    angle = np.radians(data["angle_deg"])
-    if np.any(np.diff(angle) <= 0) or angle[0] < 0 or angle[-1] >= 2 * np.pi:
-        raise BearingDefinitionError(f"{path}: column 'angle_deg' must be strictly increasing within [0, 360)")
+    degrees = data["angle_deg"]
+    for k, (n, _) in enumerate(rows):   # the file's line of the first angle out of place
+        if not 0.0 <= degrees[k] < 360.0 or (k > 0 and degrees[k] <= degrees[k - 1]):
+            after = f" after {degrees[k - 1]:.10g} on line {rows[k - 1][0]}" if k > 0 else ""
+            raise BearingDefinitionError(f"{path}, line {n}, column angle_deg = {degrees[k]:.10g}{after}: "
+                                         f"must be strictly increasing within [0, 360)")
+    angle = np.radians(degrees)
     radial = np.column_stack([data[f"radial_um_{c}"] for c in contacts]) * _UM
     axial = np.column_stack([data[f"axial_um_{c}"] for c in contacts]) * _UM
     rc = None

@@ -56,6 +56,13 @@ class Loads:
             if not math.isfinite(value):
                 raise ValueError(f"load {name} = {value!r}: must be finite (not NaN or infinite)")
 
+    def __str__(self) -> str:
+        """The load for a title or a message, in kN and kN m: the components that are not zero
+        (``"Fz = 800 kN, My = 1200 kN m"``), or ``"no load"``."""
+        parts = [f"{name} = {getattr(self, name) / 1e3:.4g} {'kN' if name[0] == 'F' else 'kN m'}"
+                 for name in LOAD_FIELDS if getattr(self, name) != 0]
+        return ", ".join(parts) or "no load"
+
     @classmethod
     def from_paper(cls, axial: float = 0.0, radial: float = 0.0, tilting_moment: float = 0.0,
                    direction: float = 0.0) -> "Loads":

@@ -37,6 +37,7 @@ with that error but not marked finished, so a rerun tries it again.
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import logging
@@ -47,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, one_line, run_case
-from .definition import Case, Study, load_study
+from .definition import Case, Study, StudyDefinitionError, load_study
 from .series import load_series
 
 REQUIRED_COLUMNS = ("case", "status", "friction_torque_mean", "friction_torque_max", "max_ball_load",
@@ -316,15 +317,17 @@ class _Prepared:
 
 # ---- the run ------------------------------------------------------------------------------------
 
-def _client(workers: int | None, scheduler: str | None):
-    """A Dask client and what to close afterwards."""
+def _client(workers: int | None, scheduler: str | None, owned: list):
+    """A Dask client and what it runs on; what the caller closes afterwards is appended to
+    ``owned`` as it is made (the cluster before its client), so that a Ctrl-C pressed while the
+    cluster starts, delivered as this returns, leaves nothing open."""
     from distributed import Client, LocalCluster
 
     if scheduler:
         if workers is not None:
             raise ValueError(f"--workers {workers}: applies to the embedded cluster only, not with --scheduler")
-        client = Client(scheduler)
-        return client, [client], f"Dask cluster at {scheduler}"
+        owned.append(Client(scheduler))
+        return owned[-1], f"Dask cluster at {scheduler}"
     n = (os.cpu_count() or 1) if workers is None else workers
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise ValueError(f"--workers {workers!r}: must be a whole number >= 1")
@@ -334,11 +337,48 @@ def _client(workers: int | None, scheduler: str | None):
     # threshold: every temporary of 128 KiB or more (the ring operator's) is then mapped and
     # unmapped, and its page faults made each step 1.6 times slower (measured on the pitch
     # bearing: 12.3 ms against 8.1 ms per step). None unsets it for our workers.
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR)
-    client = Client(cluster)
-    return client, [client, cluster], f"embedded LocalCluster, {n} worker process{'es' if n > 1 else ''}"
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}), \
+            _sigint_blocked():
+        # no dashboard; the scheduler's HTTP server (health and metrics routes, always started)
+        # on a free port of this machine, not Dask's default 8787, which another Dask may hold:
+        # "Port 8787 is already in use" at every run otherwise
+        owned.append(LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                                  silence_logs=logging.ERROR))
+        owned.append(Client(owned[-1]))
+    return owned[-1], f"embedded LocalCluster, {n} worker process{'es' if n > 1 else ''}"
+
+
+@contextlib.contextmanager
+def _sigint_blocked():
+    """SIGINT held back (blocked, not lost) in this thread while the embedded cluster starts.
+
+    A terminal's Ctrl-C goes to the whole process group, Dask's worker processes included, and
+    each of them then dies with a traceback. A blocked signal mask is inherited by new threads
+    and, through fork and exec, by new processes: the cluster's event-loop thread, started in
+    here, and every worker process it spawns (also one restarted later, after a worker died)
+    keep SIGINT blocked for good, so Ctrl-C reaches the parent alone, which stops the run and
+    closes the cluster. A Ctrl-C pressed while the cluster starts stays pending here and is
+    delivered (KeyboardInterrupt) when the block is lifted. Where the platform has no signal
+    masks (Windows), nothing changes."""
+    import signal
+    import threading
+
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    # multiprocessing starts its resource tracker at the first spawn, with SIGINT blocked around
+    # it and then unblocked (bpo-33613): that would lift this block in the event-loop thread
+    # before the workers are spawned. Started here first, it is not started again.
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    previous = block(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        block(signal.SIG_SETMASK, previous)
 
 
 def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, workers: int | None = None,
@@ -385,6 +425,7 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     if not isinstance(study, Study):
         study = load_study(study)
     out_dir = os.fspath(out_dir)
+    check_files(study)
     cases = study.cases()
     other = _foreign_study(out_dir, study, cases)
     if other is not None:
@@ -427,6 +468,39 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     return report
 
 
+def check_files(study: Study) -> None:
+    """Every file the study names, checked before anything is run or written: each bearing file
+    read and validated (:func:`~slewing_model.bearing.geometry.load_bearing`), each load file
+    readable. A file that fails would fail every case that uses it, each with the same message.
+
+    Raises
+    ------
+    StudyDefinitionError
+        Naming the study file, the key, each file and what is wrong with it (all of them).
+    """
+    from ..bearing.geometry import BearingDefinitionError, load_bearing
+
+    problems = []
+    for path in dict.fromkeys(v["file"] for v in study.variants):
+        try:
+            load_bearing(path)
+        except OSError as exc:
+            problems.append(f"bearings.files = {path!r}: cannot read the bearing file: {exc.strerror}")
+        except BearingDefinitionError as exc:   # names the file, the key, the value and the rule
+            problems.append(f"bearings.files: {exc}")
+    for kind, path in dict.fromkeys((load["kind"], load["path"]) for load in study.loads if "path" in load):
+        try:
+            with open(path, "rb"):
+                pass
+        except OSError as exc:
+            problems.append(f"loads.{kind} = {path!r}: cannot read the load series: {exc.strerror}")
+    if len(problems) == 1:
+        raise StudyDefinitionError(f"{study.path}: {problems[0]} (nothing was run or written)")
+    if problems:   # one message, a line per file
+        raise StudyDefinitionError(f"{study.path}: {len(problems)} files cannot be used (nothing was run or "
+                                   f"written):\n  " + "\n  ".join(problems))
+
+
 def _finish(out_dir: str, cases: list, records: dict, lost: dict, report: StudyReport) -> None:
     """The report's rows and failures, and ``summary.csv``."""
     report.rows = [summary_row(c, records.get(c.key), lost.get(c.key)) for c in cases]
@@ -449,17 +523,17 @@ def _run_pending(out_dir, pending, study, records, lost, report, workers, schedu
     if tasks:
         from distributed import as_completed
 
-        owned = []
-        if client is None:
-            client, owned, report.cluster = _client(workers, scheduler)
-        else:
-            report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
+        owned = []    # what this run started, closed last made first (the client, then its cluster)
         bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
         try:
+            if client is None:
+                client, report.cluster = _client(workers, scheduler, owned)
+            else:
+                report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
+            if progress:
+                from tqdm import tqdm
+
+                bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
             by_key = {}
             start = time.perf_counter()
             futures = []
@@ -485,5 +559,5 @@ def _run_pending(out_dir, pending, study, records, lost, report, workers, schedu
         finally:
             if bar is not None:
                 bar.close()
-            for thing in owned:
+            for thing in reversed(owned):
                 thing.close()

@@ -117,7 +117,9 @@ def overview(path: str, rows: list[dict]) -> str:
     plt = _pyplot()
     ok = [r for r in rows if r["status"] == "ok"]
     failed = len(rows) - len(ok)
-    fig, axes = plt.subplots(2, 2, figsize=(12, 7.5 if len(ok) <= 40 else 6.5))
+    # constrained layout: the case labels (up to a whole case name) and the titles stay inside the
+    # figure; tight_layout gave up on long labels and cut them at the left edge
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7.5 if len(ok) <= 40 else 6.5), layout="constrained")
     title = f"{len(rows)} cases, {len(ok)} ok, {failed} failed (see summary.csv)"
     variants = {case_name_parts(r["name"])[1] for r in ok}
     if len(ok) <= 40 and len(variants) == 1:
@@ -153,8 +155,8 @@ def overview(path: str, rows: list[dict]) -> str:
             ax.invert_yaxis()
             ax.set_xlabel(label)
             ax.grid(axis="x", alpha=0.3)
-            if len(keys) > 1:
-                ax.legend(fontsize=8)
+            if len(keys) > 1:   # above the panel, not over its longest bars
+                ax.legend(fontsize=8, ncols=len(keys), loc="lower left", bbox_to_anchor=(0.0, 1.0), frameon=False)
     else:   # many cases: per group of cases (seeds, blades pooled) the median, quartiles and 5-95 % range
         groups = _groups(ok)
         fig.suptitle(title + f"\nper group of cases: median (line), quartiles (box), 5-95 % (whiskers); "
@@ -172,10 +174,12 @@ def overview(path: str, rows: list[dict]) -> str:
             everything = np.concatenate(data) if data else np.array([])
             log = everything.size > 0 and everything.min() > 0 and everything.max() / everything.min() > 100
             if log:
+                from matplotlib.ticker import NullFormatter
+
                 ax.set_xscale("log")
+                ax.xaxis.set_minor_formatter(NullFormatter())   # decades only: minor labels ran together
             ax.set_xlabel(label + (" (log scale)" if log else ""))
             ax.grid(axis="x", alpha=0.3, which="both")
-    fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path

@@ -95,6 +95,18 @@ def _data_rows(lines: list[str]) -> tuple[list[list[str]], list[int]]:
     return rows, numbers
 
 
+def check_increasing_time(path, time, lines) -> None:
+    """Refuse a time column that does not increase strictly, naming the file's line (comment and
+    blank lines counted) where it stops, its time and the previous row's.
+
+    ``lines`` are the file's line numbers of the values of ``time``."""
+    stop = np.flatnonzero(np.diff(time) <= 0)
+    if stop.size:
+        k = int(stop[0]) + 1
+        raise ValueError(f"{path}, line {lines[k]}: time = {time[k]:.10g} s after {time[k - 1]:.10g} s on line "
+                         f"{lines[k - 1]}: time must be strictly increasing (rows out of order, or repeated?)")
+
+
 def read_csv(path: str, *, omega_default: float | None = None, load_frame: str | None = None,
              default_frame: str = "fixed") -> MotionSeries:
     """Read a load series CSV (SI): ``time,Fx,Fy,Fz,Mx,My[,Mz][,psi][,omega]``; a comment line
@@ -143,8 +155,9 @@ def read_csv(path: str, *, omega_default: float | None = None, load_frame: str |
             if not math.isfinite(data[i, j]):
                 raise ValueError(f"{path}, line {n}, column {header[j]} = {text!r}: must be finite")
     col = {h: data[:, j] for j, h in enumerate(header)}
-    if len(data) < 2 or np.any(np.diff(col["time"]) <= 0):
-        raise ValueError(f"{path}: at least two rows with strictly increasing time are needed")
+    if len(data) < 2:
+        raise ValueError(f"{path}: at least two rows with strictly increasing time are needed, found {len(data)}")
+    check_increasing_time(path, col["time"], numbers[1:])
     loads = np.column_stack([col.get(c, np.zeros(len(data))) for c in LOAD_COLUMNS])
     psi, omega = _motion(col["time"], col.get("psi"), col.get("omega"), omega_default, path)
     return MotionSeries(col["time"].copy(), loads, psi, omega, _frame(path, stated, load_frame, default_frame), path)

@@ -327,7 +327,9 @@ def mesh_section(profile: RingProfile, patch_half_widths, size: MeshSize | str =
         raise RuntimeError("section mesh folded: the mapping is not valid for this section")
     if area.mean() < 0:
         t = t[[0, 2, 1]]
-    mesh = MeshTri(p, t)
+    # C order, as scikit-fem keeps them: given a transposed (Fortran-order) array of over 1000
+    # elements it copies it and logs "Transforming over 1000 elements to C_CONTIGUOUS."
+    mesh = MeshTri(np.ascontiguousarray(p), np.ascontiguousarray(t))
 
     # named boundary parts from the structured node numbering
     facet_of = {tuple(sorted(e)): k for k, e in enumerate(mesh.facets.T)}
