@@ -30,7 +30,7 @@ from .section import MESH_PRESETS, MeshSize, mesh_section, ring_profile
 from .supports import BOUNDARY_CONDITIONS, NULL_SPACE, SUPPORT_REMOVES, Support
 
 #: bump when the numbers a build produces change for the same inputs (invalidates caches)
-ALGORITHM_VERSION = 2
+ALGORITHM_VERSION = 3          # 3: the ring part is projected once, after the long-wave give-back (issue 29)
 
 #: expert options and their defaults (see :func:`build_superelement`)
 DEFAULT_OPTIONS = {

@@ -8,7 +8,8 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 2. :func:`ring_part` -- minus the flat half-space compliance of the same patch
    loads, ``c_n - c_n^HS`` (the Hertz springs hold that part); at long waves,
    where this removes more than each ball's own half-space compliance,
-   :func:`halfspace_addback` gives the excess back.
+   :func:`halfspace_addback` gives the excess back. Not projected per harmonic: the
+   projection waits for the give-back (step 4).
 3. :func:`ball_blocks` -- the **aliasing sums**. A unit master force of ball
    ``b`` is the patch pressure times ``H(s - r phi_b)``; with
    ``h_n = H_hat(n / r)`` the ball-to-ball compliance is
@@ -22,7 +23,8 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 
 4. :func:`stiffness_blocks` -- on the complement of the rigid modes of ball
    harmonic j (free ring: Z for j = 0; X/Y translation and tilt for j = +-1),
-   the compliance is projected onto the positive semi-definite cone, the
+   the compliance (ring part plus the given-back excess) is projected onto the
+   positive semi-definite cone, once, the
    compliance floor is added, and it is inverted:
    ``K_hat_j = Q (Q^T G_hat_j Q + floor)^-1 Q^T``, whose null space is exactly the
    rigid modes.
@@ -31,10 +33,14 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 Why the projection and the floor (docs/superelement.md): beyond a few times
 ``r / section`` harmonics the ring answers a patch load like a half-space, and
 the concave groove slightly *stiffer* than the flat one Hertz assumes, so
-``c_n - c_n^HS`` becomes a small negative number. Such directions (short
-waves, distortion of the groove) have no compliance beyond Hertz's: they are
-given the floor, a small fraction of the Hertz (half-space) compliance of the
-patch, which keeps the matrix finite and well conditioned.
+``c_n - c_n^HS`` becomes a small negative number; next to a clamped face the
+ring is stiffer than a half-space at every wave length (the material between
+the groove and the fixed face is a layer on a rigid base). Such directions have
+no compliance beyond Hertz's: they are given the floor, a small fraction of the
+Hertz (half-space) compliance of the patch, which keeps the matrix finite and
+well conditioned. The projection is made once per ball harmonic, after the
+long-wave give-back (issue 29, item 4: projecting each continuous harmonic
+first gave the long-wave excess back twice).
 """
 from __future__ import annotations
 
@@ -140,25 +146,35 @@ def halfspace_self_block(patches, lams, youngs_modulus, poisson_ratio) -> np.nda
 
 
 def ring_part(c_fe: np.ndarray, c_hs: np.ndarray, patches, free: bool) -> tuple[np.ndarray, dict]:
-    """``P+(c_n - c_n^HS)``: the ring's compliance beyond the half-space (Hertz) part, projected
-    per harmonic onto the positive semi-definite matrices (negative directions: the ring is
-    stiffer there than the flat half-space Hertz assumes; they get no compliance).
+    """``c_n - c_n^HS``: the ring's compliance beyond the half-space (Hertz) part, per harmonic,
+    **not** projected (issue 29, item 4).
 
-    For a free ring, harmonics 0 and 1 are projected on the complement of their rigid modes
-    (only that part is used). Returns the projected compliances and a report (number of
-    clipped directions, the most negative eigenvalue relative to the largest FE one)."""
+    It may have negative directions: at high harmonics the concave groove is slightly stiffer
+    than the flat half-space; at low harmonics ``c_n^HS`` is the compliance of a *row* of patches,
+    which grows without bound as n -> 0 (n = 0 takes the value of n = 1) and exceeds what a
+    finite ring holds, most of all near a clamped face. That long-wave excess is given back per
+    ball harmonic (:func:`halfspace_addback`), so the projection onto the positive semi-definite
+    matrices waits until then (:func:`stiffness_blocks`): clipping here first would give the same
+    compliance back twice (once by the clip, once by the give-back) and soften the contacts next
+    to a clamped face (docs/superelement.md, "The clamped face").
+
+    For a free ring, harmonics 0 and 1 are restricted to the complement of their rigid modes
+    (only that part is used). Returns the compliances and a report: the number of negative
+    directions and the most negative eigenvalue relative to the largest FE one."""
     out = np.zeros_like(c_fe)
-    clipped, worst = 0, 0.0
+    negative, worst = 0, 0.0
     for n in range(c_fe.shape[0]):
         r = rigid_master_modes(patches, n) if free and n <= 1 else np.zeros((4, 0))
         q = np.linalg.qr(r, mode="complete")[0][:, r.shape[1]:] if r.shape[1] else np.eye(4)
-        w, v = np.linalg.eigh(q.T @ (c_fe[n] - c_hs[n]) @ q)
+        d = q.T @ (c_fe[n] - c_hs[n]) @ q
+        d = 0.5 * (d + d.T)
+        w = np.linalg.eigvalsh(d)
         scale = np.abs(np.linalg.eigvalsh(q.T @ c_fe[n] @ q)).max()
-        clipped += int(np.sum(w < 0))
+        negative += int(np.sum(w < 0))
         worst = min(worst, float(w.min() / scale))
-        u = q @ v
-        out[n] = (u * np.maximum(w, 0.0)) @ u.T
-    return out, {"clipped": clipped, "directions": int(4 * c_fe.shape[0]), "most_negative": worst}
+        out[n] = q @ d @ q.T
+    return out, {"negative": negative, "directions": int(4 * c_fe.shape[0]), "most_negative": worst,
+                 "projected": False}
 
 
 def ball_blocks(c: np.ndarray, patches, ball_count: int) -> np.ndarray:
