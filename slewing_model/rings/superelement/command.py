@@ -77,14 +77,14 @@ def summary(se, elapsed: float, path: str | None = None) -> str:
                  f"{'clipped':>8} {'K diag R, z [GN/m]':>20}")
     for r in ("outer", "inner"):
         rm = m["rings"][r]
-        ph = rm["projection"]["ball_harmonics"]
+        ph = rm["projection"]["per_harmonic"]
         diag = np.array(rm["diagonal_N_per_m"]) / 1e9
         null = ",".join(rm["removed_modes"]) or "none (PD)"
         lines.append(f"  {r:6} {rm['boundary_condition']:13} {null:18} {rm['mesh']['elements']:>8} "
                      f"{rm['mesh']['dofs']:>7} {100 * rm['truncation_change']:>7.2f}% "
                      f"{ph['clipped']:>4}/{ph['directions']:<4} {diag[0]:>9.3f} {diag[1]:>9.3f}")
     lines.append("  trunc.: largest change of a diagonal entry when only 3/4 of the harmonics are kept; "
-                 "clipped: ball-harmonic directions with no compliance beyond Hertz's (floor only)")
+                 "clipped: harmonic directions with no compliance beyond Hertz's (floor applies)")
     return "\n".join(lines)
 
 

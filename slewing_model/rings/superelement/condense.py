@@ -8,8 +8,9 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 2. :func:`ring_part` -- minus the flat half-space compliance of the same patch
    loads, ``c_n - c_n^HS`` (the Hertz springs hold that part); at long waves,
    where this removes more than each ball's own half-space compliance,
-   :func:`halfspace_addback` gives the excess back. Not projected per harmonic: the
-   projection waits for the give-back (step 4).
+   :func:`halfspace_addback` gives the excess back. Projected per harmonic onto
+   the positive semi-definite matrices, except the long waves that are given back:
+   their projection waits for the give-back (step 4).
 3. :func:`ball_blocks` -- the **aliasing sums**. A unit master force of ball
    ``b`` is the patch pressure times ``H(s - r phi_b)``; with
    ``h_n = H_hat(n / r)`` the ball-to-ball compliance is
@@ -38,9 +39,9 @@ ring is stiffer than a half-space at every wave length (the material between
 the groove and the fixed face is a layer on a rigid base). Such directions have
 no compliance beyond Hertz's: they are given the floor, a small fraction of the
 Hertz (half-space) compliance of the patch, which keeps the matrix finite and
-well conditioned. The projection is made once per ball harmonic, after the
-long-wave give-back (issue 29, item 4: projecting each continuous harmonic
-first gave the long-wave excess back twice).
+well conditioned. The long waves whose half-space excess is given back are
+projected once per ball harmonic, after the give-back (issue 29, item 4:
+projecting them per continuous harmonic first gave the excess back twice).
 """
 from __future__ import annotations
 
@@ -145,36 +146,67 @@ def halfspace_self_block(patches, lams, youngs_modulus, poisson_ratio) -> np.nda
     return out
 
 
-def ring_part(c_fe: np.ndarray, c_hs: np.ndarray, patches, free: bool) -> tuple[np.ndarray, dict]:
-    """``c_n - c_n^HS``: the ring's compliance beyond the half-space (Hertz) part, per harmonic,
-    **not** projected (issue 29, item 4).
+def ring_part(c_fe: np.ndarray, c_hs: np.ndarray, patches, free: bool,
+              given_back=None) -> tuple[np.ndarray, dict]:
+    """``P+(c_n - c_n^HS)``: the ring's compliance beyond the half-space (Hertz) part, projected
+    per harmonic onto the positive semi-definite matrices (negative directions: the ring is
+    stiffer there than the flat half-space Hertz assumes; they get no compliance) -- except the
+    harmonics ``given_back`` (bool per n, default none), whose long-wave excess is given back per
+    ball harmonic (:func:`halfspace_addback`, :func:`given_back_harmonics`): those stay as they are
+    and are projected with the give-back, per ball harmonic (:func:`stiffness_blocks`).
 
-    It may have negative directions: at high harmonics the concave groove is slightly stiffer
-    than the flat half-space; at low harmonics ``c_n^HS`` is the compliance of a *row* of patches,
-    which grows without bound as n -> 0 (n = 0 takes the value of n = 1) and exceeds what a
-    finite ring holds, most of all near a clamped face. That long-wave excess is given back per
-    ball harmonic (:func:`halfspace_addback`), so the projection onto the positive semi-definite
-    matrices waits until then (:func:`stiffness_blocks`): clipping here first would give the same
-    compliance back twice (once by the clip, once by the give-back) and soften the contacts next
-    to a clamped face (docs/superelement.md, "The clamped face").
+    Why (issue 29, item 4): at low n, ``c_n^HS`` is the compliance of a *row* of patches, which
+    grows without bound as n -> 0 (n = 0 takes the value of n = 1) and exceeds what a finite ring
+    holds, most of all next to a clamped face. Clipping that negative part here and then giving
+    the excess back gave the same compliance back twice and softened the contacts next to a
+    clamped face (docs/superelement.md, "The clamped face"). At the other harmonics the negative
+    directions are the concave groove's (slightly stiffer than the flat half-space); clipping them
+    per harmonic keeps the sum over harmonics convergent in N.
 
-    For a free ring, harmonics 0 and 1 are restricted to the complement of their rigid modes
-    (only that part is used). Returns the compliances and a report: the number of negative
-    directions and the most negative eigenvalue relative to the largest FE one."""
+    For a free ring, harmonics 0 and 1 are projected on the complement of their rigid modes
+    (only that part is used). Returns the projected compliances and a report (number of
+    clipped directions, the most negative eigenvalue relative to the largest FE one, and the
+    number of harmonics left for the ball-harmonic projection)."""
     out = np.zeros_like(c_fe)
-    negative, worst = 0, 0.0
+    keep = np.zeros(c_fe.shape[0], dtype=bool) if given_back is None else np.asarray(given_back, dtype=bool)
+    clipped, worst = 0, 0.0
     for n in range(c_fe.shape[0]):
         r = rigid_master_modes(patches, n) if free and n <= 1 else np.zeros((4, 0))
         q = np.linalg.qr(r, mode="complete")[0][:, r.shape[1]:] if r.shape[1] else np.eye(4)
-        d = q.T @ (c_fe[n] - c_hs[n]) @ q
-        d = 0.5 * (d + d.T)
-        w = np.linalg.eigvalsh(d)
+        w, v = np.linalg.eigh(q.T @ (c_fe[n] - c_hs[n]) @ q)
         scale = np.abs(np.linalg.eigvalsh(q.T @ c_fe[n] @ q)).max()
-        negative += int(np.sum(w < 0))
         worst = min(worst, float(w.min() / scale))
-        out[n] = q @ d @ q.T
-    return out, {"negative": negative, "directions": int(4 * c_fe.shape[0]), "most_negative": worst,
-                 "projected": False}
+        u = q @ v
+        if n < keep.size and keep[n]:
+            out[n] = (u * w) @ u.T
+        else:
+            clipped += int(np.sum(w < 0))
+            out[n] = (u * np.maximum(w, 0.0)) @ u.T
+    return out, {"clipped": clipped, "directions": int(4 * c_fe.shape[0]), "most_negative": worst,
+                 "given_back_unprojected": int(keep[:c_fe.shape[0]].sum())}
+
+
+def given_back_harmonics(back: np.ndarray, n_max: int) -> np.ndarray:
+    """Harmonics n = 0..n_max whose half-space excess :func:`halfspace_addback` gives back (``back``,
+    (B, 4, 4)): the long waves n < B / 2 (each its own ball harmonic j = n) where the give-back is
+    not zero. They are not projected before the give-back (:func:`ring_part`)."""
+    back = np.asarray(back)
+    out = np.zeros(n_max + 1, dtype=bool)
+    if back.ndim != 3:
+        return out
+    B = back.shape[0]
+    n = np.arange(min(n_max + 1, (B + 1) // 2))
+    out[n] = np.abs(back[n]).max(axis=(1, 2)) > 0
+    return out
+
+
+def condensed_blocks(c_fe: np.ndarray, c_hs: np.ndarray, back, patches, ball_count: int, free: bool, floor):
+    """Steps 2-4 on harmonics 0..len(c_fe)-1: ring part (not projected where given back), aliasing,
+    the give-back ``back`` (B, 4, 4) or 0, projection, floor, inversion. Returns
+    ``(K_hat, ring_part report, ball-harmonic report)``."""
+    c, ring_report = ring_part(c_fe, c_hs, patches, free, given_back_harmonics(back, c_fe.shape[0] - 1))
+    k_hat, report = stiffness_blocks(ball_blocks(c, patches, ball_count) + back, patches, free, floor)
+    return k_hat, ring_report, report
 
 
 def ball_blocks(c: np.ndarray, patches, ball_count: int) -> np.ndarray:
