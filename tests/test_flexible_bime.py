@@ -1,5 +1,7 @@
 """Flexible-BIME with finite element superelements (paper sections 2.2-2.4)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -154,3 +156,30 @@ def test_flexible_gradient_and_hessian_match_finite_differences(table3_errors, t
         assert (up - um) / (2 * step) == pytest.approx(g[i], rel=1e-5, abs=1e-6 * np.abs(g).max())
         assert np.allclose((gp - gm) / (2 * step), h[:, i], rtol=1e-4, atol=1e-6 * np.abs(h).max())
     assert np.allclose(h, h.T)
+
+
+def test_clamped_faces_load_the_contacts_next_to_them_under_a_moment(table1, table1_rings):
+    """Issue 29, item 4. Under a pure moment a rigid bearing loads both diagonals alike and does not
+    lift. With the outer ring clamped on its lower face and the inner ring on its upper face,
+    contacts 4 and 2 (diagonal 2) sit next to the fixed faces and contacts 1 and 3 (diagonal 1)
+    far from them: diagonal 2 is the stiffer one, so it carries more than the rigid value,
+    diagonal 1 less, and the moving ring rises (+z), towards the softer diagonal 1's side. The
+    faces swapped, everything turns over (a check that the coupling sees which face is fixed)."""
+    from slewing_model.bearing.geometry import RingSection
+
+    rigid = solve(table1, Loads(My=1e6))
+    assert abs(rigid.displacement[2]) < 1e-12
+    flexible = solve(table1, Loads(My=1e6), model="flexible", superelement=table1_rings["clamped"])
+    q1, q4 = flexible.contact_load[:, 0].max(), flexible.contact_load[:, 3].max()
+    assert q4 > rigid.contact_load[:, 3].max() and q1 < rigid.contact_load[:, 0].max()
+    assert flexible.displacement[2] > 1e-3 * rigid.displacement[4] * table1.pitch_diameter / 2
+
+    def swapped(s):
+        return RingSection(s.inner_radius, s.outer_radius, s.height, "upper" if s.bolted_face == "lower" else "lower")
+
+    turned = dataclasses.replace(table1, outer_section=swapped(table1.outer_section),
+                                 inner_section=swapped(table1.inner_section))
+    other = solve(turned, Loads(My=1e6), model="flexible", superelement=build_superelement(turned, "coarse", "clamped"))
+    assert other.contact_load[:, 0].max() == pytest.approx(q4, rel=1e-6)
+    assert other.contact_load[:, 3].max() == pytest.approx(q1, rel=1e-6)
+    assert other.displacement[2] == pytest.approx(-flexible.displacement[2], rel=1e-6)

@@ -30,7 +30,7 @@ from .section import MESH_PRESETS, MeshSize, mesh_section, ring_profile
 from .supports import BOUNDARY_CONDITIONS, NULL_SPACE, SUPPORT_REMOVES, Support
 
 #: bump when the numbers a build produces change for the same inputs (invalidates caches)
-ALGORITHM_VERSION = 2
+ALGORITHM_VERSION = 3          # 3: the given-back long waves are projected after the give-back (issue 29)
 
 #: expert options and their defaults (see :func:`build_superelement`)
 DEFAULT_OPTIONS = {
@@ -245,15 +245,14 @@ def condense_ring(h: RingHarmonics, ball_count: int, n_max: int | None = None,
     n = h.c_fe.shape[0] - 1 if n_max is None else n_max
     free = h.bc == "free"
     c_hs = h.c_hs[:n + 1] if subtract_halfspace else 0.0 * h.c_hs[:n + 1]
-    c, ring_report = cd.ring_part(h.c_fe[:n + 1], c_hs, h.patches, free)
     back = (cd.halfspace_addback(h.patches, h.lams, ball_count, h.youngs_modulus, h.poisson_ratio)
             if subtract_halfspace else 0.0)
-    k_hat, report = cd.stiffness_blocks(cd.ball_blocks(c, h.patches, ball_count) + back, h.patches, free, h.floor)
+    k_hat, ring_report, report = cd.condensed_blocks(h.c_fe[:n + 1], c_hs, back, h.patches, ball_count, free,
+                                                     h.floor)
     row = cd.first_row(k_hat)
     # harmonic truncation figure: the same with 3/4 of the harmonics
     n34 = max(2, (3 * n) // 4)
-    k34, _ = cd.stiffness_blocks(cd.ball_blocks(c[:n34 + 1], h.patches, ball_count) + back, h.patches, free,
-                                 h.floor)
+    k34, _, _ = cd.condensed_blocks(h.c_fe[:n34 + 1], c_hs[:n34 + 1], back, h.patches, ball_count, free, h.floor)
     diag, diag34 = np.diag(row[0]), np.diag(cd.first_row(k34)[0])
     trunc = float(np.max(np.abs(diag - diag34) / np.abs(diag)))
     B = ball_count

@@ -8,7 +8,9 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 2. :func:`ring_part` -- minus the flat half-space compliance of the same patch
    loads, ``c_n - c_n^HS`` (the Hertz springs hold that part); at long waves,
    where this removes more than each ball's own half-space compliance,
-   :func:`halfspace_addback` gives the excess back.
+   :func:`halfspace_addback` gives the excess back. Projected per harmonic onto
+   the positive semi-definite matrices, except the long waves that are given back:
+   their projection waits for the give-back (step 4).
 3. :func:`ball_blocks` -- the **aliasing sums**. A unit master force of ball
    ``b`` is the patch pressure times ``H(s - r phi_b)``; with
    ``h_n = H_hat(n / r)`` the ball-to-ball compliance is
@@ -22,7 +24,8 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 
 4. :func:`stiffness_blocks` -- on the complement of the rigid modes of ball
    harmonic j (free ring: Z for j = 0; X/Y translation and tilt for j = +-1),
-   the compliance is projected onto the positive semi-definite cone, the
+   the compliance (ring part plus the given-back excess) is projected onto the
+   positive semi-definite cone, once, the
    compliance floor is added, and it is inverted:
    ``K_hat_j = Q (Q^T G_hat_j Q + floor)^-1 Q^T``, whose null space is exactly the
    rigid modes.
@@ -31,10 +34,14 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
 Why the projection and the floor (docs/superelement.md): beyond a few times
 ``r / section`` harmonics the ring answers a patch load like a half-space, and
 the concave groove slightly *stiffer* than the flat one Hertz assumes, so
-``c_n - c_n^HS`` becomes a small negative number. Such directions (short
-waves, distortion of the groove) have no compliance beyond Hertz's: they are
-given the floor, a small fraction of the Hertz (half-space) compliance of the
-patch, which keeps the matrix finite and well conditioned.
+``c_n - c_n^HS`` becomes a small negative number; next to a clamped face the
+ring is stiffer than a half-space at every wave length (the material between
+the groove and the fixed face is a layer on a rigid base). Such directions have
+no compliance beyond Hertz's: they are given the floor, a small fraction of the
+Hertz (half-space) compliance of the patch, which keeps the matrix finite and
+well conditioned. The long waves whose half-space excess is given back are
+projected once per ball harmonic, after the give-back (issue 29, item 4:
+projecting them per continuous harmonic first gave the excess back twice).
 """
 from __future__ import annotations
 
@@ -139,26 +146,67 @@ def halfspace_self_block(patches, lams, youngs_modulus, poisson_ratio) -> np.nda
     return out
 
 
-def ring_part(c_fe: np.ndarray, c_hs: np.ndarray, patches, free: bool) -> tuple[np.ndarray, dict]:
+def ring_part(c_fe: np.ndarray, c_hs: np.ndarray, patches, free: bool,
+              given_back=None) -> tuple[np.ndarray, dict]:
     """``P+(c_n - c_n^HS)``: the ring's compliance beyond the half-space (Hertz) part, projected
     per harmonic onto the positive semi-definite matrices (negative directions: the ring is
-    stiffer there than the flat half-space Hertz assumes; they get no compliance).
+    stiffer there than the flat half-space Hertz assumes; they get no compliance) -- except the
+    harmonics ``given_back`` (bool per n, default none), whose long-wave excess is given back per
+    ball harmonic (:func:`halfspace_addback`, :func:`given_back_harmonics`): those stay as they are
+    and are projected with the give-back, per ball harmonic (:func:`stiffness_blocks`).
+
+    Why (issue 29, item 4): at low n, ``c_n^HS`` is the compliance of a *row* of patches, which
+    grows without bound as n -> 0 (n = 0 takes the value of n = 1) and exceeds what a finite ring
+    holds, most of all next to a clamped face. Clipping that negative part here and then giving
+    the excess back gave the same compliance back twice and softened the contacts next to a
+    clamped face (docs/superelement.md, "The clamped face"). At the other harmonics the negative
+    directions are the concave groove's (slightly stiffer than the flat half-space); clipping them
+    per harmonic keeps the sum over harmonics convergent in N.
 
     For a free ring, harmonics 0 and 1 are projected on the complement of their rigid modes
     (only that part is used). Returns the projected compliances and a report (number of
-    clipped directions, the most negative eigenvalue relative to the largest FE one)."""
+    clipped directions, the most negative eigenvalue relative to the largest FE one, and the
+    number of harmonics left for the ball-harmonic projection)."""
     out = np.zeros_like(c_fe)
+    keep = np.zeros(c_fe.shape[0], dtype=bool) if given_back is None else np.asarray(given_back, dtype=bool)
     clipped, worst = 0, 0.0
     for n in range(c_fe.shape[0]):
         r = rigid_master_modes(patches, n) if free and n <= 1 else np.zeros((4, 0))
         q = np.linalg.qr(r, mode="complete")[0][:, r.shape[1]:] if r.shape[1] else np.eye(4)
         w, v = np.linalg.eigh(q.T @ (c_fe[n] - c_hs[n]) @ q)
         scale = np.abs(np.linalg.eigvalsh(q.T @ c_fe[n] @ q)).max()
-        clipped += int(np.sum(w < 0))
         worst = min(worst, float(w.min() / scale))
         u = q @ v
-        out[n] = (u * np.maximum(w, 0.0)) @ u.T
-    return out, {"clipped": clipped, "directions": int(4 * c_fe.shape[0]), "most_negative": worst}
+        if n < keep.size and keep[n]:
+            out[n] = (u * w) @ u.T
+        else:
+            clipped += int(np.sum(w < 0))
+            out[n] = (u * np.maximum(w, 0.0)) @ u.T
+    return out, {"clipped": clipped, "directions": int(4 * c_fe.shape[0]), "most_negative": worst,
+                 "given_back_unprojected": int(keep[:c_fe.shape[0]].sum())}
+
+
+def given_back_harmonics(back: np.ndarray, n_max: int) -> np.ndarray:
+    """Harmonics n = 0..n_max whose half-space excess :func:`halfspace_addback` gives back (``back``,
+    (B, 4, 4)): the long waves n < B / 2 (each its own ball harmonic j = n) where the give-back is
+    not zero. They are not projected before the give-back (:func:`ring_part`)."""
+    back = np.asarray(back)
+    out = np.zeros(n_max + 1, dtype=bool)
+    if back.ndim != 3:
+        return out
+    B = back.shape[0]
+    n = np.arange(min(n_max + 1, (B + 1) // 2))
+    out[n] = np.abs(back[n]).max(axis=(1, 2)) > 0
+    return out
+
+
+def condensed_blocks(c_fe: np.ndarray, c_hs: np.ndarray, back, patches, ball_count: int, free: bool, floor):
+    """Steps 2-4 on harmonics 0..len(c_fe)-1: ring part (not projected where given back), aliasing,
+    the give-back ``back`` (B, 4, 4) or 0, projection, floor, inversion. Returns
+    ``(K_hat, ring_part report, ball-harmonic report)``."""
+    c, ring_report = ring_part(c_fe, c_hs, patches, free, given_back_harmonics(back, c_fe.shape[0] - 1))
+    k_hat, report = stiffness_blocks(ball_blocks(c, patches, ball_count) + back, patches, free, floor)
+    return k_hat, ring_report, report
 
 
 def ball_blocks(c: np.ndarray, patches, ball_count: int) -> np.ndarray:
