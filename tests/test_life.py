@@ -296,3 +296,27 @@ def test_outer_ring_rotating_swaps_the_exponents():
     r = life.radial_bearing_life(q, Z, DW, DM, 0.0, RI, RE, "outer", C)
     assert r.equivalent_load[0] == pytest.approx((np.sum(q ** (10 / 3)) / Z) ** 0.3, rel=1e-14)
     assert r.equivalent_load[1] == pytest.approx((np.sum(q ** 3) / Z) ** (1 / 3), rel=1e-14)
+
+
+# ---- issue 28: wrong answers found by a new user and by the life review ----------------------------
+@pytest.mark.parametrize("phase_deg", [0.0, 37.0, 90.0, 180.0, 270.0])
+def test_relubrication_gap_does_not_depend_on_where_the_record_starts(phase_deg):
+    """A steady ±3° swing at 0.2 Hz (range 6° above the 4.86° threshold) over 40 s: the longest time
+    without a 4.86° movement is, in every period T = 5 s, the stretch around a peak where the angle
+    stays within 4.86° of it, T (π + 2 asin(4.86/3 - 1)) / 2π = 3.564 s, whatever the phase at which
+    the record starts (the old dead band anchored at ψ[0] gave 40 s from ψ = 0, 3.05 s from a peak)."""
+    dt, a, h, period = 0.01, math.radians(3.0), math.radians(4.86), 5.0
+    t = np.arange(0.0, 40.0 + dt / 2, dt)
+    psi = a * np.sin(2 * np.pi * t / period + math.radians(phase_deg))
+    expected = period * (math.pi + 2 * math.asin(h / a - 1)) / (2 * math.pi)
+    assert life.relubrication_gap(t, psi, h) == pytest.approx(expected, abs=2 * dt)
+
+
+def test_relubrication_gap_of_a_ring_that_never_moves_enough_is_the_run():
+    """A swing of full range 1° against a 4.86° threshold, and a slow drift of 4° in 100 s: no movement
+    of 4.86° ever, the gap is the whole run; a drift of 10° in 100 s moves 4.86° every 48.6 s."""
+    t = np.linspace(0.0, 100.0, 10001)
+    h = math.radians(4.86)
+    assert life.relubrication_gap(t, math.radians(0.5) * np.sin(t), h) == pytest.approx(100.0)
+    assert life.relubrication_gap(t, math.radians(4.0) * t / 100, h) == pytest.approx(100.0)
+    assert life.relubrication_gap(t, math.radians(10.0) * t / 100, h) == pytest.approx(48.6, abs=0.02)
