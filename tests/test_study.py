@@ -284,3 +284,25 @@ def test_superelement_built_once_per_bearing_variant(tmp_path):
     assert len(flexible) == 8 and all(se is flexible[0] for se in flexible)
     assert all(t.superelement is None for t in tasks if t.variant["ring_model"] == "rigid")
     flexible[0].check(load_bearing(TABLE3))              # built for this bearing
+
+
+def test_every_json_of_a_study_is_strict_json_and_no_track_0(tmp_path):
+    """A ring standing still (no cycles: infinite lives, no worst track, no DG03 ratio) and one turning:
+    every JSON file the study writes parses as RFC 8259 JSON (no bare Infinity or NaN, which e.g.
+    Node's JSON.parse refuses); summary.csv has no track 0 and no "nan" for the still case."""
+    path = write_study(tmp_path, idling("still", 6, fz=3e4, omega=0.0) + idling("turning", 6, fz=3e4),
+                       preloads=(0,), seeds=(1,))
+    run_study(path, tmp_path / "out", workers=1, progress=False, figures=True)
+
+    def refuse(name):
+        raise ValueError(f"{name} is not JSON")
+
+    files = list((tmp_path / "out").rglob("*.json"))
+    assert len(files) >= 5                      # study.json, and per case case.json, result.json, life_summary.json
+    for f in files:
+        json.loads(f.read_text(), parse_constant=refuse)
+    rows = {r["load"]: r for r in summary(tmp_path / "out")}
+    still = rows["still"]
+    assert still["life_worst_track"] == "" and still["life_L10_h"] == "inf" and still["life_dg03_ratio"] == ""
+    assert "nan" not in " ".join(still.values()).lower()
+    assert rows["turning"]["life_worst_track"] in ("1", "2", "3", "4")

@@ -27,7 +27,11 @@ Life and wear (:mod:`slewing_model.life`, ``docs/life.md``)
     ``life_map_L10_h``: the same from the raceway damage map; ``life_dg03_L10_h`` and
     ``life_dg03_ratio`` (DG03's life over ours); ``life_cycles`` (rainflow count of ``psi``);
     ``life_share_x2b_below_1`` and ``life_share_below_critical`` (shares of the cycles);
-    ``life_relubrication_gap_s``. The raceway map (4 tracks x slices) and the cycles (swing,
+    ``life_relubrication_gap_s``; ``life_micro_cycles`` (cycles left out of the two shares counted by
+    cycles: swings below 10 steps of the series' angle resolution) and the two shares weighted by
+    damage, ``life_damage_share_x2b_below_1`` and ``life_damage_share_below_critical``. A value that
+    does not exist (no worst track without damage, no ratio or share without cycles) is an empty
+    cell. The raceway map (4 tracks x slices) and the cycles (swing,
     count, x/2b) come back in ``CaseResult.life``.
 
 Load spectrum (for a life calculation)
@@ -47,6 +51,7 @@ import numpy as np
 
 from ..distribution.bime import Loads
 from ..life import LifeAccumulator, LifeModel, analyse_run
+from ..life.command import life_files
 from ..simulation.simulator import BearingSimulator, SimulatorSettings
 from .series import MotionSeries
 
@@ -59,7 +64,8 @@ STATISTICS = ("friction_torque_mean", "friction_torque_max", "friction_torque_p9
               "rotation", "duration", "steps",
               "life_L10_h", "life_worst_track", "life_damage_per_h", "life_map_L10_h", "life_dg03_L10_h",
               "life_dg03_ratio", "life_cycles", "life_share_x2b_below_1", "life_share_below_critical",
-              "life_relubrication_gap_s")
+              "life_relubrication_gap_s", "life_micro_cycles", "life_damage_share_x2b_below_1",
+              "life_damage_share_below_critical")
 HISTOGRAM_COLUMNS = ("ball", "diagonal", "load_lower_N", "load_upper_N", "time_s", "rotation_rad")
 
 
@@ -195,10 +201,7 @@ def run_case(task: CaseTask) -> CaseResult:
         return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram,
                           {"error": one_line(exc)})
     stats.update(result.summary())
-    cycles = {"damage_map": result.damage_map, "swing": result.swing, "count": result.count,
-              "travel_ratio": result.travel_ratio, "peak_pressure": result.peak_pressure,
-              "track_travel_ratio": result.track_travel_ratio, "cycle_peak_pressure": result.cycle_peak_pressure,
-              "critical_angle": model_critical(sim)}
+    cycles = {**life_files(result, life.model), "peak_pressure": result.peak_pressure}
     return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram, cycles)
 
 

@@ -37,7 +37,8 @@ def _pyplot():
 
 
 def _value(row, key):
-    return float(row[key])
+    """A number of a summary row; an empty cell (no value) is NaN."""
+    return float(row[key]) if row[key] != "" else float("nan")
 
 
 def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
