@@ -306,3 +306,18 @@ def test_every_json_of_a_study_is_strict_json_and_no_track_0(tmp_path):
     assert still["life_worst_track"] == "" and still["life_L10_h"] == "inf" and still["life_dg03_ratio"] == ""
     assert "nan" not in " ".join(still.values()).lower()
     assert rows["turning"]["life_worst_track"] in ("1", "2", "3", "4")
+
+
+def test_life_figure_groups_variants_and_adds_only_parts_of_one_duty(tmp_path):
+    """Two load series (parts of one duty) x two preloads (alternative designs): the life figure's groups
+    are the two bearing variants, each holding both load series; the variants are never added."""
+    from slewing_model.study.figures import life_groups
+
+    path = write_study(tmp_path, idling("a", 6, fz=3e4) + idling("b", 6, fz=5e4), preloads=(0, 20), seeds=(1,))
+    result = run_study(path, tmp_path / "out", workers=1, progress=False, figures=True)
+    groups = life_groups(str(tmp_path / "out"), result.rows)
+    assert len(groups) == 2
+    for folders in groups.values():
+        loads = sorted(r["load"] for r in result.rows if os.path.join(str(tmp_path / "out"), "cases", r["case"]) in folders)
+        assert loads == ["a", "b"]
+    assert (tmp_path / "out" / "figures" / "life.png").stat().st_size > 0

@@ -110,6 +110,7 @@ class CaseResult:
         ``host:pid`` of the process that ran it.
     timeseries : ndarray (n, len(TIMESERIES_COLUMNS)) or None
     statistics : dict or None
+        As written to ``result.json`` (``json_ready``: an infinite value is "inf", no value None).
     histogram : ndarray (m, len(HISTOGRAM_COLUMNS)) or None
     life : dict or None
         ``damage_map`` (4, slices) of contacts 1..4; ``swing`` (rad), ``count`` and ``travel_ratio``
@@ -201,6 +202,7 @@ def run_case(task: CaseTask) -> CaseResult:
         return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram,
                           {"error": one_line(exc)})
     stats.update(result.summary())
+    stats = json_ready(stats)           # as result.json holds them: inf as "inf", no value as None
     cycles = {**life_files(result, life.model), "peak_pressure": result.peak_pressure}
     return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram, cycles)
 
@@ -233,6 +235,31 @@ def _nice_ceiling(x: float) -> float:
         if m * p >= x * (1 - 1e-12):
             return m * p
     return 10.0 * p  # pragma: no cover
+
+
+def json_ready(data):
+    """``data`` with every non-finite number made JSON (RFC 8259 has no Infinity or NaN): an infinite
+    value (a life without damage) becomes the string ``"inf"`` (``"-inf"``), which ``float()`` reads
+    back; NaN (a value that does not exist) becomes ``null``. Numpy scalars and arrays become
+    numbers and lists."""
+    if isinstance(data, dict):
+        return {k: json_ready(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [json_ready(v) for v in data]
+    if isinstance(data, np.ndarray):
+        return json_ready(data.tolist())
+    if isinstance(data, (bool, np.bool_)):
+        return bool(data)
+    if isinstance(data, (int, np.integer)):
+        return int(data)
+    if isinstance(data, (float, np.floating)):
+        x = float(data)
+        if math.isnan(x):
+            return None
+        if math.isinf(x):
+            return "inf" if x > 0 else "-inf"
+        return x
+    return data
 
 
 def statistics(out: np.ndarray, diagonal: np.ndarray, bins: int) -> tuple[dict, np.ndarray]:

@@ -53,7 +53,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, one_line, run_case
+from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, json_ready, one_line, \
+    run_case
 from .definition import Case, Study, load_study
 from .series import load_series
 
@@ -172,31 +173,6 @@ def read_result(out_dir: str, key: str) -> dict | None:
     except (OSError, ValueError):
         return None
     return data if data.get("key") == key else None
-
-
-def json_ready(data):
-    """``data`` with every non-finite number made JSON (RFC 8259 has no Infinity or NaN): an infinite
-    value (a life without damage) becomes the string ``"inf"`` (``"-inf"``), which ``float()`` reads
-    back; NaN (a value that does not exist) becomes ``null``. Numpy scalars and arrays become
-    numbers and lists."""
-    if isinstance(data, dict):
-        return {k: json_ready(v) for k, v in data.items()}
-    if isinstance(data, (list, tuple)):
-        return [json_ready(v) for v in data]
-    if isinstance(data, np.ndarray):
-        return json_ready(data.tolist())
-    if isinstance(data, (bool, np.bool_)):
-        return bool(data)
-    if isinstance(data, (int, np.integer)):
-        return int(data)
-    if isinstance(data, (float, np.floating)):
-        x = float(data)
-        if math.isnan(x):
-            return None
-        if math.isinf(x):
-            return "inf" if x > 0 else "-inf"
-        return x
-    return data
 
 
 def write_json(path: str, data) -> None:
