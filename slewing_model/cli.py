@@ -212,6 +212,8 @@ def _run_loads(args) -> int:
     what = f"pitch bearing of blade {args.blade}" if args.bearing == "pitch" else "yaw bearing"
     mounting = args.mounting or ("tip" if args.bearing == "pitch" else "up")
     rate = used["rate"] or f"the rate of {used['angle']}"
+    if os.path.dirname(args.output):      # e.g. results/fastv8.csv on a fresh clone: results/ is made
+        os.makedirs(os.path.dirname(args.output), exist_ok=True)
     series.write_csv(args.output, comments=(
         f"slewing loads: {what} from {args.file}",
         f"channels: {', '.join(used['loads'])} ({used['frame']} frame), psi from {used['angle']}, omega from {rate}",

@@ -154,3 +154,15 @@ def test_life_help_shows_defaults_like_the_other_commands(capsys):
     for option in ("--ring-model", "--slices", "--relubrication-swing", "--rating", "--output"):
         assert option in text
     assert "(default: rigid)" in text and "(default: the first count from 1440" in text
+
+
+def test_docs_life_commands_write_only_into_results():
+    """The commands docs/life.md gives write into results/ (ignored by git), not into the
+    repository's root: the former `-o fastv8.csv` left an untracked file behind."""
+    import re
+
+    text = (ROOT / "docs/life.md").read_text()
+    outputs = re.findall(r"\.venv/bin/slewing (?:loads|life|batch) .*?-o (\S+)", text)
+    assert len(outputs) >= 3
+    assert all(o.startswith("results/") for o in outputs), outputs
+    assert "results/" in (ROOT / ".gitignore").read_text().split()

@@ -389,7 +389,8 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
             d = next(iter(duties.values()))
             life_k = d["duration"] / 3600.0 / d["cycle_track"][k] if d["cycle_track"][k] > 0 else float("inf")
             ax.set_title(f"contact {TRACK_LABELS[k]}: D = {d['cycle_track'][k]:.3g} (cycle rule), "
-                         f"{d['map_track'][k]:.3g} (map); L10 of the track {_fmt_h(life_k)}", fontsize=9, loc="left")
+                         f"{d['map_track'][k]:.3g} (map) in {d['duration']:.4g} s; L10 of the track alone "
+                         f"{_fmt_h(life_k)}", fontsize=9, loc="left")
         else:
             text = "; ".join(f"{label or 'all'} D {d['map_track'][k]:.2g}" for label, d in
                              list(duties.items())[:3])
@@ -441,10 +442,13 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
     ax3 = fig.add_subplot(grid[3, 1])
     ax3.axis("off")
     lines = []
+    lines.append(f"L10 in hours of the duty ({sum(d['duration'] for d in duties.values()):.4g} s"
+                 f"{'' if one else ' over all groups'}) repeated:")
     for label, d in list(duties.items())[:MAX_GROUP_LINES]:
-        lines.append(f"{label + ': ' if label else ''}L10 {_fmt_h(d['ours_h'])} (ISO/TS 16281 + oscillation rule), "
-                     f"{_fmt_h(d['map_h'])} (map), {_fmt_h(d['dg03_h'])} (DG03) = "
-                     f"{'-' if np.isnan(d['ratio']) else format(d['ratio'], '.2f')} x ours")
+        worst = f"worst track {int(np.argmax(d['cycle_track'])) + 1}" if d["cycle_track"].max() > 0 else "no damage"
+        ratio = "-" if np.isnan(d["ratio"]) else f"{d['ratio']:.2f} x ours"
+        lines.append(f"{label + ': ' if label else ''}ISO/TS 16281 + oscillation rule {_fmt_h(d['ours_h'])} ({worst})")
+        lines.append(f"{'    ' if label else ''}raceway map {_fmt_h(d['map_h'])};  DG03 {_fmt_h(d['dg03_h'])} = {ratio}")
     if len(duties) > MAX_GROUP_LINES:
         ours = np.array([d["ours_h"] for d in duties.values()])
         ratio = np.array([d["ratio"] for d in duties.values()])
@@ -452,9 +456,9 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
                      f"{_fmt_h(float(ours.min()))}..{_fmt_h(float(ours.max()))}; DG03/ours median "
                      f"{np.nanmedian(ratio):.2f}")
     cases = sum(len(v) for v in groups.values())
-    lines.append(f"hours of the duty repeated; {cases} run(s)" + ("" if one else
+    lines.append(f"{cases} run(s)" + ("" if one else
                  f" in {len(duties)} groups of alternative designs, each group's runs added, groups never added"))
-    ax3.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=8, wrap=True, transform=ax3.transAxes)
+    ax3.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax3.transAxes)
     if title:
         fig.suptitle(title)
     fig.tight_layout()
