@@ -59,7 +59,7 @@ def run(args) -> int:
     from ..distribution.results import Loads, NoEquilibriumError
     from ..simulation.simulator import BearingSimulator, SimulatorSettings
     from ..study.series import read_csv
-    from .duty import MICRO_CYCLE_STEPS, LifeAccumulator, LifeModel, LifeSettings, analyse_run
+    from .duty import MICRO_CYCLE_STEPS, LifeAccumulator, LifeModel, LifeSettings, analyse_run, life_files
 
     check_arguments(args)
     bearing = load_bearing(args.bearing)
@@ -145,15 +145,3 @@ def run(args) -> int:
                   f"(no figure: matplotlib is not installed)")
     return 0
 
-
-def life_files(res, model) -> dict:
-    """What :func:`slewing_model.study.engine.write_life` writes of a run (maps, cycles, summary)."""
-    return {"damage_map": res.damage_map, "swing": res.swing, "count": res.count,
-            "travel_ratio": res.travel_ratio, "track_travel_ratio": res.track_travel_ratio,
-            "cycle_peak_pressure": res.cycle_peak_pressure, "critical_angle": model.critical,
-            "cycle_damage": res.cycle_damage,
-            "summary": {"track_damage": res.track_damage, "map_track_damage": res.map_track_damage,
-                        "duration_s": res.duration, "life_L10_h": res.life_hours,
-                        "life_map_L10_h": res.map_life_hours, "life_dg03_L10_h": res.dg03.hours,
-                        "life_dg03_ratio": res.dg03_ratio, "life_worst_track": res.worst_track,
-                        "micro_swing_rad": res.micro_swing}}

@@ -473,3 +473,17 @@ def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
         relubrication_swing=m.relubrication_swing, cycle_damage=cycle_damage, micro_swing=micro_swing,
         micro_cycles=float(cyc.count[~counted].sum()), damage_share_below_one=d_share,
         damage_share_below_critical=d_below, warnings=tuple(motion_warnings(t, psi)))
+
+
+def life_files(res, model) -> dict:
+    """What :func:`slewing_model.study.engine.write_life` writes of a run (maps, cycles, summary): plain
+    arrays and numbers of ``res`` (:class:`LifeResult`) and ``model`` (:class:`LifeModel`)."""
+    return {"damage_map": res.damage_map, "swing": res.swing, "count": res.count,
+            "travel_ratio": res.travel_ratio, "track_travel_ratio": res.track_travel_ratio,
+            "cycle_peak_pressure": res.cycle_peak_pressure, "critical_angle": model.critical,
+            "cycle_damage": res.cycle_damage,
+            "summary": {"track_damage": res.track_damage, "map_track_damage": res.map_track_damage,
+                        "duration_s": res.duration, "life_L10_h": res.life_hours,
+                        "life_map_L10_h": res.map_life_hours, "life_dg03_L10_h": res.dg03.hours,
+                        "life_dg03_ratio": res.dg03_ratio, "life_worst_track": res.worst_track,
+                        "micro_swing_rad": res.micro_swing}}

@@ -51,7 +51,7 @@ import numpy as np
 
 from ..distribution.bime import Loads
 from ..life import LifeAccumulator, LifeModel, analyse_run
-from ..life.command import life_files
+from ..life.duty import life_files
 from ..simulation.simulator import BearingSimulator, SimulatorSettings
 from .series import MotionSeries
 
