@@ -353,6 +353,10 @@ def _duty(runs: list[dict]) -> dict:
             "dg03_h": hours(dg03), "ratio": hours(dg03) / ours if np.isfinite(ours) and ours > 0 else float("nan")}
 
 
+def _short(label: str, width: int = 48) -> str:
+    return label if len(label) <= width else label[:width - 3] + "..."
+
+
 def _fmt_h(h: float) -> str:
     return "inf" if not np.isfinite(h) else f"{h:.3g} h"
 
@@ -379,7 +383,7 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
         if len(duties) <= MAX_GROUP_LINES:
             for j, (label, duty) in enumerate(duties.items()):
                 ax.stairs(duty["map"][k], edges, lw=0.8, fill=one, alpha=0.8 if one else 1.0,
-                          color=f"C{k if one else j}", label=None if one else label)
+                          color=f"C{k if one else j}", label=None if one else _short(label))
         else:
             maps = np.array([duty["map"][k] for duty in duties.values()])
             ax.stairs(maps.max(axis=0), edges, baseline=maps.min(axis=0), fill=True, alpha=0.35, color=f"C{k}",
@@ -392,10 +396,9 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
                          f"{d['map_track'][k]:.3g} (map) in {d['duration']:.4g} s; L10 of the track alone "
                          f"{_fmt_h(life_k)}", fontsize=9, loc="left")
         else:
-            text = "; ".join(f"{label or 'all'} D {d['map_track'][k]:.2g}" for label, d in
-                             list(duties.items())[:3])
-            ax.set_title(f"contact {TRACK_LABELS[k]} (map): {text}{' ...' if len(duties) > 3 else ''}",
-                         fontsize=9, loc="left")
+            dk = np.array([d["map_track"][k] for d in duties.values()])
+            ax.set_title(f"contact {TRACK_LABELS[k]}, map: D median {np.median(dk):.3g}, range {dk.min():.3g}.."
+                         f"{dk.max():.3g} over the {len(duties)} variants", fontsize=9, loc="left")
         ax.set_xlim(0, 360)
         ax.set_ylabel("slice damage d_j", fontsize=8)
         ax.grid(alpha=0.3)
@@ -442,12 +445,13 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
     ax3 = fig.add_subplot(grid[3, 1])
     ax3.axis("off")
     lines = []
-    lines.append(f"L10 in hours of the duty ({sum(d['duration'] for d in duties.values()):.4g} s"
-                 f"{'' if one else ' over all groups'}) repeated:")
-    for label, d in list(duties.items())[:MAX_GROUP_LINES]:
+    lines.append(f"L10 in hours of the duty ({next(iter(duties.values()))['duration']:.4g} s) repeated:" if one else
+                 "L10 in hours of each variant's duty repeated:")
+    for label, d in (list(duties.items()) if len(duties) <= MAX_GROUP_LINES else []):
         worst = f"worst track {int(np.argmax(d['cycle_track'])) + 1}" if d["cycle_track"].max() > 0 else "no damage"
         ratio = "-" if np.isnan(d["ratio"]) else f"{d['ratio']:.2f} x ours"
-        lines.append(f"{label + ': ' if label else ''}ISO/TS 16281 + oscillation rule {_fmt_h(d['ours_h'])} ({worst})")
+        lines.append(f"{_short(label) + ': ' if label else ''}ISO/TS 16281 + oscillation rule {_fmt_h(d['ours_h'])} "
+                     f"({worst})")
         lines.append(f"{'    ' if label else ''}raceway map {_fmt_h(d['map_h'])};  DG03 {_fmt_h(d['dg03_h'])} = {ratio}")
     if len(duties) > MAX_GROUP_LINES:
         ours = np.array([d["ours_h"] for d in duties.values()])
@@ -456,8 +460,8 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
                      f"{_fmt_h(float(ours.min()))}..{_fmt_h(float(ours.max()))}; DG03/ours median "
                      f"{np.nanmedian(ratio):.2f}")
     cases = sum(len(v) for v in groups.values())
-    lines.append(f"{cases} run(s)" + ("" if one else
-                 f" in {len(duties)} groups of alternative designs, each group's runs added, groups never added"))
+    lines.append(f"{cases} run(s)" + (" of one duty, added" if one and cases > 1 else "") + ("" if one else
+                 f" in {len(duties)} variants (alternative designs): each one's runs added, variants never added"))
     ax3.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax3.transAxes)
     if title:
         fig.suptitle(title)
