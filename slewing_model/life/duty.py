@@ -486,4 +486,4 @@ def life_files(res, model) -> dict:
                         "duration_s": res.duration, "life_L10_h": res.life_hours,
                         "life_map_L10_h": res.map_life_hours, "life_dg03_L10_h": res.dg03.hours,
                         "life_dg03_ratio": res.dg03_ratio, "life_worst_track": res.worst_track,
-                        "micro_swing_rad": res.micro_swing}}
+                        "micro_swing_rad": res.micro_swing, "warnings": list(res.warnings)}}
