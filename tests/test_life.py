@@ -440,3 +440,19 @@ def test_dg03_factor_is_used_as_stated_above_the_critical_angle():
     r = life.dg03_life([pea] * 4, [theta] * 4, [1.0] * 4, ca, 150, math.radians(4.8), 3600.0)
     assert r.life_cycles == pytest.approx((ca * (180 / 8.0) ** 0.3 * 150 ** 0.033 / pea) ** 3 * 1e6, rel=1e-12)
     assert r.above_critical
+
+
+@pytest.mark.parametrize("kind", ["smooth", "even"])
+def test_a_series_without_quantisation_keeps_the_tolerance_as_micro_swing(kind):
+    """Only a recording's quantisation sets the micro-cycle threshold: a finely sampled sine (changes
+    not whole multiples of the smallest) and an evenly stepped triangle (every change the same) show
+    none, so the threshold is the reversal tolerance and every cycle counts."""
+    model = life.LifeModel(BEARING, "inner", "fixed")
+    acc = life.LifeAccumulator(model, record=True)
+    psi = (math.radians(0.5) * np.sin(np.linspace(0, 6 * np.pi, 301)) if kind == "smooth"
+           else steady_swing(math.radians(0.5), 3, per_half=10))
+    for k, p in enumerate(psi):
+        acc.step(0.05 * k, p, synthetic_step(BEARING, p, lambda phi: np.full_like(phi, 1e5)), (0, 0, 1e6, 0, 0))
+    r = life.analyse_run(acc)
+    assert r.micro_swing == model.settings.reversal_tolerance
+    assert r.micro_cycles == 0 and r.count.sum() >= 3

@@ -33,8 +33,8 @@ from .wear import rolling_travel, relubrication_gap
 #: above the 16-bit quantisation of recorded pitch angles (about 5e-6 rad over 18°)
 DEFAULT_REVERSAL_TOLERANCE = 1e-5
 #: a rainflow cycle is a micro-cycle, left out of the x/2b and critical-angle shares counted by cycles,
-#: when its swing is below this many steps of the series' angle resolution (the smallest non-zero
-#: change of ψ between samples: the recording's quantisation): each of a cycle's two reversals is
+#: when its swing is below this many steps of the series' angle resolution (:func:`angle_resolution`,
+#: the recording's quantisation step): each of a cycle's two reversals is
 #: rounded by up to half a step, so a swing of 10 steps is known to ±10 %, and shorter ones are mostly
 #: rounding (the FAST v8 pitch series: steps of 2.1e-6 rad, its smallest cycles 7 steps)
 MICRO_CYCLE_STEPS = 10
@@ -380,11 +380,23 @@ def _hours(duration, damage):
 
 
 def angle_resolution(psi) -> float:
-    """The series' angle resolution, rad: the smallest change of ``psi`` between samples above
-    rounding of the number format (the recording's quantisation step); 0 for a constant series."""
+    """The recording's angle resolution (quantisation step) of ``psi``, rad; 0 when the series shows none.
+
+    The smallest change of ``psi`` between samples above rounding of the number format, ``q``, is taken
+    as the recording's step when the series shows that it is one: the changes are whole multiples of
+    ``q`` (95 % of the changes up to 20 q within 5 % of a whole multiple; ``q`` is the mean of the
+    changes within 10 % of the smallest, as the written digits round it) and not all of one size
+    (some are 2 q or more). A smoothly sampled angle (changes that are
+    not multiples of its smallest one) or an evenly stepped one (every change the same: the sampling's
+    grid, not a recording's) has none."""
     step = np.abs(np.diff(np.asarray(psi, dtype=float)))
     step = step[step > _ANGLE_NOISE]
-    return float(step.min()) if step.size else 0.0
+    if step.size == 0:
+        return 0.0
+    q = float(step[step < 1.1 * step.min()].mean())     # one step, averaged over the written digits' rounding
+    k = step[step < 20.5 * q] / q                       # the small changes, where a quantisation shows
+    whole = np.abs(k - np.round(k)) < 0.05
+    return q if whole.mean() >= 0.95 and np.any(k >= 1.95) else 0.0
 
 
 def motion_warnings(time, psi) -> list[str]:
