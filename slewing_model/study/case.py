@@ -199,7 +199,7 @@ def run_case(task: CaseTask) -> CaseResult:
     try:
         result = analyse_run(life)
     except Exception as exc:  # noqa: BLE001 - e.g. rainflow not installed: the case's other results stand
-        return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram,
+        return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, json_ready(stats), histogram,
                           {"error": one_line(exc)})
     stats.update(result.summary())
     stats = json_ready(stats)           # as result.json holds them: inf as "inf", no value as None
