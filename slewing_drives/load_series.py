@@ -211,7 +211,7 @@ def synthetic_blade_root_loads(duration: float, *, dt: float = 0.01, seed: int =
         mean_thrust_moment * thrust,                                 # My: flapwise thrust moment
         mean_pitching_moment * thrust + pitching_moment_gravity * np.sin(azimuth),  # Mz: on the pitch drive
     ])
-    return LoadSeries(t, loads)
+    return LoadSeries(t, loads, load_frame="rotating")                # the blade frame pitches with the blade
 
 
 def synthetic_tower_top_loads(duration: float, *, dt: float = 0.05, seed: int = 0,

@@ -264,7 +264,7 @@ def _add_life(sub) -> None:
     """``slewing life LOADS.csv BEARING.toml`` (slewing_model.life.command)."""
     from .life import command
 
-    p = sub.add_parser("life", help="life and wear of one load series: ISO/TS 16281 with oscillations, raceway "
+    p = _add_parser(sub, "life", help="life and wear of one load series: ISO/TS 16281 with oscillations, raceway "
                                     "damage map, DG03, x/2b (docs/life.md)")
     command.add_arguments(p)
     p.set_defaults(func=command.run)

@@ -3,6 +3,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from slewing_model.cli import main
 
@@ -41,3 +42,127 @@ def test_parquet_time_series_round_trip(tmp_path):
     back = pq.read_table(tmp_path / "t.parquet")
     assert back.column_names == list(TIMESERIES_COLUMNS)
     np.testing.assert_array_equal(np.column_stack([back.column(c).to_numpy() for c in TIMESERIES_COLUMNS]), table)
+
+
+# ---- issue 28: what a new user tripped on ------------------------------------------------------------
+TABLE3 = ROOT / "examples/bearings/table3.toml"
+
+
+def strict_json(path):
+    """Parse as JSON (RFC 8259): Python's json reads the non-standard Infinity and NaN unless told not to."""
+    def refuse(name):
+        raise ValueError(f"{path}: {name} is not JSON")
+    return json.loads(Path(path).read_text(), parse_constant=refuse)
+
+
+def write_series(path, t, psi, fz=5e4, header="time,Fx,Fy,Fz,Mx,My,Mz,psi"):
+    fz = np.broadcast_to(fz, t.shape)
+    rows = np.column_stack([t, 0 * t, 0 * t, fz, 0 * t, 0 * t, 0 * t, psi])
+    np.savetxt(path, rows[:, :len(header.split(","))], delimiter=",", header=header, comments="")
+    return path
+
+
+def test_constant_angle_gives_no_track_0_and_no_nan(tmp_path, capsys):
+    """A ring that never moves: no rainflow cycle, no damage. There is no worst track (tracks are
+    1-4), no DG03 ratio and no share: the output says so instead of "track 0", "nan x ours", "nan%",
+    and the JSON holds null for them and "inf" for the lives."""
+    t = np.linspace(0.0, 2.0, 21)
+    csv = write_series(tmp_path / "still.csv", t, 0 * t)
+    out = tmp_path / "out"
+    assert main(["life", str(csv), str(TABLE3), "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "track 0" not in text and "nan" not in text.lower()
+    summary = strict_json(out / "life_summary.json")
+    assert summary["life_worst_track"] is None and summary["life_dg03_ratio"] is None
+    assert summary["life_share_x2b_below_1"] is None
+    assert summary["life_L10_h"] == "inf" and float(summary["life_map_L10_h"]) == float("inf")
+    assert not (out / "life.png").exists()                 # nothing to draw
+
+
+def test_life_summary_is_strict_json(tmp_path):
+    """A swinging run: every number of life_summary.json parses as JSON (no Infinity, no NaN)."""
+    t = np.linspace(0.0, 4.0, 161)
+    csv = write_series(tmp_path / "swing.csv", t, np.radians(3.0) * np.sin(2 * np.pi * t))
+    assert main(["life", str(csv), str(TABLE3), "-o", str(tmp_path / "out")]) == 0
+    summary = strict_json(tmp_path / "out" / "life_summary.json")
+    assert summary["life_worst_track"] in (1, 2, 3, 4) and summary["life_L10_h"] > 0
+
+
+@pytest.mark.parametrize("option, value, message", [
+    ("--slices", "0", "--slices 0: must be a whole number >= 4"),
+    ("--slices", "-5", "--slices -5: must be a whole number >= 4"),
+    ("--relubrication-swing", "-1", "--relubrication-swing -1 deg: must be finite and > 0 (deg)"),
+    ("--relubrication-swing", "0", "--relubrication-swing 0 deg: must be finite and > 0 (deg)"),
+])
+def test_bad_options_are_refused_naming_option_value_and_rule(tmp_path, capsys, option, value, message):
+    """--slices 0 was silently replaced by the default; --relubrication-swing given in degrees was
+    reported back in radians. Both refused, in the unit given, before any work."""
+    t = np.linspace(0.0, 1.0, 11)
+    csv = write_series(tmp_path / "s.csv", t, 0.01 * t)
+    assert main(["life", str(csv), str(TABLE3), option, value]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_series_without_psi_is_refused_naming_the_column(capsys):
+    """The shipped blade-root series has loads only: `slewing life` used to report 0 cycles and
+    infinite lives without a word; it is refused, naming the missing column."""
+    assert main(["life", str(ROOT / "examples/loads/blade_root_loads.csv"), str(TABLE3)]) == 2
+    err = capsys.readouterr().err
+    assert "blade_root_loads.csv: no column psi" in err
+
+
+def test_the_example_blade_root_series_states_its_frame():
+    """Blade-root loads are in the blade frame, which pitches with the moving ring: the file says
+    `# load_frame = rotating`, and both readers take it."""
+    from slewing_drives import LoadSeries
+    from slewing_model.study.series import read_csv
+
+    path = ROOT / "examples/loads/blade_root_loads.csv"
+    assert "# load_frame = rotating" in path.read_text().splitlines()[:3]
+    assert LoadSeries.read_csv(path).load_frame == "rotating"
+    assert read_csv(str(path)).load_frame == "rotating"
+
+
+def test_load_beyond_capacity_names_the_line_and_time(tmp_path, capsys):
+    """Row 6 of 11 (file line 7, after the header) carries an axial load the bearing cannot take:
+    the message names the file, the line and the time, not only the loads."""
+    t = np.linspace(0.0, 1.0, 11)
+    fz = np.full_like(t, 5e4)
+    fz[5] = 5e9
+    csv = write_series(tmp_path / "crush.csv", t, 0.01 * t, fz=fz)
+    assert main(["life", str(csv), str(TABLE3)]) == 2
+    err = capsys.readouterr().err
+    assert f"{csv}, line 7, t = 0.5 s:" in err
+
+
+def test_psi_in_degrees_is_flagged(tmp_path, capsys):
+    """A pitch angle of 0..8 degrees written as if in rad: 8 "rad" is more than a revolution and its
+    speed of 4 "rad/s" beyond any pitch drive; the run warns (the same series in rad does not)."""
+    t = np.linspace(0.0, 4.0, 81)
+    deg = 4.0 * (1 - np.cos(np.pi * t / 2))                   # 0..8 deg, at most 2π deg/s
+    for psi, flagged in ((deg, True), (np.radians(deg), False)):
+        csv = write_series(tmp_path / "p.csv", t, psi)
+        assert main(["life", str(csv), str(TABLE3)]) == 0
+        err = capsys.readouterr().err
+        assert ("is psi in degrees?" in err) == flagged
+
+
+def test_life_help_shows_defaults_like_the_other_commands(capsys):
+    with pytest.raises(SystemExit):
+        main(["life", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for option in ("--ring-model", "--slices", "--relubrication-swing", "--rating", "--output"):
+        assert option in text
+    assert "(default: rigid)" in text and "(default: the first count from 1440" in text
+
+
+def test_docs_life_commands_write_only_into_results():
+    """The commands docs/life.md gives write into results/ (ignored by git), not into the
+    repository's root: the former `-o fastv8.csv` left an untracked file behind."""
+    import re
+
+    text = (ROOT / "docs/life.md").read_text()
+    outputs = re.findall(r"\.venv/bin/slewing (?:loads|life|batch) .*?-o (\S+)", text)
+    assert len(outputs) >= 3
+    assert all(o.startswith("results/") for o in outputs), outputs
+    assert "results/" in (ROOT / ".gitignore").read_text().split()

@@ -323,3 +323,40 @@ def test_every_bad_file_of_a_study_is_named_in_one_message(tmp_path, capsys):
     assert f"loads.csv = '{absent_loads}': cannot read the load series: No such file or directory" in err
     assert f"{broken}: bearing.ball_count = -" in err                  # the bearing file's own message
     assert list(out_dir.iterdir()) == []
+
+
+def test_every_json_of_a_study_is_strict_json_and_no_track_0(tmp_path):
+    """A ring standing still (no cycles: infinite lives, no worst track, no DG03 ratio) and one turning:
+    every JSON file the study writes parses as RFC 8259 JSON (no bare Infinity or NaN, which e.g.
+    Node's JSON.parse refuses); summary.csv has no track 0 and no "nan" for the still case."""
+    path = write_study(tmp_path, idling("still", 6, fz=3e4, omega=0.0) + idling("turning", 6, fz=3e4),
+                       preloads=(0,), seeds=(1,))
+    run_study(path, tmp_path / "out", workers=1, progress=False, figures=True)
+
+    def refuse(name):
+        raise ValueError(f"{name} is not JSON")
+
+    files = list((tmp_path / "out").rglob("*.json"))
+    assert len(files) >= 5                      # study.json, and per case case.json, result.json, life_summary.json
+    for f in files:
+        json.loads(f.read_text(), parse_constant=refuse)
+    rows = {r["load"]: r for r in summary(tmp_path / "out")}
+    still = rows["still"]
+    assert still["life_worst_track"] == "" and still["life_L10_h"] == "inf" and still["life_dg03_ratio"] == ""
+    assert "nan" not in " ".join(still.values()).lower()
+    assert rows["turning"]["life_worst_track"] in ("1", "2", "3", "4")
+
+
+def test_life_figure_groups_variants_and_adds_only_parts_of_one_duty(tmp_path):
+    """Two load series (parts of one duty) x two preloads (alternative designs): the life figure's groups
+    are the two bearing variants, each holding both load series; the variants are never added."""
+    from slewing_model.study.figures import life_groups
+
+    path = write_study(tmp_path, idling("a", 6, fz=3e4) + idling("b", 6, fz=5e4), preloads=(0, 20), seeds=(1,))
+    result = run_study(path, tmp_path / "out", workers=1, progress=False, figures=True)
+    groups = life_groups(str(tmp_path / "out"), result.rows)
+    assert len(groups) == 2
+    for folders in groups.values():
+        loads = sorted(r["load"] for r in result.rows if os.path.join(str(tmp_path / "out"), "cases", r["case"]) in folders)
+        assert loads == ["a", "b"]
+    assert (tmp_path / "out" / "figures" / "life.png").stat().st_size > 0

@@ -16,7 +16,7 @@ from .rating import (LifeInputError, Raceway, RacewayLife, axial_rating, combine
                      four_point_capacities, iso281_axial_rating, raceway_capacity, raceway_life,
                      radial_bearing_life, radial_raceway_capacities)
 from .oscillation import critical_angle, dg03_rating_factor, equivalent_revolutions, rainflow_cycles
-from .raceway_map import RacewayMap, track_damage
+from .raceway_map import RacewayMap, default_slices, track_damage
 from .wear import rolling_travel, relubrication_gap
 from .dg03 import DG03Life, dg03_life, equivalent_axial_load
 from .duty import LifeAccumulator, LifeModel, LifeResult, LifeSettings, analyse_run
@@ -26,7 +26,7 @@ __all__ = [
     "four_point_capacities", "iso281_axial_rating", "raceway_capacity", "raceway_life", "radial_bearing_life",
     "radial_raceway_capacities",
     "critical_angle", "dg03_rating_factor", "equivalent_revolutions", "rainflow_cycles",
-    "RacewayMap", "track_damage", "rolling_travel", "relubrication_gap",
+    "RacewayMap", "default_slices", "track_damage", "rolling_travel", "relubrication_gap",
     "DG03Life", "dg03_life", "equivalent_axial_load",
     "LifeAccumulator", "LifeModel", "LifeResult", "LifeSettings", "analyse_run",
 ]

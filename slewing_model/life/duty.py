@@ -26,12 +26,27 @@ from .dg03 import DG03Life, dg03_life, equivalent_axial_load
 from .oscillation import critical_angle, equivalent_revolutions, rainflow_cycles, span_mean
 from .rating import TRACK_RINGS, LifeInputError, axial_rating, combined_damage, equivalent_load, \
     four_point_capacities
-from .raceway_map import DEFAULT_SLICES, RacewayMap, passes_per_revolution, track_damage
+from .raceway_map import DEFAULT_SLICES, RacewayMap, default_slices, passes_per_revolution, track_damage
 from .wear import rolling_travel, relubrication_gap
 
 #: default reversal tolerance of the online half-cycle detector and smallest rainflow swing, rad:
 #: above the 16-bit quantisation of recorded pitch angles (about 5e-6 rad over 18°)
 DEFAULT_REVERSAL_TOLERANCE = 1e-5
+#: a rainflow cycle is a micro-cycle, left out of the x/2b and critical-angle shares counted by cycles,
+#: when its swing is below this many steps of the series' angle resolution (:func:`angle_resolution`,
+#: the recording's quantisation step): each of a cycle's two reversals is
+#: rounded by up to half a step, so a swing of 10 steps is known to ±10 %, and shorter ones are mostly
+#: rounding (the FAST v8 pitch series: steps of 2.1e-6 rad, its smallest cycles 7 steps)
+MICRO_CYCLE_STEPS = 10
+#: changes of ψ between samples below this are rounding of the number format, not of the recording, rad
+_ANGLE_NOISE = 1e-12
+#: largest plausible speed of a pitch or yaw bearing's ring, rad/s (28.6 deg/s): pitch systems feather at
+#: up to about 10 deg/s, yaw drives turn at about 0.5 deg/s; a series in degrees read as radians shows
+#: 57.3 times its speed, so a blade pitching at 0.5 deg/s already exceeds it
+PLAUSIBLE_SPEED = 0.5
+#: largest plausible range of ψ of a run, rad: a pitch bearing turns through at most about 95 deg; a pitch
+#: series of more than 6.3 deg in degrees read as radians exceeds one revolution
+PLAUSIBLE_RANGE = 2 * math.pi
 
 
 @dataclass(frozen=True)
@@ -43,8 +58,9 @@ class LifeSettings:
     rating : float or None, N
         Basic dynamic axial rating ``Ca`` of the bearing (ISO 281, from the maker's catalogue);
         None: from the raceway geometry (:func:`slewing_model.life.rating.axial_rating`).
-    slices : int
-        Slices of each track in the raceway map.
+    slices : int or None
+        Slices of each track in the raceway map; None: :func:`~.raceway_map.default_slices` of the
+        bearing's ball count (at least 1440, with no common divisor with Z: no aliasing).
     reversal_tolerance : float, rad
         Smallest movement against the current direction that counts as a reversal of ``ψ``
         (online half-cycles), and smallest rainflow swing kept.
@@ -58,14 +74,15 @@ class LifeSettings:
     """
 
     rating: float | None = None
-    slices: int = DEFAULT_SLICES
+    slices: int | None = None
     reversal_tolerance: float = DEFAULT_REVERSAL_TOLERANCE
     relubrication_swing: float | None = None
     rating_factor: object = None
 
     def __post_init__(self):
-        if isinstance(self.slices, bool) or not isinstance(self.slices, (int, np.integer)) or self.slices < 4:
-            raise LifeInputError(f"slices = {self.slices!r}: must be a whole number >= 4")
+        if self.slices is not None and (isinstance(self.slices, bool) or not isinstance(self.slices, (int, np.integer))
+                                        or self.slices < 4):
+            raise LifeInputError(f"slices = {self.slices!r}: must be a whole number >= 4, or None (the default)")
         if self.rating is not None and not (math.isfinite(self.rating) and self.rating > 0):
             raise LifeInputError(f"rating = {self.rating!r}: must be finite and > 0 (N), or None")
         if not (math.isfinite(self.reversal_tolerance) and self.reversal_tolerance > 0):
@@ -105,6 +122,14 @@ class LifeModel:
         moving = np.array([r == self.moving_ring for r in TRACK_RINGS])
         self.rotating = moving if load_frame == "fixed" else ~moving                 # turns relative to the load
         self.relubrication_swing = self.settings.relubrication_swing or float(self.critical.max())
+        self.slices = self.settings.slices or default_slices(bearing.ball_count)
+
+    def track_standing_loads(self, contact_load) -> np.ndarray:
+        """``Qe`` of the four tracks at one step with the exponent 10/3 of a ring standing relative
+        to the load, N (4,): what a swing below a track's critical angle makes of every track (each
+        point of the raceway meets only the balls next to it, see :func:`analyse_run`)."""
+        q = np.asarray(contact_load, dtype=float)
+        return np.array([float(equivalent_load(q[:, k], False)) for k in range(4)])
 
     def track_equivalent_loads(self, contact_load) -> np.ndarray:
         """ISO/TS 16281 ``Qe`` of the four tracks at one step from the ball loads (B, 4), N (4,)."""
@@ -113,7 +138,7 @@ class LifeModel:
 
 
 #: the per-step numbers :class:`LifeAccumulator` records (``record=True``), per track where (4,)
-RECORD_FIELDS = ("time", "psi", "qe", "b_max", "angle_at_b_max", "p_max", "pea")
+RECORD_FIELDS = ("time", "psi", "qe", "qe_standing", "b_max", "angle_at_b_max", "p_max", "pea")
 
 
 @dataclass
@@ -148,7 +173,7 @@ class LifeAccumulator:
 
     def __init__(self, model: LifeModel, record: bool = False):
         self.model = model
-        self.map = RacewayMap(model.capacity, model.passes, model.moving_ring, model.settings.slices)
+        self.map = RacewayMap(model.capacity, model.passes, model.moving_ring, model.slices)
         self.half = HalfCycles()
         self.record = record
         self.rows: list = []
@@ -166,7 +191,8 @@ class LifeAccumulator:
         if self.record:
             pea = float(equivalent_axial_load(np.asarray(loads, float)[:5], self.model.bearing.pitch_diameter)[0]) \
                 if loads is not None else math.nan
-            self.rows.append((time, psi, self.model.track_equivalent_loads(d.contact_load), b[j, cols],
+            self.rows.append((time, psi, self.model.track_equivalent_loads(d.contact_load),
+                              self.model.track_standing_loads(d.contact_load), b[j, cols],
                               d.contact_angle[j, cols], d.contact_pressure.max(axis=0), pea))
 
     def _half_cycle(self, psi, b, angle) -> None:
@@ -257,9 +283,9 @@ class LifeResult:
     damage : float
         The bearing's (tracks combined by the weakest link).
     life_hours : float, h
-        ``duration / damage``.
-    worst_track : int
-        Contact 1..4 with the largest damage (0: no damage, the ring never moved).
+        ``duration / damage`` (inf: no damage).
+    worst_track : int or None
+        Contact 1..4 with the largest damage; None when nothing was damaged (the ring never moved).
     map_track_damage : ndarray (4,), map_damage : float, map_life_hours : float
         The same from the raceway map.
     damage_map : ndarray (4, slices)
@@ -267,27 +293,40 @@ class LifeResult:
     swing, count : ndarray
         Rainflow cycles (rad; 1 or 0.5).
     below_critical : float
-        Share of cycles (by count) whose swing is below the inner raceway's critical angle.
+        Share of the cycles (by count, micro-cycles left out) whose swing is below the inner
+        raceway's critical angle; NaN without such cycles.
     travel_ratio : ndarray
         ``x/2b`` of each cycle (the smallest over the loaded tracks).
+    share_below_one : float
+        Share of the cycles (by count, micro-cycles left out) with ``x/2b < 1``; NaN without such cycles.
     track_travel_ratio : ndarray (cycles, 4)
         ``x/2b`` of each cycle and contact 1..4 (the contact's widest patch in the cycle; inf: unloaded).
     cycle_peak_pressure : ndarray (cycles, 4), Pa
         Largest Hertz pressure of each contact in each cycle.
-    share_below_one : float
-        Share of cycles (by count) with ``x/2b < 1``.
     peak_pressure : ndarray (4,), Pa
         Largest Hertz pressure of each track over the run.
     relubrication_gap : float, s
         Longest time without a movement of ``relubrication_swing``.
     relubrication_swing : float, rad
+    cycle_damage : ndarray (cycles, 4)
+        Damage of each cycle on contacts 1..4 (the terms of ``track_damage``).
+    micro_swing : float, rad
+        Swing below which a cycle is a micro-cycle (:data:`MICRO_CYCLE_STEPS` steps of the series'
+        angle resolution, at least the reversal tolerance).
+    micro_cycles : float
+        Number of micro-cycles (by count).
+    damage_share_below_one, damage_share_below_critical : float
+        The two shares weighted by each cycle's damage on the worst track instead of counted (every
+        cycle, micro-cycles too: they weigh what they damage); NaN without damage.
+    warnings : tuple of str
+        Plausibility warnings on the series (:func:`motion_warnings`).
     """
 
     duration: float
     track_damage: np.ndarray
     damage: float
     life_hours: float
-    worst_track: int
+    worst_track: int | None
     map_track_damage: np.ndarray
     map_damage: float
     map_life_hours: float
@@ -303,16 +342,36 @@ class LifeResult:
     peak_pressure: np.ndarray
     relubrication_gap: float
     relubrication_swing: float
+    cycle_damage: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    micro_swing: float = 0.0
+    micro_cycles: float = 0.0
+    damage_share_below_one: float = math.nan
+    damage_share_below_critical: float = math.nan
+    warnings: tuple = ()
+
+    @property
+    def dg03_ratio(self) -> float:
+        """DG03's life over ours (NaN when neither has damage: no cycles)."""
+        if math.isinf(self.life_hours) and math.isinf(self.dg03.hours):
+            return math.nan
+        return self.dg03.hours / self.life_hours if self.life_hours > 0 else math.nan
 
     def summary(self) -> dict:
-        """The numbers of a study's summary row."""
+        """The numbers of a study's summary row; None where a value does not exist (no worst track
+        without damage, no ratio or share without cycles); inf: no damage, an infinite life."""
+        def value(x):
+            return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
+
         return {
             "life_L10_h": self.life_hours, "life_worst_track": self.worst_track,
-            "life_damage_per_h": self.damage / self.duration * 3600.0 if self.duration > 0 else math.nan,
+            "life_damage_per_h": value(self.damage / self.duration * 3600.0 if self.duration > 0 else math.nan),
             "life_map_L10_h": self.map_life_hours, "life_dg03_L10_h": self.dg03.hours,
-            "life_dg03_ratio": self.dg03.hours / self.life_hours if self.life_hours > 0 else math.nan,
-            "life_cycles": float(self.count.sum()), "life_share_x2b_below_1": self.share_below_one,
-            "life_share_below_critical": self.below_critical, "life_relubrication_gap_s": self.relubrication_gap,
+            "life_dg03_ratio": value(self.dg03_ratio),
+            "life_cycles": float(self.count.sum()), "life_share_x2b_below_1": value(self.share_below_one),
+            "life_share_below_critical": value(self.below_critical), "life_relubrication_gap_s": self.relubrication_gap,
+            "life_micro_cycles": self.micro_cycles,
+            "life_damage_share_x2b_below_1": value(self.damage_share_below_one),
+            "life_damage_share_below_critical": value(self.damage_share_below_critical),
         }
 
 
@@ -320,18 +379,70 @@ def _hours(duration, damage):
     return duration / damage / 3600.0 if damage > 0 else math.inf
 
 
+def angle_resolution(psi) -> float:
+    """The recording's angle resolution (quantisation step) of ``psi``, rad; 0 when the series shows none.
+
+    The smallest change of ``psi`` between samples above rounding of the number format, ``q``, is taken
+    as the recording's step when the series shows that it is one: the changes are whole multiples of
+    ``q`` (95 % of the changes up to 20 q within 5 % of a whole multiple; ``q`` is the mean of the
+    changes within 10 % of the smallest, as the written digits round it) and not all of one size
+    (some are 2 q or more). A smoothly sampled angle (changes that are
+    not multiples of its smallest one) or an evenly stepped one (every change the same: the sampling's
+    grid, not a recording's) has none."""
+    step = np.abs(np.diff(np.asarray(psi, dtype=float)))
+    step = step[step > _ANGLE_NOISE]
+    if step.size == 0:
+        return 0.0
+    q = float(step[step < 1.1 * step.min()].mean())     # one step, averaged over the written digits' rounding
+    k = step[step < 20.5 * q] / q                       # the small changes, where a quantisation shows
+    whole = np.abs(k - np.round(k)) < 0.05
+    return q if whole.mean() >= 0.95 and np.any(k >= 1.95) else 0.0
+
+
+def motion_warnings(time, psi) -> list[str]:
+    """Plausibility of a pitch or yaw bearing's ring angle ``psi`` (rad) over ``time`` (s): a speed
+    above :data:`PLAUSIBLE_SPEED` or a range above :data:`PLAUSIBLE_RANGE` most likely means an
+    angle given in degrees (the lives then come out far too short). Messages name the value and the rule."""
+    t, p = np.asarray(time, dtype=float), np.asarray(psi, dtype=float)
+    out = []
+    if p.size > 1:
+        speed = np.abs(np.diff(p) / np.diff(t))
+        k = int(np.argmax(speed))
+        if speed[k] > PLAUSIBLE_SPEED:
+            out.append(f"psi changes at {speed[k]:.3g} rad/s ({math.degrees(speed[k]):.3g} deg/s) at t = {t[k]:.6g} s, "
+                       f"more than the {PLAUSIBLE_SPEED:g} rad/s a pitch or yaw bearing turns: is psi in degrees? "
+                       f"It must be in rad")
+        span = float(p.max() - p.min())
+        if span > PLAUSIBLE_RANGE:
+            out.append(f"psi spans {span:.4g} rad ({math.degrees(span):.4g} deg), more than one revolution "
+                       f"({PLAUSIBLE_RANGE:.4g} rad): is psi in degrees? It must be in rad (a yaw bearing that "
+                       f"really turned that far may ignore this)")
+    return out
+
+
 def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
-    """Life and wear of a recorded run (``LifeAccumulator(record=True)`` stepped through it)."""
+    """Life and wear of a recorded run (``LifeAccumulator(record=True)`` stepped through it).
+
+    The equivalent load of a track in a cycle: ISO/TS 16281's ``Qe`` of its ring, except under a
+    swing below the track's critical angle, where a ring that turns relative to the load is
+    treated as standing (exponent 10/3): a point of its raceway is then rolled over only by the
+    ball next to it, meeting the load at its own place again and again, never the others --
+    exactly ISO's situation of a standing ring. ISO's exponent 3 would understate its damage by
+    ``(Qe,10/3 / Qe,3)^3`` (1.139 for the rigid-ring moment distribution ``Q ∝ cos^1.5 φ``,
+    ``docs/life.md``)."""
     m, r = accumulator.model, accumulator.records()
     t, psi = r["time"], r["psi"]
     duration = float(t[-1] - t[0])
     tol = m.settings.reversal_tolerance
     cyc = rainflow_cycles(psi, min_swing=tol)
     w = np.abs(np.diff(psi, prepend=psi[0]))                       # the ring's rotation at each sample
-    qe = span_mean(r["qe"], w, cyc.start, cyc.end)                 # (cycles, 4), N
+    below_track = cyc.swing[:, None] < m.critical[None, :]         # (cycles, 4): the swing below the track's
+    qe = np.where(below_track, span_mean(r["qe_standing"], w, cyc.start, cyc.end),
+                  span_mean(r["qe"], w, cyc.start, cyc.end))      # (cycles, 4), N
     rev = equivalent_revolutions(cyc.swing[:, None], m.critical[None, :], m.bearing.ball_count,
                                  m.settings.rating_factor)        # (cycles, 4)
-    track = np.sum(cyc.count[:, None] * rev * (qe / m.capacity) ** 3, axis=0) / 1e6
+    cycle_damage = cyc.count[:, None] * rev * (qe / m.capacity) ** 3 / 1e6
+    track = np.sum(cycle_damage, axis=0)
     damage = float(combined_damage(track))
     map_track = accumulator.track_damage
     map_damage = float(combined_damage(map_track))
@@ -349,19 +460,42 @@ def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
         track_ratio[i, loaded] = x / (2 * bmax[loaded])
         cycle_pressure[i] = pmax[s:e + 1].max(axis=0)
     ratio = track_ratio.min(axis=1) if cyc.swing.size else np.zeros(0)
-    total = float(cyc.count.sum())
-    share = float(cyc.count[ratio < 1.0].sum() / total) if total else math.nan
-    below = float(cyc.count[cyc.swing < m.critical.min()].sum() / total) if total else math.nan
+    micro_swing = max(tol, MICRO_CYCLE_STEPS * angle_resolution(psi))
+    counted = cyc.swing >= micro_swing
+    total = float(cyc.count[counted].sum())
+    share = float(cyc.count[counted & (ratio < 1.0)].sum() / total) if total else math.nan
+    below = float(cyc.count[counted & (cyc.swing < m.critical.min())].sum() / total) if total else math.nan
+    worst = int(np.argmax(track)) if damage > 0 else None
+    weight = cycle_damage[:, worst] if worst is not None else np.zeros(cyc.swing.size)
+    weight_sum = float(weight.sum())
+    d_share = float(weight[ratio < 1.0].sum() / weight_sum) if weight_sum > 0 else math.nan
+    d_below = float(weight[cyc.swing < m.critical.min()].sum() / weight_sum) if weight_sum > 0 else math.nan
 
     pea = span_mean(r["pea"], w, cyc.start, cyc.end) if np.all(np.isfinite(r["pea"])) else np.full(cyc.swing.size,
                                                                                                       math.nan)
     dg = dg03_life(pea, cyc.swing, cyc.count, m.rating, m.bearing.ball_count, float(m.critical.max()), duration)
     return LifeResult(
         duration=duration, track_damage=track, damage=damage, life_hours=_hours(duration, damage),
-        worst_track=int(np.argmax(track)) + 1 if damage > 0 else 0, map_track_damage=map_track, map_damage=map_damage,
+        worst_track=None if worst is None else worst + 1, map_track_damage=map_track, map_damage=map_damage,
         map_life_hours=_hours(duration, map_damage), damage_map=accumulator.map.damage_map.copy(), dg03=dg,
         swing=cyc.swing, count=cyc.count, below_critical=below, travel_ratio=ratio, share_below_one=share,
         track_travel_ratio=track_ratio, cycle_peak_pressure=cycle_pressure,
         peak_pressure=r["p_max"].max(axis=0),
         relubrication_gap=relubrication_gap(t, psi, m.relubrication_swing),
-        relubrication_swing=m.relubrication_swing)
+        relubrication_swing=m.relubrication_swing, cycle_damage=cycle_damage, micro_swing=micro_swing,
+        micro_cycles=float(cyc.count[~counted].sum()), damage_share_below_one=d_share,
+        damage_share_below_critical=d_below, warnings=tuple(motion_warnings(t, psi)))
+
+
+def life_files(res, model) -> dict:
+    """What :func:`slewing_model.study.engine.write_life` writes of a run (maps, cycles, summary): plain
+    arrays and numbers of ``res`` (:class:`LifeResult`) and ``model`` (:class:`LifeModel`)."""
+    return {"damage_map": res.damage_map, "swing": res.swing, "count": res.count,
+            "travel_ratio": res.travel_ratio, "track_travel_ratio": res.track_travel_ratio,
+            "cycle_peak_pressure": res.cycle_peak_pressure, "critical_angle": model.critical,
+            "cycle_damage": res.cycle_damage,
+            "summary": {"track_damage": res.track_damage, "map_track_damage": res.map_track_damage,
+                        "duration_s": res.duration, "life_L10_h": res.life_hours,
+                        "life_map_L10_h": res.map_life_hours, "life_dg03_L10_h": res.dg03.hours,
+                        "life_dg03_ratio": res.dg03_ratio, "life_worst_track": res.worst_track,
+                        "micro_swing_rad": res.micro_swing, "warnings": list(res.warnings)}}

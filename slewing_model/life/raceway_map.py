@@ -43,8 +43,27 @@ import numpy as np
 
 from .rating import TRACK_RINGS, WEIBULL_SLOPE, LifeInputError, gamma
 
-#: default number of slices of a track around its circumference
-DEFAULT_SLICES = 720
+#: fewest slices of a track around its circumference by default (0.25 deg each); the default is the
+#: first count from here with no common divisor with the ball count (:func:`default_slices`)
+DEFAULT_SLICES = 1440
+
+
+def default_slices(ball_count: int, minimum: int = DEFAULT_SLICES) -> int:
+    """Slices of a track by default: the smallest ``N >= minimum`` with ``gcd(N, Z) = 1`` (1441 for
+    Z = 150).
+
+    Why coprime: the balls sit ``360°/Z`` apart, so against a grid of ``N`` slices their tracks
+    start at only ``Z / gcd(N, Z)`` different offsets (5 for 720 slices and 150 balls): each ball's
+    short track then covers either k or k + 1 slice centres together with the others, and a swing
+    whose track is about a slice long is counted ±20 % wrong (the life review, issue 28). With
+    ``gcd(N, Z) = 1`` the Z balls fall at Z offsets ``1/Z`` of a slice apart: over the balls the
+    track is sampled at ``1/Z`` of a slice, and the map's damage of a steady swing of 0.7-3° is
+    within 2 % of its converged value (0.5°: 2.6 %, 0.3°: 4 %; 150 balls, 1441 slices; tested
+    against the closed form of ``docs/life.md``)."""
+    n = int(minimum)
+    while math.gcd(n, int(ball_count)) != 1:
+        n += 1
+    return n
 
 
 def passes_per_revolution(ball_count, ball_diameter, pitch_diameter, contact_angle):

@@ -61,24 +61,40 @@ def travel_by_ring_kinematics(swing, pitch_diameter, ball_diameter, contact_angl
 
 
 def relubrication_gap(time, psi, threshold):
-    """Longest time (s) between movements of at least ``threshold`` (rad) of the ring angle: a
-    movement is counted whenever ``psi`` has left the last reference by ``threshold``, and the
-    reference then moves to it (a dead-band tracker, so drift in small steps counts too)."""
+    """Longest time (s) during which the ring angle ``psi`` (rad) stays within a band narrower than
+    ``threshold`` (rad): the longest stretch of samples ``i..j`` with ``max(psi) - min(psi) <
+    threshold``, its length ``t_j - t_i``.
+
+    No movement of ``threshold`` happens inside such a stretch (two angles ``threshold`` apart
+    would make the band that wide), and slow drift counts as soon as it adds up to ``threshold``.
+    The answer does not depend on where the record starts: a steady swing of full range
+    ``2A >= threshold`` gives, in every period ``T``, the stretch around a peak where the angle
+    stays within ``threshold`` of it, ``T (π + 2 asin(threshold/A - 1)) / (2π)`` for a sine
+    (tested at several starting phases). A ring that never moves by ``threshold`` gives the run.
+    Sliding window with monotone queues of the band's maximum and minimum: O(n)."""
+    from collections import deque
+
     t = np.asarray(time, dtype=float)
     p = np.asarray(psi, dtype=float)
     if t.size == 0:
         return 0.0
-    ref, last, gap = p[0], t[0], 0.0
-    moved = []
-    for k in range(1, p.size):          # O(n), a plain loop: post-processing only
-        if abs(p[k] - ref) >= threshold:
-            moved.append(t[k])
-            ref = p[k]
-    last = t[0]
-    for tm in moved:
-        gap = max(gap, tm - last)
-        last = tm
-    return float(max(gap, t[-1] - last))
+    high, low = deque(), deque()        # sample indices of the window's decreasing maxima, increasing minima
+    start, gap = 0, 0.0
+    for j in range(p.size):             # a plain loop: post-processing only
+        while high and p[high[-1]] <= p[j]:
+            high.pop()
+        high.append(j)
+        while low and p[low[-1]] >= p[j]:
+            low.pop()
+        low.append(j)
+        while p[high[0]] - p[low[0]] >= threshold:     # sample j moved the band to threshold: shrink it
+            start += 1
+            if high[0] < start:
+                high.popleft()
+            if low[0] < start:
+                low.popleft()
+        gap = max(gap, t[j] - t[start])
+    return float(gap)
 
 
 def relubrication_swing(pitch_diameter, ball_diameter, contact_angle, semi_axis_b,

@@ -27,7 +27,11 @@ Life and wear (:mod:`slewing_model.life`, ``docs/life.md``)
     ``life_map_L10_h``: the same from the raceway damage map; ``life_dg03_L10_h`` and
     ``life_dg03_ratio`` (DG03's life over ours); ``life_cycles`` (rainflow count of ``psi``);
     ``life_share_x2b_below_1`` and ``life_share_below_critical`` (shares of the cycles);
-    ``life_relubrication_gap_s``. The raceway map (4 tracks x slices) and the cycles (swing,
+    ``life_relubrication_gap_s``; ``life_micro_cycles`` (cycles left out of the two shares counted by
+    cycles: swings below 10 steps of the series' angle resolution) and the two shares weighted by
+    damage, ``life_damage_share_x2b_below_1`` and ``life_damage_share_below_critical``. A value that
+    does not exist (no worst track without damage, no ratio or share without cycles) is an empty
+    cell. The raceway map (4 tracks x slices) and the cycles (swing,
     count, x/2b) come back in ``CaseResult.life``.
 
 Load spectrum (for a life calculation)
@@ -47,6 +51,7 @@ import numpy as np
 
 from ..distribution.bime import Loads
 from ..life import LifeAccumulator, LifeModel, analyse_run
+from ..life.duty import life_files
 from ..simulation.simulator import BearingSimulator, SimulatorSettings
 from .series import MotionSeries
 
@@ -59,7 +64,8 @@ STATISTICS = ("friction_torque_mean", "friction_torque_max", "friction_torque_p9
               "rotation", "duration", "steps",
               "life_L10_h", "life_worst_track", "life_damage_per_h", "life_map_L10_h", "life_dg03_L10_h",
               "life_dg03_ratio", "life_cycles", "life_share_x2b_below_1", "life_share_below_critical",
-              "life_relubrication_gap_s")
+              "life_relubrication_gap_s", "life_micro_cycles", "life_damage_share_x2b_below_1",
+              "life_damage_share_below_critical")
 HISTOGRAM_COLUMNS = ("ball", "diagonal", "load_lower_N", "load_upper_N", "time_s", "rotation_rad")
 
 
@@ -104,6 +110,7 @@ class CaseResult:
         ``host:pid`` of the process that ran it.
     timeseries : ndarray (n, len(TIMESERIES_COLUMNS)) or None
     statistics : dict or None
+        As written to ``result.json`` (``json_ready``: an infinite value is "inf", no value None).
     histogram : ndarray (m, len(HISTOGRAM_COLUMNS)) or None
     life : dict or None
         ``damage_map`` (4, slices) of contacts 1..4; ``swing`` (rad), ``count`` and ``travel_ratio``
@@ -192,13 +199,11 @@ def run_case(task: CaseTask) -> CaseResult:
     try:
         result = analyse_run(life)
     except Exception as exc:  # noqa: BLE001 - e.g. rainflow not installed: the case's other results stand
-        return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram,
+        return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, json_ready(stats), histogram,
                           {"error": one_line(exc)})
     stats.update(result.summary())
-    cycles = {"damage_map": result.damage_map, "swing": result.swing, "count": result.count,
-              "travel_ratio": result.travel_ratio, "peak_pressure": result.peak_pressure,
-              "track_travel_ratio": result.track_travel_ratio, "cycle_peak_pressure": result.cycle_peak_pressure,
-              "critical_angle": model_critical(sim)}
+    stats = json_ready(stats)           # as result.json holds them: inf as "inf", no value as None
+    cycles = {**life_files(result, life.model), "peak_pressure": result.peak_pressure}
     return CaseResult(task.key, "ok", time.perf_counter() - start, worker, out, stats, histogram, cycles)
 
 
@@ -230,6 +235,31 @@ def _nice_ceiling(x: float) -> float:
         if m * p >= x * (1 - 1e-12):
             return m * p
     return 10.0 * p  # pragma: no cover
+
+
+def json_ready(data):
+    """``data`` with every non-finite number made JSON (RFC 8259 has no Infinity or NaN): an infinite
+    value (a life without damage) becomes the string ``"inf"`` (``"-inf"``), which ``float()`` reads
+    back; NaN (a value that does not exist) becomes ``null``. Numpy scalars and arrays become
+    numbers and lists."""
+    if isinstance(data, dict):
+        return {k: json_ready(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [json_ready(v) for v in data]
+    if isinstance(data, np.ndarray):
+        return json_ready(data.tolist())
+    if isinstance(data, (bool, np.bool_)):
+        return bool(data)
+    if isinstance(data, (int, np.integer)):
+        return int(data)
+    if isinstance(data, (float, np.floating)):
+        x = float(data)
+        if math.isnan(x):
+            return None
+        if math.isinf(x):
+            return "inf" if x > 0 else "-inf"
+        return x
+    return data
 
 
 def statistics(out: np.ndarray, diagonal: np.ndarray, bins: int) -> tuple[dict, np.ndarray]:

@@ -24,10 +24,16 @@ Output directory::
                                        contacts 1..4 in that slice (slewing_model.life.raceway_map)
     DIR/cases/<key>/life_cycles.csv    rainflow cycles of psi: swing (rad), count, x/2b (smallest over the
                                        loaded contacts), and per contact 1..4 x/2b, swing over its
-                                       critical angle and peak Hertz pressure (Pa)
+                                       critical angle and peak Hertz pressure (Pa); then the cycle's
+                                       damage of contacts 1..4 (damage_1..4)
+    DIR/cases/<key>/life_summary.json  per track damage (cycle rule and map), the three lives, DG03's ratio
     DIR/cases/<key>/ball_load_histogram.csv   ball, diagonal, load bin, time, rotation
     DIR/cases/<key>/result.json        status, statistics, wall time, worker (written last)
     DIR/figures/*.png                  see slewing_model.study.figures
+
+Every JSON file is strict JSON (:func:`json_ready`): an infinite value (a life without damage) is
+the string ``"inf"``, a value that does not exist (NaN) is ``null``; in ``summary.csv`` ``inf`` and
+an empty cell.
 
 A folder holding another study's results is refused (``overwrite`` clears them).
 A case whose ``result.json`` exists is finished: a rerun skips it (failed cases
@@ -41,13 +47,15 @@ import contextlib
 import csv
 import json
 import logging
+import math
 import os
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, one_line, run_case
+from .case import HISTOGRAM_COLUMNS, STATISTICS, TIMESERIES_COLUMNS, CaseResult, CaseTask, json_ready, one_line, \
+    run_case
 from .definition import Case, Study, StudyDefinitionError, load_study
 from .series import load_series
 
@@ -168,11 +176,16 @@ def read_result(out_dir: str, key: str) -> dict | None:
     return data if data.get("key") == key else None
 
 
-def _write_json(path: str, data) -> None:
+def write_json(path: str, data) -> None:
+    """Write ``data`` as strict JSON (:func:`json_ready`; ``allow_nan=False`` refuses anything left),
+    atomically (a temporary file, then renamed)."""
     tmp = path + ".tmp"
     with open(tmp, "w") as fh:
-        json.dump(data, fh, indent=1, sort_keys=True)
+        json.dump(json_ready(data), fh, indent=1, sort_keys=True, allow_nan=False)
     os.replace(tmp, path)
+
+
+_write_json = write_json
 
 
 def write_case(out_dir: str, case: Case, result: CaseResult) -> dict:
@@ -227,8 +240,13 @@ def write_life(folder: str, life: dict) -> None:
             columns += [np.asarray(life["track_travel_ratio"])[:, k], swing / life["critical_angle"][k],
                         np.asarray(life["cycle_peak_pressure"])[:, k]]
             header += [f"travel_ratio_{k + 1}", f"swing_over_critical_{k + 1}", f"peak_pressure_{k + 1}_Pa"]
-    np.savetxt(os.path.join(folder, "life_cycles.csv"), np.column_stack(columns), delimiter=",", fmt="%.10g",
-               header=",".join(header), comments="")
+    if "cycle_damage" in life:
+        columns += [np.asarray(life["cycle_damage"])[:, k] for k in range(4)]
+        header += [f"damage_{k + 1}" for k in range(4)]
+    np.savetxt(os.path.join(folder, "life_cycles.csv"), np.column_stack(columns) if len(columns[0]) else
+               np.zeros((0, len(header))), delimiter=",", fmt="%.10g", header=",".join(header), comments="")
+    if "summary" in life:
+        write_json(os.path.join(folder, "life_summary.json"), life["summary"])
 
 
 def summary_row(case: Case, record: dict | None, status: str | None = None) -> dict:
@@ -243,8 +261,13 @@ def summary_row(case: Case, record: dict | None, status: str | None = None) -> d
     if record is not None:
         row.update(status=record["status"], elapsed_s=f"{record['elapsed_s']:.4g}", worker=record["worker"])
         for k, value in (record.get("statistics") or {}).items():
-            if k in row:
-                row[k] = value if isinstance(value, int) else f"{value:.10g}"
+            if k in row:    # None or NaN: no value, an empty cell; "inf" (JSON's infinity) stays "inf"
+                if value is None or isinstance(value, str):
+                    row[k] = "" if value is None else value
+                elif isinstance(value, int):
+                    row[k] = value
+                else:
+                    row[k] = "" if math.isnan(value) else f"{value:.10g}"
     if status is not None:
         row["status"] = status
     row["status"] = " ".join(str(row["status"]).split())   # one line

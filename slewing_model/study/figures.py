@@ -8,9 +8,12 @@
   friction torque of each case against it, with the median and the 5-95 % band over
   the other axes of the product (error seeds, load series), per load series, bearing
   and ring model.
-* ``life.png`` -- the raceway damage map of each track, all cases together (each run once:
-  their slice damages add up), unrolled around the ring, and the histogram of ``x/2b`` over
-  all cases' rainflow cycles (``slewing_model.life``; ``docs/life.md``).
+* ``life.png`` -- the raceway damage map of each track as steps, unrolled around its ring, with
+  each track's damage and L10 and the ratio of DG03's life to ours; the cases of one bearing
+  variant are parts of one duty (their load series, each run once: slice damages add up), while
+  different variants are alternative designs, drawn side by side (or, beyond six, their median and
+  range), never added; and ``x/2b`` of the rainflow cycles as shares of the cycles and of the
+  damage (``slewing_model.life``; ``docs/life.md``).
 * ``worst_case.png`` -- the time series of the case with the largest friction torque:
   ring angle and drive moment, friction torque, largest ball load.
 """
@@ -37,7 +40,8 @@ def _pyplot():
 
 
 def _value(row, key):
-    return float(row[key])
+    """A number of a summary row; an empty cell (no value) is NaN."""
+    return float(row[key]) if row[key] != "" else float("nan")
 
 
 def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
@@ -51,10 +55,10 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
         if len(values) >= 3:
             written.append(band_against(os.path.join(folder, f"friction_torque_vs_{key}.png"), ok, key, label,
                                         note=errors_note(cases)))
-    maps = [os.path.join(out_dir, "cases", r["case"]) for r in ok]
-    maps = [m for m in maps if os.path.exists(os.path.join(m, "raceway_damage.csv"))]
-    if maps:
-        written.append(life_figure(os.path.join(folder, "life.png"), maps))
+    groups = life_groups(out_dir, ok)
+    if groups:
+        written.append(life_figure(os.path.join(folder, "life.png"), dict(groups) if len(groups) > 1
+                                   else next(iter(groups.values()))))
     if ok:
         worst = max(ok, key=lambda r: _value(r, "friction_torque_max"))
         path = os.path.join(out_dir, "cases", worst["case"], "timeseries.csv")
@@ -63,6 +67,19 @@ def study_figures(out_dir: str, cases, rows: list[dict]) -> list[str]:
             written.append(time_series(os.path.join(folder, "worst_case.png"), path, worst["name"],
                                        psi_note=psi_note(case.load if case is not None else {})))
     return written
+
+
+def life_groups(out_dir: str, rows: list[dict]) -> dict:
+    """The finished cases' folders by bearing variant: ``{variant name: [case folders]}``. A variant's
+    cases are parts of one duty (its load series), whose damages add up; different variants (files,
+    ring models, preloads, friction, error seeds: a Monte Carlo study's draws) are alternative designs
+    and are never added together."""
+    groups = defaultdict(list)
+    for r in rows:
+        folder = os.path.join(out_dir, "cases", r["case"])
+        if r["status"] == "ok" and os.path.exists(os.path.join(folder, "raceway_damage.csv")):
+            groups[case_name_parts(r["name"])[1]].append(folder)
+    return dict(groups)
 
 
 def _amplitudes(values) -> str:
@@ -293,43 +310,163 @@ def time_series(path: str, csv_path: str, name: str, psi_note: str = "") -> str:
     return path
 
 
-def life_figure(path: str, case_dirs: list[str], title: str | None = None) -> str:
-    """Raceway damage around each track (summed over the cases) and the histogram of x/2b."""
+TRACK_LABELS = ("1 (outer ring)", "2 (inner ring)", "3 (inner ring)", "4 (outer ring)")
+#: above this many groups of alternative designs, the map shows their median and range, not a line each
+MAX_GROUP_LINES = 6
+
+
+def _read_life(folder: str) -> dict:
+    """A case's (or a `slewing life` run's) map, cycles and life summary."""
+    import json
+
+    d = np.loadtxt(os.path.join(folder, "raceway_damage.csv"), delimiter=",", skiprows=1, ndmin=2)
+    path = os.path.join(folder, "life_cycles.csv")
+    with open(path) as fh:
+        header = fh.readline().strip().split(",")
+        empty = not fh.readline().strip()                 # a ring that never moved: no cycles
+    c = np.zeros((0, len(header))) if empty else np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    summary = {}
+    if os.path.exists(os.path.join(folder, "life_summary.json")):
+        with open(os.path.join(folder, "life_summary.json")) as fh:
+            summary = json.load(fh)
+    return {"angle": d[:, 0], "map": d[:, 1:].T, "cycles": {h: c[:, j] for j, h in enumerate(header)},
+            "summary": summary}
+
+
+def _number(x) -> float:
+    """A number of a life summary (JSON: "inf" for infinity, null for none)."""
+    return float("nan") if x is None else float(x)
+
+
+def _duty(runs: list[dict]) -> dict:
+    """One duty made of the runs (parts of it, each run once): maps and cycle damages add up; the
+    tracks' damages by the weakest link (map) and Miner's rule (cycle rule); DG03 by Miner's rule."""
+    from ..life.raceway_map import track_damage
+    from ..life.rating import combined_damage
+
+    damage_map = sum(r["map"] for r in runs)
+    duration = sum(_number(r["summary"].get("duration_s", 0.0)) for r in runs)
+    cycle = sum(np.asarray(r["summary"].get("track_damage", np.zeros(4)), float) for r in runs)
+    dg03 = sum(duration_i / 3600.0 / h if h > 0 else 0.0 for duration_i, h in
+               ((_number(r["summary"].get("duration_s", 0.0)), _number(r["summary"].get("life_dg03_L10_h", "inf")))
+                for r in runs))
+    hours = lambda d: duration / 3600.0 / d if d > 0 else float("inf")   # noqa: E731
+    ours = hours(float(combined_damage(cycle)))
+    return {"map": damage_map, "map_track": track_damage(damage_map), "cycle_track": cycle,
+            "duration": duration, "ours_h": ours, "map_h": hours(float(combined_damage(track_damage(damage_map)))),
+            "dg03_h": hours(dg03), "ratio": hours(dg03) / ours if np.isfinite(ours) and ours > 0 else float("nan")}
+
+
+def _short(label: str, width: int = 48) -> str:
+    return label if len(label) <= width else label[:width - 3] + "..."
+
+
+def _fmt_h(h: float) -> str:
+    return "inf" if not np.isfinite(h) else f"{h:.3g} h"
+
+
+def life_figure(path: str, case_dirs, title: str | None = None) -> str:
+    """The raceway damage map of each track as steps (an empty slice shows as a gap), with each track's
+    damage and life; and x/2b of the rainflow cycles, shares of the cycles and of the damage.
+
+    ``case_dirs``: a list of folders that are parts of one duty (their maps add up: the cases of one
+    bearing over several load series, or one `slewing life` run), or a dict ``{label: [folders]}`` of
+    groups that are alternative designs (bearing variants): each group is one duty, and the groups are
+    drawn side by side (up to :data:`MAX_GROUP_LINES`; beyond, their median and range), never added."""
     plt = _pyplot()
-    damage, ratios, counts = None, [], []
-    for folder in case_dirs:
-        d = np.loadtxt(os.path.join(folder, "raceway_damage.csv"), delimiter=",", skiprows=1, ndmin=2)
-        damage = d if damage is None else np.column_stack([d[:, 0], damage[:, 1:] + d[:, 1:]])
-        cycles = os.path.join(folder, "life_cycles.csv")
-        with open(cycles) as fh:
-            empty = len(fh.read().splitlines()) < 2          # a ring that never moved: no cycles
-        c = np.zeros((0, 3)) if empty else np.loadtxt(cycles, delimiter=",", skiprows=1, ndmin=2)
-        if c.size:
-            ratios.append(c[:, 2])
-            counts.append(c[:, 1])
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
-    labels = ("1 (outer ring)", "2 (inner ring)", "3 (inner ring)", "4 (outer ring)")
-    for k in range(4):
-        ax1.plot(damage[:, 0], damage[:, k + 1], lw=1.0, label=f"contact {labels[k]}")
-    ax1.set_xlabel("slice centre, angle around its own ring [deg]")
-    ax1.set_ylabel("slice damage d_j [-]")
-    ax1.set_xlim(0, 360)
-    ax1.set_title(f"raceway damage map, {len(case_dirs)} case(s) each run once")
-    ax1.legend(fontsize=8)
-    ax1.grid(alpha=0.3)
+    groups = case_dirs if isinstance(case_dirs, dict) else {"": list(case_dirs)}
+    runs = {label: [_read_life(f) for f in folders] for label, folders in groups.items()}
+    duties = {label: _duty(r) for label, r in runs.items()}
+    angle = next(iter(runs.values()))[0]["angle"]
+    edges = np.linspace(0.0, 360.0, angle.size + 1)
+    fig = plt.figure(figsize=(13, 9))
+    grid = fig.add_gridspec(4, 2, width_ratios=(1.6, 1.0))
+    axes = [fig.add_subplot(grid[k, 0]) for k in range(4)]
+    one = len(duties) == 1
+    for k, ax in enumerate(axes):
+        if len(duties) <= MAX_GROUP_LINES:
+            for j, (label, duty) in enumerate(duties.items()):
+                ax.stairs(duty["map"][k], edges, lw=0.8, fill=one, alpha=0.8 if one else 1.0,
+                          color=f"C{k if one else j}", label=None if one else _short(label))
+        else:
+            maps = np.array([duty["map"][k] for duty in duties.values()])
+            ax.stairs(maps.max(axis=0), edges, baseline=maps.min(axis=0), fill=True, alpha=0.35, color=f"C{k}",
+                      label=f"range over the {len(duties)} variants")
+            ax.stairs(np.median(maps, axis=0), edges, color=f"C{k}", lw=0.8, label="median")
+        if one:
+            d = next(iter(duties.values()))
+            life_k = d["duration"] / 3600.0 / d["cycle_track"][k] if d["cycle_track"][k] > 0 else float("inf")
+            ax.set_title(f"contact {TRACK_LABELS[k]}: D = {d['cycle_track'][k]:.3g} (cycle rule), "
+                         f"{d['map_track'][k]:.3g} (map) in {d['duration']:.4g} s; L10 of the track alone "
+                         f"{_fmt_h(life_k)}", fontsize=9, loc="left")
+        else:
+            dk = np.array([d["map_track"][k] for d in duties.values()])
+            ax.set_title(f"contact {TRACK_LABELS[k]}, map: D median {np.median(dk):.3g}, range {dk.min():.3g}.."
+                         f"{dk.max():.3g} over the {len(duties)} variants", fontsize=9, loc="left")
+        ax.set_xlim(0, 360)
+        ax.set_ylabel("slice damage d_j", fontsize=8)
+        ax.grid(alpha=0.3)
+        if k < 3:
+            ax.tick_params(labelbottom=False)
+    axes[3].set_xlabel("slice, angle around its own ring [deg] (steps: a slice no ball rolled over is 0)")
+    if not one and len(duties) <= MAX_GROUP_LINES:
+        axes[0].legend(fontsize=7, loc="upper right")
+
+    ax2 = fig.add_subplot(grid[0:3, 1])
+    ratios, counted, damage = [], [], []
+    for r in (x for group in runs.values() for x in group):
+        c = r["cycles"]
+        if not c.get("count", np.zeros(0)).size:
+            continue
+        micro = _number(r["summary"].get("micro_swing_rad", 0.0))
+        micro = 0.0 if np.isnan(micro) else micro
+        worst = r["summary"].get("life_worst_track")
+        ratios.append(c["travel_ratio"])
+        counted.append(np.where(c["swing_rad"] >= micro, c["count"], 0.0))
+        damage.append(c[f"damage_{worst}"] if worst and f"damage_{worst}" in c else np.zeros(c["count"].size))
     if ratios:
-        r, w = np.concatenate(ratios), np.concatenate(counts)
+        r, wc, wd = np.concatenate(ratios), np.concatenate(counted), np.concatenate(damage)
         keep = np.isfinite(r) & (r > 0)
-        r, w = r[keep], w[keep]
-        edges = np.logspace(np.floor(np.log10(r.min())), np.ceil(np.log10(r.max())), 41)
-        ax2.hist(r, bins=edges, weights=w, color="tab:blue", alpha=0.8)
+        r, wc, wd = r[keep], wc[keep], wd[keep]
+        lo, hi = np.floor(np.log10(r.min())), np.ceil(np.log10(r.max()))
+        bins = np.logspace(lo, max(hi, lo + 1), int(max(hi - lo, 1) * 4) + 1)
+        shares, labels = [], []
+        if wc.sum() > 0:
+            shares.append(("cycles", wc / wc.sum(), "tab:blue"))
+        if wd.sum() > 0:
+            shares.append(("damage (worst track)", wd / wd.sum(), "tab:red"))
+        if shares:
+            ax2.hist([r] * len(shares), bins=bins, weights=[s[1] for s in shares], color=[s[2] for s in shares],
+                     label=[f"share of the {s[0]}: {s[1][r < 1].sum():.0%} below 1" for s in shares])
+            ax2.legend(fontsize=8, loc="upper left")
         ax2.axvline(1.0, color="k", ls="--", lw=1)
-        below = w[r < 1].sum() / w.sum() if w.sum() else float("nan")
         ax2.set_xscale("log")
-        ax2.set_title(f"x/2b of the rainflow cycles: {below:.0%} below 1 (patch never uncovered)")
+    ax2.set_title("x/2b of the rainflow cycles (micro-cycles left out of the count)", fontsize=9)
     ax2.set_xlabel("rolling travel over contact width, x/2b [-]")
-    ax2.set_ylabel("cycles")
+    ax2.set_ylabel("share per bin")
     ax2.grid(alpha=0.3)
+
+    ax3 = fig.add_subplot(grid[3, 1])
+    ax3.axis("off")
+    lines = []
+    lines.append(f"L10 in hours of the duty ({next(iter(duties.values()))['duration']:.4g} s) repeated:" if one else
+                 "L10 in hours of each variant's duty repeated:")
+    for label, d in (list(duties.items()) if len(duties) <= MAX_GROUP_LINES else []):
+        worst = f"worst track {int(np.argmax(d['cycle_track'])) + 1}" if d["cycle_track"].max() > 0 else "no damage"
+        ratio = "-" if np.isnan(d["ratio"]) else f"{d['ratio']:.2f} x ours"
+        lines.append(f"{_short(label) + ': ' if label else ''}ISO/TS 16281 + oscillation rule {_fmt_h(d['ours_h'])} "
+                     f"({worst})")
+        lines.append(f"{'    ' if label else ''}raceway map {_fmt_h(d['map_h'])};  DG03 {_fmt_h(d['dg03_h'])} = {ratio}")
+    if len(duties) > MAX_GROUP_LINES:
+        ours = np.array([d["ours_h"] for d in duties.values()])
+        ratio = np.array([d["ratio"] for d in duties.values()])
+        lines.append(f"{len(duties)} variants: L10 (ours) median {_fmt_h(float(np.median(ours)))}, range "
+                     f"{_fmt_h(float(ours.min()))}..{_fmt_h(float(ours.max()))}; DG03/ours median "
+                     f"{np.nanmedian(ratio):.2f}")
+    cases = sum(len(v) for v in groups.values())
+    lines.append(f"{cases} run(s)" + (" of one duty, added" if one and cases > 1 else "") + ("" if one else
+                 f" in {len(duties)} variants (alternative designs): each one's runs added, variants never added"))
+    ax3.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax3.transAxes)
     if title:
         fig.suptitle(title)
     fig.tight_layout()

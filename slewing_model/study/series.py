@@ -40,6 +40,11 @@ class MotionSeries:
         Frame of the loads (rotating: turns with ``psi``).
     source : str
         Where the series comes from (for messages).
+    lines : tuple of int or None
+        Line of the file each row was read from (for messages), None when not read from a text file.
+    recorded_motion : bool
+        Whether the series gave the motion (``psi`` or ``omega``); False: ``psi`` was made up (the
+        ring stands still, or turns at the study's ``omega_rad_s``).
     """
 
     time: np.ndarray
@@ -48,6 +53,13 @@ class MotionSeries:
     omega: np.ndarray
     load_frame: str = "fixed"
     source: str = ""
+    lines: tuple | None = None
+    recorded_motion: bool = True
+
+    def where(self, k: int) -> str:
+        """``FILE, line L, t = T s`` of row ``k`` (0-based), for messages."""
+        line = f", line {self.lines[k]}" if self.lines is not None else f", row {k + 1}"
+        return f"{self.source}{line}, t = {self.time[k]:.6g} s"
 
     def __post_init__(self):
         n = self.time.shape[0]
@@ -160,7 +172,8 @@ def read_csv(path: str, *, omega_default: float | None = None, load_frame: str |
     check_increasing_time(path, col["time"], numbers[1:])
     loads = np.column_stack([col.get(c, np.zeros(len(data))) for c in LOAD_COLUMNS])
     psi, omega = _motion(col["time"], col.get("psi"), col.get("omega"), omega_default, path)
-    return MotionSeries(col["time"].copy(), loads, psi, omega, _frame(path, stated, load_frame, default_frame), path)
+    return MotionSeries(col["time"].copy(), loads, psi, omega, _frame(path, stated, load_frame, default_frame), path,
+                        tuple(numbers[1:]), "psi" in col or "omega" in col)
 
 
 def write_csv(path: str, series: MotionSeries) -> None:
