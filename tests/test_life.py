@@ -184,6 +184,31 @@ def test_small_oscillation_damages_only_the_slices_balls_cross():
     assert share < 0.6
 
 
+def test_track_damage_kept_step_by_step_equals_the_whole_map_and_states_stay_as_taken():
+    """The map changes only where balls crossed, and each track's sum of d_j^(10/9) follows it
+    (issue 31): after a swinging and turning run it equals the sum over the whole map to
+    round-off; a state taken mid-run (the simulator takes one before every step) is not changed
+    by the steps after it, and restoring it gives back the same damages bit for bit."""
+    from slewing_model.life.raceway_map import track_damage
+
+    model = life.LifeModel(BEARING, "inner", "fixed")
+    acc = life.LifeAccumulator(model)
+    pattern = lambda phi: 2.0e5 * (1 + 0.5 * np.cos(phi))      # noqa: E731
+    psis = np.concatenate([np.linspace(0.0, 0.3, 200), 0.3 + 0.02 * np.sin(np.linspace(0, 40, 400)),
+                           np.linspace(0.3, 7.0, 300)])
+    state = None
+    for i, psi in enumerate(psis):
+        if i == 450:
+            state = acc.get_state()
+            kept_map, kept_damage = state["map"]["map"].copy(), acc.track_damage.copy()
+        acc.step(0.0, psi, synthetic_step(BEARING, psi, pattern))
+    np.testing.assert_allclose(acc.track_damage, track_damage(acc.map.damage_map), rtol=1e-12, atol=0.0)
+    assert np.all(acc.track_damage[[0, 2]] > 0)
+    np.testing.assert_array_equal(state["map"]["map"], kept_map)        # untouched by the later steps
+    acc.set_state(state)
+    np.testing.assert_array_equal(acc.track_damage, kept_damage)
+
+
 def test_half_cycle_travel_ratio():
     """A triangle wave of full swing Δψ: the last completed half-cycle's x/2b is
     Δψ (dm/4)(1 - γ²) / 2b for the patch half-width b of the synthetic loads."""

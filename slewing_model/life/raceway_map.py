@@ -114,40 +114,57 @@ class RacewayMap:
 
     def reset(self) -> None:
         self.damage_map = np.zeros((4, self.slices))    # d_j of every slice of contacts 1..4
+        self._power = np.zeros(4)                       # Σ_j d_j^(10/9) of each track, kept as slices change
+        self._shared = False                            # damage_map handed out by get_state: copy before a change
         self._angle = None                              # ball angles of the last step (B,), rad
         self._psi = 0.0
         self._q3 = None                                 # Q^3 of the last step (B, 4)
 
     def update(self, ball_angle, psi: float, contact_load) -> None:
-        """Add the passes from the last step to this one (the first call only records)."""
+        """Add the passes from the last step to this one (the first call only records). Only the
+        slices a ball crossed change, and each track's ``Σ d_j^(10/9)`` follows them."""
         q3 = np.maximum(contact_load, 0.0) ** 3
         if self._angle is not None:
             mean = 0.5 * (q3 + self._q3) * self.scale
-            added = None
             for ring_moving in (False, True):
+                tracks = np.flatnonzero(self.moving == ring_moving)
                 shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)
                 ball, where = crossed_slices(self._angle - shift_old, ball_angle - shift_new, self.slices)
-                if ball.size:
-                    for k in np.nonzero(self.moving == ring_moving)[0]:
-                        if added is None:
-                            added = np.zeros_like(self.damage_map)
-                        added[k] = np.bincount(where, mean[ball, k], minlength=self.slices)
-            if added is not None:
-                self.damage_map = self.damage_map + added     # a new array: states keep theirs unchanged
+                if ball.size and tracks.size:
+                    self._add(tracks, ball, where, mean)
         self._angle = np.array(ball_angle, dtype=float)
         self._psi = float(psi)
         self._q3 = q3
 
+    def _add(self, tracks, ball, where, mean) -> None:
+        """Add ``mean[ball, k]`` to slice ``where`` of each track ``k`` of ``tracks``."""
+        if self._shared:                                # a state holds the map: it stays as it was
+            self.damage_map = self.damage_map.copy()
+            self._shared = False
+        crossed, inverse = np.unique(where, return_inverse=True)
+        for k in tracks:
+            old = self.damage_map[k, crossed]
+            new = old + np.bincount(inverse, mean[ball, k], minlength=crossed.size)
+            self._power[k] += float(np.sum(new ** WEIBULL_SLOPE - old ** WEIBULL_SLOPE))
+            self.damage_map[k, crossed] = new
+
     def track_damage(self) -> np.ndarray:
-        """``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)`` of contacts 1..4, (4,)."""
-        return track_damage(self.damage_map)
+        """``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)`` of contacts 1..4, (4,), from the sums kept step by
+        step (:func:`track_damage` sums the whole map again; they agree to round-off)."""
+        return (np.maximum(self._power, 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
 
     def get_state(self) -> dict:
-        """The map's state (arrays not copied: :meth:`update` never changes them in place)."""
-        return {"map": self.damage_map, "angle": self._angle, "psi": self._psi, "q3": self._q3}
+        """The map's state (the map is not copied: the next update copies it before a change)."""
+        self._shared = True
+        return {"map": self.damage_map, "power": self._power.copy(), "angle": self._angle, "psi": self._psi,
+                "q3": self._q3}
 
     def set_state(self, state: dict) -> None:
         self.damage_map = np.array(state["map"], dtype=float).reshape(4, self.slices)
+        self._shared = False
+        power = state.get("power")
+        self._power = (np.sum(self.damage_map ** WEIBULL_SLOPE, axis=1) if power is None
+                       else np.array(power, dtype=float))
         self._angle = None if state["angle"] is None else np.array(state["angle"], dtype=float)
         self._psi = float(state["psi"])
         self._q3 = None if state["q3"] is None else np.array(state["q3"], dtype=float)
