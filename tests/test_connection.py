@@ -339,3 +339,48 @@ def test_a_matrix_market_file_of_the_wrong_size_is_refused(table1, tmp_path):
     write_matrix_market(tmp_path / "k.mtx", np.eye(9))
     with pytest.raises(ImportedMatrixError, match="a 9 x 9 matrix: the nodes file has 4 nodes, so it must be 12 x 12"):
         _build(_load(tmp_path, _matrix_table("matrix_market")), "free", harmonics=8)
+
+
+# ---- where the user says it: the CLI and the FMU read the connection through the bearing file ----
+
+def test_superelement_and_solve_commands_read_the_connection(tmp_path):
+    """``slewing superelement`` builds the connected superelement from the file alone; ``slewing
+    solve --superelement`` accepts it for that file and refuses it for the unconnected one."""
+    path = tmp_path / "tube.toml"
+    path.write_text(TABLE1 + TUBE)
+    out = tmp_path / "se.npz"
+    cmd = [sys.executable, "-m", "slewing_model.cli"]
+    run = subprocess.run(cmd + ["superelement", str(path), "--harmonics", "8", "--quiet", "-o", str(out)],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode == 0, run.stderr
+    assert "connected" in run.stdout
+    se = Superelement.load(out, load_bearing(path))
+    assert se.outer.boundary_condition == "connected" and se.inner.boundary_condition == "free"
+    assert se.metadata["rings"]["outer"]["connection"]["kind"] == "tube"
+    run = subprocess.run(cmd + ["solve", str(path), "--fz", "200000", "--superelement", str(out), "--json"],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode == 0, run.stderr
+    plain = tmp_path / "plain.toml"
+    plain.write_text(TABLE1)
+    run = subprocess.run(cmd + ["solve", str(plain), "--fz", "200000", "--superelement", str(out)],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode != 0 and "connection" in run.stderr
+
+
+def test_the_fmu_reads_the_connection_back_from_its_bearing_json(tmp_path, builds, table1):
+    """build_fmu.py packs ``bearing.to_dict()`` as JSON and the superelement; the FMU restores the
+    bearing with ``Bearing.from_si_dict`` and loads the superelement against it: a connected
+    bearing survives that trip (also with an imported matrix, whose files the FMU does not need)."""
+    import json
+
+    tube = table1.with_connection({"outer": _tube(table1)})
+    back = Bearing.from_si_dict(json.loads(json.dumps(tube.to_dict())))
+    assert back.connection == tube.connection
+    builds["steel"].save(tmp_path / "se.npz")
+    Superelement.load(tmp_path / "se.npz", back)
+    _small_face_set(table1, tmp_path)
+    _write_lines(tmp_path / "k.mtx", 1e9 * np.eye(12))
+    imported = _load(tmp_path, _matrix_table("calculix"))
+    (tmp_path / "k.mtx").unlink()
+    again = Bearing.from_si_dict(json.loads(json.dumps(imported.to_dict())))
+    assert again.connection == imported.connection and bearing_hash(again) == bearing_hash(imported)
