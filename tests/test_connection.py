@@ -384,3 +384,45 @@ def test_the_fmu_reads_the_connection_back_from_its_bearing_json(tmp_path, build
     (tmp_path / "k.mtx").unlink()
     again = Bearing.from_si_dict(json.loads(json.dumps(imported.to_dict())))
     assert again.connection == imported.connection and bearing_hash(again) == bearing_hash(imported)
+
+
+# ---- the adapter's own model against closed forms -----------------------------------------------
+
+def test_orthotropic_model_with_isotropic_constants_is_the_ring_model():
+    """The general-D assembly against the ring model's own (Lame) assembly, same mesh: K0, K1, K2 equal."""
+    from slewing_model.bearing.connection import elasticity
+    from slewing_model.rings.superelement.adapters import OrthotropicHarmonicModel
+    from slewing_model.rings.superelement.harmonic import HarmonicRingModel
+    from slewing_model.rings.superelement.section import rectangle_mesh
+
+    mesh = rectangle_mesh(0.9, 1.1, 0.2, 3, 3)
+    e, nu = 200e9, 0.3
+    a = HarmonicRingModel(mesh, e, nu)
+    b = OrthotropicHarmonicModel(mesh, elasticity(e, e, e, e / (2 * (1 + nu)), nu))
+    for ka, kb in ((a.K0, b.K0), (a.K1, b.K1), (a.K2, b.K2)):
+        assert abs(ka - kb).max() < 1e-10 * abs(ka).max()
+
+
+@pytest.mark.parametrize("field, expected", [
+    # uniform axial displacement of the face: E_z pi (ro^2 - ri^2) / L (nu = 0: no end effect)
+    ("axial", lambda ri, ro, L, ez, g: ez * np.pi * (ro**2 - ri**2) / L),
+    # rotation of the face about the axis (V = r): torque per radian G J / L, J = pi (ro^4 - ri^4) / 2
+    ("torsion", lambda ri, ro, L, ez, g: g * np.pi * (ro**4 - ri**4) / 2 / L),
+])
+def test_tube_face_stiffness_against_closed_forms(table1, field, expected):
+    """An orthotropic tube (axial 40 GPa, hoop 12 GPa, shear 4 GPa, nu = 0) on the outer ring's
+    face, harmonic 0: the face stiffness of a rigid axial pull and of a rigid twist of the face is
+    the bar's and the shaft's closed form (both fields are exact in the quadratic elements)."""
+    from slewing_model.rings.superelement.adapters import ring_face_stiffness
+
+    s = table1.outer_section
+    ri, ro, L, ez, g = s.inner_radius, s.outer_radius, 0.4, 40e9, 4e9
+    tube = Adapter("outer", "tube", ri, ro, L, "far_end", ez, 12e9, 12e9, g, 0.0)
+    fs = ring_face_stiffness(table1, "outer", tube, mesh="coarse")
+    q = np.zeros(fs.face.size)
+    if field == "axial":
+        q[2::3] = 1.0
+    else:
+        q[1::3] = fs.face.r
+    stiffness = 2 * np.pi * q @ fs.matrix(0) @ q          # c_0 = 2 pi: the whole circumference
+    assert stiffness == pytest.approx(expected(ri, ro, L, ez, g), rel=1e-6)
