@@ -22,7 +22,9 @@ the two), so each adapter face edge lies inside one ring face edge. The adapter'
 the annulus are **tied** to the ring face: their displacement is the ring face's quadratic
 field there (``T``, exact where the meshes match). Per harmonic the adapter is condensed onto
 those tied nodes (Schur complement ``S(n) = K_tt - K_ti K_ii^-1 K_it``) and
-``F(n) = T^T S(n) T``. The adapter's face outside the annulus is free.
+``F(n) = T^T S(n) T``. The adapter's face outside the annulus is free. (The build does not form
+``F(n)``: it solves the ring and the adapter's interior DOFs as one sparse system, the tied DOFs
+eliminated through ``T`` -- the same condensation, cheaper; ``F(n)`` serves exports.)
 
 Build time only (scipy, scikit-fem).
 """
@@ -242,6 +244,31 @@ class AdapterFaceStiffness:
     def dofs(self) -> np.ndarray:
         return self.face.dofs
 
+    @property
+    def extra_component(self) -> np.ndarray:
+        """Component (0 U, 1 V, 2 W) of each adapter DOF the connected model carries (the interior ones)."""
+        return self.model.component[self.interior]
+
+    def blocks(self, n: int, ring_ndofs: int):
+        """The adapter in the connected model's sparse system, harmonic n: ``(A, C, D)`` with
+        ``A = Tr^T K_tt Tr`` (ring x ring), ``C = Tr^T K_ti`` (ring x interior), ``D = K_ii``;
+        ``Tr`` the tie from all ring DOFs to the adapter's tied DOFs. Solving the ring and the
+        adapter's interior together is the condensation of :meth:`condensed` without forming it."""
+        k = self.model.stiffness(n)
+        tr = self._tie(ring_ndofs)
+        t, i = self.tied, self.interior
+        k_t = k[t]
+        a = (tr.T @ k_t[:, t] @ tr).tocsr()
+        c = (tr.T @ k_t[:, i]).tocsr()
+        return a, c, k[i][:, i].tocsr()
+
+    def _tie(self, ring_ndofs: int) -> sp.csr_matrix:
+        if getattr(self, "_tr", None) is None or self._tr.shape[1] != ring_ndofs:
+            rows, cols = np.nonzero(self.T)
+            self._tr = sp.csr_matrix((self.T[rows, cols], (rows, self.face.dofs[cols])),
+                                     shape=(len(self.tied), ring_ndofs))
+        return self._tr
+
     def condensed(self, n: int) -> np.ndarray:
         """The adapter condensed onto its tied DOFs, harmonic n: ``S(n)`` (t, t), N/m per unit
         of the theta integral."""
@@ -254,7 +281,8 @@ class AdapterFaceStiffness:
         return 0.5 * (s + s.T)
 
     def matrix(self, n: int) -> np.ndarray:
-        """``F(n) = T^T S(n) T`` on the ring face DOFs (:attr:`RingFace.dofs`)."""
+        """``F(n) = T^T S(n) T`` on the ring face DOFs (:attr:`RingFace.dofs`): the adapter's face
+        stiffness (for exports; the build solves ring and adapter together, :meth:`blocks`)."""
         if n not in self._cache:
             self._cache[n] = self.T.T @ self.condensed(n) @ self.T
         return self._cache[n]
@@ -263,18 +291,39 @@ class AdapterFaceStiffness:
 # ---- the ring with its face stiffness ----------------------------------------------------------
 
 class ConnectedModel:
-    """A ring model whose ``K(n)`` carries a face stiffness (``face.dofs``, ``face.matrix(n)``);
-    everything else is the ring model's."""
+    """A ring model joined to a connected structure; everything not below is the ring model's.
+
+    A parametric adapter brings its interior DOFs into the system (appended after the ring's:
+    ``ndofs`` and ``component`` cover both; the ring's load vectors are padded with zeros by
+    :meth:`pad`) and its tied DOFs are eliminated through the tie, so the ring and the adapter are
+    one sparse system per harmonic. An imported stiffness (dense, on the face DOFs) is added to
+    ``K(n)`` as it is."""
 
     def __init__(self, model: HarmonicRingModel, face_stiffness):
         self._model = model
         self.face_stiffness = face_stiffness
+        self.ring_ndofs = model.ndofs
+        self.sparse = hasattr(face_stiffness, "blocks")
+        extra = face_stiffness.extra_component if self.sparse else np.zeros(0, dtype=int)
+        self.component = np.concatenate([model.component, extra])
 
     def __getattr__(self, name):
         return getattr(self._model, name)
 
+    @property
+    def ndofs(self) -> int:
+        return len(self.component)
+
+    def pad(self, vectors: np.ndarray) -> np.ndarray:
+        """Ring DOF vectors (ring_ndofs, ...) extended with zeros on the adapter's DOFs."""
+        extra = self.ndofs - self.ring_ndofs
+        return np.concatenate([vectors, np.zeros((extra,) + vectors.shape[1:])], axis=0)
+
     def stiffness(self, n: int) -> sp.csr_matrix:
         k = self._model.stiffness(n)
+        if self.sparse:
+            a, c, d = self.face_stiffness.blocks(n, self.ring_ndofs)
+            return sp.bmat([[k + a, c], [c.T, d]], format="csr")
         d = self.face_stiffness.dofs
         f = self.face_stiffness.matrix(n)
         add = sp.coo_matrix((f.ravel(), (np.repeat(d, len(d)), np.tile(d, len(d)))), shape=k.shape)

@@ -233,6 +233,7 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     connection_info = None
     if bc == CONNECTED:                    # issue 29: the bolted face joined to a tube, plate or matrix
         model, support, connection_info = connect(model, sm, bearing.connection[ring], size)
+        loads = model.pad(loads)
     else:
         support = Support(bc, model, sm.bolted_facets)
     if progress is not None:
