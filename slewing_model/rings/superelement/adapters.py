@@ -191,6 +191,9 @@ class AdapterFaceStiffness:
         self.face = face
         ri, ro = adapter.inner_radius, adapter.outer_radius
         lo, hi = max(ri, face.inner_radius), min(ro, face.outer_radius)
+        if hi <= lo:
+            raise ValueError(f"the {adapter.kind} on the {adapter.ring} ring (r {ri * 1e3:g}..{ro * 1e3:g} mm) does "
+                             f"not overlap its bolted face (r {face.inner_radius * 1e3:g}..{face.outer_radius * 1e3:g} mm)")
         self.annulus = (lo, hi)
         inside = face.vertex_r[(face.vertex_r > lo) & (face.vertex_r < hi)]
         spacing = np.diff(np.concatenate([[lo], inside, [hi]]))

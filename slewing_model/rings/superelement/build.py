@@ -243,7 +243,8 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     t2 = time.perf_counter()
     c_hs = cd.halfspace_blocks(patches, lams, range(n_max + 1), e, nu)
     floor = _floor(bearing, ring, opts["compliance_floor"], opts["reference_pressure"])
-    info = {"mesh": {**sm.info, "dofs": int(model.ndofs)}, "patch_semi_axes_m": [list(s) for s in sizes],
+    info = {"mesh": {**sm.info, "dofs": int(getattr(model, "ring_ndofs", model.ndofs))},
+            "patch_semi_axes_m": [list(s) for s in sizes],
             "seconds": {"setup": t1 - t0, "harmonics": t2 - t1}}
     if connection_info is not None:
         info["connection"] = connection_info

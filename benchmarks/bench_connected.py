@@ -1,0 +1,91 @@
+"""Connected structures (issue 29): what they cost at build time, and that the step costs the same.
+
+    .venv/bin/python benchmarks/bench_connected.py [--steps 400] [--meshes coarse fine]
+
+1. Superelement build time (no cache) of the pitch bearing, free rings and bolted as in
+   ``pitch_bearing_bolted.toml`` (hub flange on the outer ring, blade root on the inner one),
+   per mesh, each build in this process one after the other.
+2. The step: the benchmark's pitch case (``cases.pitch``: blade-root series, pitching +-5 deg,
+   flexible rings, friction on) through :class:`BearingSimulator` with the free and with the
+   bolted superelement (coarse), interleaved step by step in one run: the median step time of each.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT))
+
+
+def builds(meshes):
+    from slewing_model import load_bearing
+    from slewing_model.rings.superelement import build_superelement
+
+    plain = load_bearing(ROOT / "examples/bearings/pitch_bearing.toml")
+    bolted = load_bearing(ROOT / "examples/bearings/pitch_bearing_bolted.toml")
+    rows = []
+    for mesh in meshes:
+        for name, bearing in (("free", plain), ("bolted", bolted)):
+            t0 = time.perf_counter()
+            se = build_superelement(bearing, mesh=mesh, bc="free", cache=False)
+            seconds = time.perf_counter() - t0
+            rings = se.metadata["rings"]
+            extra = [rings[r].get("connection", {}).get("dofs", 0) for r in ("outer", "inner")]
+            rows.append((mesh, name, seconds, [rings[r]["mesh"]["dofs"] for r in ("outer", "inner")], extra,
+                         [rings[r]["harmonics"] for r in ("outer", "inner")]))
+            print(f"build {mesh:6} {name:7} {seconds:7.2f} s  ring DOFs {rows[-1][3]}  adapter DOFs {extra}  "
+                  f"harmonics {rows[-1][5]}", flush=True)
+    return rows
+
+
+def steps(n):
+    import numpy as np
+
+    from cases import pitch
+    from slewing_model import Loads, load_bearing
+    from slewing_model.rings.superelement import build_superelement
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    case = pitch(n)
+    sims = {}
+    for name, file in (("free", "pitch_bearing.toml"), ("bolted", "pitch_bearing_bolted.toml")):
+        bearing = load_bearing(ROOT / "examples/bearings" / file)
+        se = build_superelement(bearing, mesh="coarse", bc="free")
+        sims[name] = BearingSimulator(bearing, se, SimulatorSettings(ring_model="flexible", load_frame="rotating"))
+    times = {k: [] for k in sims}
+    peaks = {k: [] for k in sims}
+    iters = {k: [] for k in sims}
+    for i in range(case.steps):
+        loads = Loads(*case.loads[i])
+        for name, sim in sims.items():
+            t0 = time.perf_counter()
+            r = sim.step(loads, float(case.psi[i]), float(case.omega[i]))
+            times[name].append(time.perf_counter() - t0)
+            peaks[name].append(r.distribution.max_ball_load)
+            iters[name].append(r.distribution.iterations)
+    for name in sims:
+        t = np.array(times[name][10:])            # the first steps start cold
+        print(f"step {name:7} median {1e3 * statistics.median(t):.2f} ms, mean {1e3 * t.mean():.2f} ms, "
+              f"Newton iterations mean {np.mean(iters[name]):.2f}, peak ball load max "
+              f"{max(peaks[name]) / 1e3:.1f} kN", flush=True)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--steps", type=int, default=400)
+    p.add_argument("--meshes", nargs="*", default=["coarse", "fine"])
+    p.add_argument("--no-builds", action="store_true")
+    args = p.parse_args()
+    if not args.no_builds:
+        builds(args.meshes)
+    if args.steps:
+        steps(args.steps)
+
+
+if __name__ == "__main__":
+    main()
