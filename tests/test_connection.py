@@ -426,3 +426,21 @@ def test_tube_face_stiffness_against_closed_forms(table1, field, expected):
         q[1::3] = fs.face.r
     stiffness = 2 * np.pi * q @ fs.matrix(0) @ q          # c_0 = 2 pi: the whole circumference
     assert stiffness == pytest.approx(expected(ri, ro, L, ez, g), rel=1e-6)
+
+
+def test_a_calculix_written_substructure_file_is_read_node_by_node():
+    """tests/data/calculix/blocksub.mtx, written by CalculiX 2.20 (*SUBSTRUCTURE GENERATE of
+    block_substructure.inp: its user-element layout, lower triangle row by row, one retained DOF
+    per element "node"), read with the nodes in another order, equals the retained block of the
+    block's stiffness assembled here from the C3D8 element matrix (what that CalculiX version
+    writes: see check_substructure.py there)."""
+    sys.path.insert(0, str(ROOT / "tests" / "data" / "calculix"))
+    from check_substructure import block_matrices
+
+    from slewing_model.rings.superelement.imported import read_calculix
+
+    top, k_tt, _ = block_matrices()
+    order = np.random.default_rng(3).permutation(len(top))
+    k = read_calculix(str(ROOT / "tests" / "data" / "calculix" / "blocksub.mtx"), top[order])
+    dofs = (3 * order[:, None] + np.arange(3)).ravel()
+    assert np.abs(k - k_tt[np.ix_(dofs, dofs)]).max() < 1e-10 * np.abs(k_tt).max()

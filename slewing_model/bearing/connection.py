@@ -13,8 +13,8 @@ stiffness of the structure it is bolted to, and the superelement
   ``inner_diameter_mm``, ``outer_diameter_mm``, ``thickness_mm``; clamped along its
   ``clamped_edge = "inner"`` or ``"outer"`` cylindrical edge (where it meets the rest of the hub).
 * ``type = "matrix"``: a stiffness condensed to nodes on the bolted face by any FE tool:
-  ``format = "calculix"`` (``*SUBSTRUCTURE MATRIX OUTPUT, OUTPUT FILE=MATRIX``: lines
-  ``row node, row dof, column node, column dof, value``) or ``"matrix_market"``
+  ``format = "calculix"`` (``*SUBSTRUCTURE MATRIX OUTPUT``: the user-element layout of CalculiX
+  2.20, or lines ``row node, row dof, column node, column dof, value``) or ``"matrix_market"``
   (``%%MatrixMarket matrix coordinate real symmetric|general``, DOF ``3 k + c`` of the k-th
   node of ``nodes_csv``); ``file``, ``nodes_csv`` (columns ``node,x_mm,y_mm,z_mm`` in the
   bearing's frame: z the axis, origin the bearing centre in the ball plane) and

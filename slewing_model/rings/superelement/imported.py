@@ -5,9 +5,11 @@ ring's bolted face, three translations per node in the global Cartesian axes (z 
 axis, origin the bearing centre in the ball plane):
 
 * ``format = "calculix"``: CalculiX's ``*SUBSTRUCTURE GENERATE`` with
-  ``*SUBSTRUCTURE MATRIX OUTPUT, FILE NAME=..., OUTPUT FILE=MATRIX`` writes ``name.mtx``, one
-  entry per line ``row node, row dof, column node, column dof, value`` (dof 1..3 = x, y, z),
-  one triangle or both. The nodes' coordinates come from ``nodes_csv``.
+  ``*SUBSTRUCTURE MATRIX OUTPUT, FILE NAME=...`` writes ``name.mtx``: in CalculiX 2.20 an Abaqus
+  user element (:func:`_read_calculix_user_element`); with ``OUTPUT FILE=MATRIX`` (later
+  manuals) one entry per line ``row node, row dof, column node, column dof, value`` (dof 1..3 =
+  x, y, z), one triangle or both. The nodes' coordinates come from ``nodes_csv``. (CalculiX
+  2.20 writes the retained block without condensing the interior: docs/connected_structures.md.)
 * ``format = "matrix_market"``: ``%%MatrixMarket matrix coordinate real symmetric`` (or
   ``general``); DOF ``3 k + c`` (0-based) is component c (x, y, z) of the k-th row of ``nodes_csv``.
 
@@ -80,26 +82,95 @@ def read_nodes(path: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def read_calculix(path: str, ids: np.ndarray) -> np.ndarray:
-    """Dense K (3k, 3k) of a CalculiX ``OUTPUT FILE=MATRIX`` ``.mtx`` in the order of ``ids``."""
+    """Dense K (3k, 3k) of a CalculiX substructure ``.mtx`` in the order of ``ids``: either layout
+    (the user-element one CalculiX 2.20 writes, or the line-per-entry ``OUTPUT FILE=MATRIX`` one)."""
+    with open(path) as fh:
+        text = fh.read()
+    if "*USER ELEMENT" in text.upper():
+        return _read_calculix_user_element(text, path, ids)
+    return _read_calculix_entries(text, path, ids)
+
+
+def _read_calculix_user_element(text: str, path: str, ids: np.ndarray) -> np.ndarray:
+    """The layout of ``*SUBSTRUCTURE MATRIX OUTPUT`` in CalculiX 2.20 (Abaqus's user element):
+
+    * ``*USER ELEMENT, NODES=m, LINEAR``; comment lines ``** ELEMENT NODES`` then ``**`` lines with
+      the global node number of each of the m element "nodes" (one per retained DOF);
+    * data lines: the first one the DOF of element node 1, each next one ``position, dof`` where
+      the DOF changes (positions not listed keep the previous DOF);
+    * ``*MATRIX, TYPE=STIFFNESS``: the lower triangle row by row (row i holds i entries),
+      comma-separated, any number per line."""
+    where = {int(n): k for k, n in enumerate(ids)}
+    lines = text.splitlines()
+    try:
+        head = next(i for i, l in enumerate(lines) if l.strip().upper().startswith("*USER ELEMENT"))
+        start = next(i for i, l in enumerate(lines) if l.strip().upper().startswith("** ELEMENT NODES"))
+        mat = next(i for i, l in enumerate(lines) if l.strip().upper().startswith("*MATRIX"))
+    except StopIteration:
+        raise ImportedMatrixError(f"{path}: a CalculiX user-element file needs '*USER ELEMENT', '** ELEMENT NODES' "
+                                  f"and '*MATRIX, TYPE=STIFFNESS'") from None
+    if "STIFFNESS" not in lines[mat].upper():
+        raise ImportedMatrixError(f"{path}: {lines[mat].strip()!r}: the matrix must be TYPE=STIFFNESS")
+    nodes, i = [], start + 1
+    while i < len(lines) and lines[i].strip().startswith("**"):
+        nodes += [int(x) for x in lines[i].strip()[2:].replace(",", " ").split()]
+        i += 1
+    m = len(nodes)
+    declared = [x for x in lines[head].upper().replace(" ", "").split(",") if x.startswith("NODES=")]
+    if declared and int(declared[0][6:]) != m:
+        raise ImportedMatrixError(f"{path}: *USER ELEMENT declares {declared[0][6:]} nodes, the ELEMENT NODES list "
+                                  f"holds {m}")
+    dof_at, current = {}, None
+    for line in lines[i:mat]:
+        parts = [int(x) for x in line.replace(",", " ").split() if x]
+        if not parts or line.strip().startswith("*"):
+            continue
+        if current is None:
+            dof_at[1] = current = parts[0]
+        else:
+            dof_at[parts[0]] = parts[1]
+    dofs, d = [], None
+    for k in range(1, m + 1):
+        d = dof_at.get(k, d)
+        dofs.append(d)
+    values = np.array([float(x) for l in lines[mat + 1:] if l.strip() and not l.strip().startswith("*")
+                       for x in l.replace(",", " ").split()])
+    if len(values) != m * (m + 1) // 2:
+        raise ImportedMatrixError(f"{path}: {len(values)} matrix entries, a lower triangle of {m} DOFs has "
+                                  f"{m * (m + 1) // 2}")
+    index = []
+    for n, d in zip(nodes, dofs):
+        if n not in where:
+            raise ImportedMatrixError(f"{path}: node {n} is not in the nodes file")
+        if d not in (1, 2, 3):
+            raise ImportedMatrixError(f"{path}: node {n} dof {d}: must be 1, 2 or 3 (translations)")
+        index.append(3 * where[n] + d - 1)
+    r, c = np.tril_indices(m)
+    index = np.array(index)
+    return _assemble(index[r], index[c], values, 3 * len(ids), path, one_triangle_allowed=True)
+
+
+def _read_calculix_entries(text: str, path: str, ids: np.ndarray) -> np.ndarray:
+    """Lines ``row node, row dof, column node, column dof, value`` (``OUTPUT FILE=MATRIX``, the format
+    ``*MATRIX ASSEMBLE`` reads)."""
     where = {int(n): k for k, n in enumerate(ids)}
     data = []
-    with open(path) as fh:
-        for line_no, line in enumerate(fh, start=1):
-            s = line.strip()
-            if not s or s.startswith("*"):
-                continue
-            parts = [p for p in s.replace(",", " ").split() if p]
-            try:
-                n1, d1, n2, d2, v = int(parts[0]), int(parts[1]), int(parts[2]), int(parts[3]), float(parts[4])
-            except (ValueError, IndexError):
-                raise ImportedMatrixError(f"{path}, line {line_no}: {s!r}: must be 'row node, row dof, column node, "
-                                          f"column dof, value'") from None
-            for n, d in ((n1, d1), (n2, d2)):
-                if n not in where:
-                    raise ImportedMatrixError(f"{path}, line {line_no}: node {n} is not in the nodes file")
-                if d not in (1, 2, 3):
-                    raise ImportedMatrixError(f"{path}, line {line_no}: dof {d}: must be 1, 2 or 3 (translations)")
-            data.append((3 * where[n1] + d1 - 1, 3 * where[n2] + d2 - 1, v))
+    for line_no, line in enumerate(text.splitlines(), start=1):
+        s = line.strip()
+        if not s or s.startswith("*"):
+            continue
+        parts = [p for p in s.replace(",", " ").split() if p]
+        try:
+            n1, d1, n2, d2, v = int(parts[0]), int(parts[1]), int(parts[2]), int(parts[3]), float(parts[4])
+        except (ValueError, IndexError):
+            raise ImportedMatrixError(f"{path}, line {line_no}: {s!r}: must be 'row node, row dof, column node, "
+                                      f"column dof, value'") from None
+        for n, d in ((n1, d1), (n2, d2)):
+            if n not in where:
+                raise ImportedMatrixError(f"{path}, line {line_no}: node {n} is not in the nodes file")
+            if d not in (1, 2, 3):
+                raise ImportedMatrixError(f"{path}, line {line_no}: dof {d}: must be 1, 2 or 3 (translations)")
+        data.append((3 * where[n1] + d1 - 1, 3 * where[n2] + d2 - 1, v))
     if not data:
         raise ImportedMatrixError(f"{path}: no matrix entries")
     i, j, v = (np.array(x) for x in zip(*data))
