@@ -444,3 +444,19 @@ def test_a_calculix_written_substructure_file_is_read_node_by_node():
     k = read_calculix(str(ROOT / "tests" / "data" / "calculix" / "blocksub.mtx"), top[order])
     dofs = (3 * order[:, None] + np.arange(3)).ravel()
     assert np.abs(k - k_tt[np.ix_(dofs, dofs)]).max() < 1e-10 * np.abs(k_tt).max()
+
+
+def test_a_very_stiff_plate_on_the_upper_face_reproduces_the_clamped_face(table1, builds):
+    """The inner ring (bolted on its upper face) on a plate 1e4 times stiffer than steel, wider
+    than the face and clamped along its inner edge: the clamped inner ring within 1 %."""
+    s = table1.inner_section
+    plate = Adapter("inner", "plate", s.inner_radius - 0.05, s.outer_radius, 0.04, "inner",
+                    *(1e4 * STEEL,) * 3, 1e4 * STEEL / 2.6, 0.3)
+    se = _build(table1.with_connection({"inner": plate}), "clamped")
+    a = se.inner.harmonic_blocks().real
+    c = builds["clamped"].inner.harmonic_blocks().real
+    worst = max(np.linalg.norm(np.linalg.inv(x) - np.linalg.inv(y)) / np.linalg.norm(np.linalg.inv(y))
+                for x, y in zip(a, c))
+    assert worst < 0.01, worst
+    assert se.metadata["rings"]["inner"]["connection"]["bolted_annulus_m"] == pytest.approx(
+        [s.inner_radius, s.outer_radius])

@@ -24,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, help="output file (.npz)")
     parser.add_argument("--mesh", choices=list(MESH_PRESETS), default=DEFAULT_MESH, help=MESH_HELP)
     parser.add_argument("--bc", choices=BOUNDARY_CONDITIONS, default="free",
-                        help="boundary condition of both rings (free: the paper's idling model)")
+                        help="boundary condition of both rings (free: the paper's idling model); a ring the "
+                             "bearing file connects ([connection.<ring>]) is held by its connected structure instead")
     parser.add_argument("--bc-outer", choices=BOUNDARY_CONDITIONS, help="boundary condition of the outer ring only")
     parser.add_argument("--bc-inner", choices=BOUNDARY_CONDITIONS, help="boundary condition of the inner ring only")
     parser.add_argument("--harmonics", type=int, help="highest Fourier harmonic (not given: from the section)")
