@@ -5,7 +5,10 @@
 1. Superelement build time (no cache) of the pitch bearing, free rings and bolted as in
    ``pitch_bearing_bolted.toml`` (hub flange on the outer ring, blade root on the inner one),
    per mesh, each build in this process one after the other.
-2. The step: the benchmark's pitch case (``cases.pitch``: blade-root series, pitching +-5 deg,
+2. ``--compare``: the pitch bearing at the two instants of the shipped blade-root series with the
+   largest and the smallest moment, free / clamped / frictionless / bolted rings (coarse) and
+   rigid rings: peak ball load and friction torque.
+3. The step: the benchmark's pitch case (``cases.pitch``: blade-root series, pitching +-5 deg,
    flexible rings, friction on) through :class:`BearingSimulator` with the free and with the
    bolted superelement (coarse), interleaved step by step in one run: the median step time of each.
 """
@@ -75,14 +78,43 @@ def steps(n):
               f"{max(peaks[name]) / 1e3:.1f} kN", flush=True)
 
 
+def compare():
+    import numpy as np
+
+    from slewing_model import Loads, load_bearing
+    from slewing_model.distribution.bime import solve
+    from slewing_model.friction.torque import friction_torque
+    from slewing_model.rings.superelement import build_superelement
+
+    data = np.genfromtxt(ROOT / "examples/loads/blade_root_loads.csv", delimiter=",", names=True)
+    moment = np.hypot(data["Mx"], data["My"])
+    bolted = load_bearing(ROOT / "examples/bearings/pitch_bearing_bolted.toml")
+    plain = bolted.with_connection(None)
+    ses = {bc: build_superelement(plain, "coarse", bc) for bc in ("free", "clamped", "frictionless")}
+    ses["bolted"] = build_superelement(bolted, "coarse", "free")
+    ses["rigid"] = None
+    for k in (int(np.argmax(moment)), int(np.argmin(moment))):
+        loads = Loads(*(float(data[f][k]) for f in ("Fx", "Fy", "Fz", "Mx", "My")))
+        print(f"t = {data['time'][k]:.2f} s: |M| = {moment[k] / 1e6:.2f} MN m, Fz = {data['Fz'][k] / 1e3:.0f} kN, "
+              f"Fr = {np.hypot(data['Fx'][k], data['Fy'][k]) / 1e3:.0f} kN")
+        for name, se in ses.items():
+            r = solve(plain, loads, model="rigid" if se is None else "flexible", superelement=se)
+            f = friction_torque(plain, r, omega=1.0)
+            print(f"  {name:12} peak ball load {r.max_ball_load / 1e3:7.1f} kN, friction torque "
+                  f"{f.magnitude / 1e3:6.2f} kN m", flush=True)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--steps", type=int, default=400)
     p.add_argument("--meshes", nargs="*", default=["coarse", "fine"])
     p.add_argument("--no-builds", action="store_true")
+    p.add_argument("--compare", action="store_true", help="the free / clamped / frictionless / bolted table")
     args = p.parse_args()
     if not args.no_builds:
         builds(args.meshes)
+    if args.compare:
+        compare()
     if args.steps:
         steps(args.steps)
 
