@@ -84,6 +84,10 @@ def summary(se, elapsed: float, path: str | None = None) -> str:
         lines.append(f"  {r:6} {rm['boundary_condition']:13} {null:18} {rm['mesh']['elements']:>8} "
                      f"{rm['mesh']['dofs']:>7} {100 * rm['truncation_change']:>7.2f}% "
                      f"{ph['clipped']:>4}/{ph['directions']:<4} {diag[0]:>9.3f} {diag[1]:>9.3f}")
+    for r in ("outer", "inner"):
+        conn = m["rings"][r].get("connection")
+        if conn:
+            lines.append(f"  {r} ring: {conn['support']}")
     lines.append("  trunc.: largest change of a diagonal entry when only 3/4 of the harmonics are kept; "
                  "clipped: harmonic directions with no compliance beyond Hertz's (floor applies)")
     return "\n".join(lines)

@@ -347,7 +347,7 @@ class _Section:
 
 def export_face_stiffness(face_stiffness, n_max: int, angles: int | None = None):
     """A Cartesian stiffness (3k, 3k) on nodes at ``angles`` equally spaced angles times the ring
-    face's P2 node radii, whose projection (:func:`harmonic_face_stiffness`) gives back
+    face's P2 node radii the structure touches, whose projection (:func:`harmonic_face_stiffness`) gives back
     ``face_stiffness.matrix(n)`` exactly for ``n <= n_max`` (and nothing above): for
     round trips and to hand a parametric adapter to another tool.
 
@@ -358,8 +358,13 @@ def export_face_stiffness(face_stiffness, n_max: int, angles: int | None = None)
     m = angles or 2 * n_max + 2
     if m <= 2 * n_max:
         raise ValueError(f"angles = {m}: must exceed 2 n_max = {2 * n_max}")
-    theta = np.repeat(2 * np.pi * np.arange(m) / m, len(face.r))
-    r = np.tile(face.r, m)
+    # only the face radii the structure touches (its rows are not all zero)
+    touched = np.zeros(len(face.r), dtype=bool)
+    for n in range(n_max + 1):
+        touched |= np.abs(face_stiffness.matrix(n)).reshape(len(face.r), -1).max(axis=1) > 0
+    radii = face.r[touched]
+    theta = np.repeat(2 * np.pi * np.arange(m) / m, len(radii))
+    r = np.tile(radii, m)
     k3 = np.zeros((3 * len(r), 3 * len(r)))
     for n in range(n_max + 1):
         f = face_stiffness.matrix(n)
