@@ -8,7 +8,10 @@
 2. ``--compare``: the pitch bearing at the two instants of the shipped blade-root series with the
    largest and the smallest moment, free / clamped / frictionless / bolted rings (coarse) and
    rigid rings: peak ball load and friction torque.
-3. The step: the benchmark's pitch case (``cases.pitch``: blade-root series, pitching +-5 deg,
+3. ``--tubes``: table1 (100 balls) with both rings bolted to steel tubes as wide as their faces,
+   0.3 m and 1 m long, under a tilting moment of 1 MN m and an axial force of 1 MN: peak ball load
+   against clamped, frictionless and free rings (coarse).
+4. The step: the benchmark's pitch case (``cases.pitch``: blade-root series, pitching +-5 deg,
    flexible rings, friction on) through :class:`BearingSimulator` with the free and with the
    bolted superelement (coarse), interleaved step by step in one run: the median step time of each.
 """
@@ -104,17 +107,45 @@ def compare():
                   f"{f.magnitude / 1e3:6.2f} kN m", flush=True)
 
 
+def tubes():
+    from slewing_model import Loads, load_bearing
+    from slewing_model.bearing.connection import Adapter
+    from slewing_model.distribution.bime import solve
+    from slewing_model.rings.superelement import build_superelement
+
+    b = load_bearing(ROOT / "examples/bearings/table1.toml")
+
+    def tube(ring, length):
+        s = b.outer_section if ring == "outer" else b.inner_section
+        return Adapter(ring, "tube", s.inner_radius, s.outer_radius, length, "far_end", 210e9, 210e9, 210e9,
+                       210e9 / 2.6, 0.3)
+
+    ses = {bc: build_superelement(b, "coarse", bc) for bc in ("clamped", "frictionless", "free")}
+    for length in (0.3, 1.0):
+        ses[f"tubes {length:g} m"] = build_superelement(
+            b.with_connection({"outer": tube("outer", length), "inner": tube("inner", length)}), "coarse", "free")
+    for loads in (Loads(0, 0, 0, 0, 1.0e6), Loads(0, 0, 1.0e6, 0, 0)):
+        print(loads)
+        q = {k: solve(b, loads, model="flexible", superelement=se).max_ball_load for k, se in ses.items()}
+        for k, v in q.items():
+            print(f"  {k:13} peak {v / 1e3:7.2f} kN, against clamped {100 * (v / q['clamped'] - 1):+6.1f} %, "
+                  f"against frictionless {100 * (v / q['frictionless'] - 1):+6.1f} %", flush=True)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--steps", type=int, default=400)
     p.add_argument("--meshes", nargs="*", default=["coarse", "fine"])
     p.add_argument("--no-builds", action="store_true")
     p.add_argument("--compare", action="store_true", help="the free / clamped / frictionless / bolted table")
+    p.add_argument("--tubes", action="store_true", help="table1 on steel tubes against the idealisations")
     args = p.parse_args()
     if not args.no_builds:
         builds(args.meshes)
     if args.compare:
         compare()
+    if args.tubes:
+        tubes()
     if args.steps:
         steps(args.steps)
 
