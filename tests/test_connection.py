@@ -460,3 +460,8 @@ def test_a_very_stiff_plate_on_the_upper_face_reproduces_the_clamped_face(table1
     assert worst < 0.01, worst
     assert se.metadata["rings"]["inner"]["connection"]["bolted_annulus_m"] == pytest.approx(
         [s.inner_radius, s.outer_radius])
+
+
+def test_with_connection_refuses_a_connection_for_the_other_ring(table1):
+    with pytest.raises(BearingDefinitionError, match="connection.outer"):
+        table1.with_connection({"outer": _tube(table1, ring="inner")})

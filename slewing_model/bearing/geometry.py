@@ -171,7 +171,12 @@ class Bearing:
     def with_connection(self, connection) -> "Bearing":
         """A copy whose rings are bolted to ``connection`` ({ring: Adapter or ImportedStiffness});
         None: to nothing (free, clamped or frictionless as the superelement's ``bc`` says)."""
-        return _replace(self, connection=dict(connection) if connection else None)
+        connection = dict(connection) if connection else None
+        for ring, c in (connection or {}).items():
+            if ring not in RING_CONTACTS or getattr(c, "ring", None) != ring:
+                _fail(f"connection.{ring}", c, "keys must be 'outer' or 'inner', each holding that ring's "
+                      "Adapter or ImportedStiffness")
+        return _replace(self, connection=connection)
 
     def to_dict(self) -> dict:
         """The definition as plain SI data (for hashes, JSON and the FMU)."""
