@@ -196,6 +196,14 @@ class AdapterFaceStiffness:
                              f"not overlap its bolted face (r {face.inner_radius * 1e3:g}..{face.outer_radius * 1e3:g} mm)")
         self.annulus = (lo, hi)
         inside = face.vertex_r[(face.vertex_r > lo) & (face.vertex_r < hi)]
+        # a ring face vertex very near the annulus' edge would leave a sliver: drop it (the tie then
+        # holds the adapter's node there to the ring's field, a node-to-surface tie)
+        v = face.vertex_r
+        for end in (lo, hi):
+            k = int(np.clip(np.searchsorted(v, end), 1, len(v) - 1))
+            length = v[k] - v[k - 1]                       # the ring face edge holding this end
+            if min(abs(v - end)) > 1e-9 * max(end, 1.0):   # the end is the adapter's, inside a face edge
+                inside = inside[np.abs(inside - end) > 0.3 * length]
         spacing = np.diff(np.concatenate([[lo], inside, [hi]]))
         h0 = float(spacing.min())
         h_cap = max(size.max_size * h_section, h0)
