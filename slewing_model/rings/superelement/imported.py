@@ -133,8 +133,11 @@ def _read_calculix_user_element(text: str, path: str, ids: np.ndarray) -> np.nda
     for k in range(1, m + 1):
         d = dof_at.get(k, d)
         dofs.append(d)
-    values = np.array([float(x) for l in lines[mat + 1:] if l.strip() and not l.strip().startswith("*")
-                       for x in l.replace(",", " ").split()])
+    try:
+        values = np.array(" ".join(l for l in lines[mat + 1:] if l.strip() and not l.strip().startswith("*"))
+                          .replace(",", " ").split(), dtype=float)
+    except ValueError as exc:
+        raise ImportedMatrixError(f"{path}: a matrix entry is not a number ({exc})") from None
     if len(values) != m * (m + 1) // 2:
         raise ImportedMatrixError(f"{path}: {len(values)} matrix entries, a lower triangle of {m} DOFs has "
                                   f"{m * (m + 1) // 2}")
@@ -154,6 +157,19 @@ def _read_calculix_entries(text: str, path: str, ids: np.ndarray) -> np.ndarray:
     """Lines ``row node, row dof, column node, column dof, value`` (``OUTPUT FILE=MATRIX``, the format
     ``*MATRIX ASSEMBLE`` reads)."""
     where = {int(n): k for k, n in enumerate(ids)}
+    try:        # the quick way; a malformed file is read again line by line for its message
+        rows = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("*")]
+        table = np.array(" ".join(rows).replace(",", " ").split(), dtype=float).reshape(-1, 5)
+        nodes, dofs = table[:, [0, 2]].astype(int), table[:, [1, 3]].astype(int)
+        if (np.all(np.isin(nodes, ids)) and np.all((dofs >= 1) & (dofs <= 3))
+                and np.all(table[:, :4] == np.round(table[:, :4]))):
+            pos = np.zeros(max(int(nodes.max()), int(np.max(ids))) + 1, dtype=int)
+            pos[ids] = np.arange(len(ids))
+            i = 3 * pos[nodes[:, 0]] + dofs[:, 0] - 1
+            j = 3 * pos[nodes[:, 1]] + dofs[:, 1] - 1
+            return _assemble(i, j, table[:, 4], 3 * len(ids), path, one_triangle_allowed=True)
+    except ValueError:
+        pass
     data = []
     for line_no, line in enumerate(text.splitlines(), start=1):
         s = line.strip()
