@@ -50,7 +50,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     output : path, optional
         FMU file; default ``SlewingBearing_<name>.fmu`` beside the definition's name, in ``build/``.
     bc : {"free", "clamped", "frictionless"}
-        Ring support of the superelement.
+        Ring support of the superelement; a ring the bearing file connects (``[connection.<ring>]``,
+        docs/connected_structures.md) is held by its connected structure instead.
     mesh : {"coarse", "fine"}
         Superelement mesh; "fine" (default) is within 0.5 % of a finer one, "coarse" is for tests.
     fmi_version : {2, 3}

@@ -22,7 +22,7 @@ __version__ = "0.1.0"
 #: rings/superelement (scikit-fem, build time), study, loads, cli, plots and life/command (host side)
 RUNTIME_MODULES = ("__init__",
                    "bearing/__init__", "bearing/conventions", "bearing/geometry", "bearing/manufacturing",
-                   "bearing/contact",
+                   "bearing/contact", "bearing/connection",
                    "rings/__init__", "rings/stiffness", "rings/compliance", "rings/reduced_operator",
                    "distribution/__init__", "distribution/results", "distribution/assembly", "distribution/kernel",
                    "distribution/bime",

@@ -62,7 +62,8 @@ def _add_solve(sub) -> None:
                        help=f"{name} on the moving ring, {unit} (fixed frame)")
     p.add_argument("--model", choices=("rigid", "flexible"), default="rigid", help="ring model")
     p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free",
-                   help="ring support of the flexible model's superelement")
+                   help="ring support of the flexible model's superelement (a ring the bearing file connects, "
+                        "[connection.<ring>], is held by that instead)")
     p.add_argument("--mesh", choices=("coarse", "fine", "finer"), default=DEFAULT_MESH, help=MESH_HELP)
     _add_superelement_file(p)
     p.add_argument("--preload", type=_finite_float, default=None, metavar="m",
@@ -143,7 +144,8 @@ def _add_plot(sub) -> None:
     p.add_argument("--preload", type=_finite_float, default=None, metavar="m", help="ball preload, m")
     p.add_argument("--quantity", choices=("interference", "load"), default="interference", help="what to plot")
     p.add_argument("--bc", choices=("free", "clamped", "frictionless"), default="free",
-                   help="ring support of the flexible rings' superelement")
+                   help="ring support of the flexible rings' superelement (a ring the bearing file connects, "
+                        "[connection.<ring>], is held by that instead)")
     p.add_argument("--mesh", choices=("coarse", "fine", "finer"), default=DEFAULT_MESH, help=MESH_HELP)
     _add_superelement_file(p)
     p.add_argument("-o", "--output", required=True, help="PNG file to write")

@@ -48,6 +48,11 @@ def _assert_names(message, path, table, key, known):
     ("[errors]\nouter_csv = 'x.csv'\n", "errors", "outer_csv", ["outer_ring_csv", "ball_diameters_csv", "synthetic"]),
     ("[errors.synthetic]\nseed = 1\nradial_amplitude = 3.0\n", "errors.synthetic", "radial_amplitude",
      ["radial_amplitude_um", "axial_amplitude_um", "waviness_orders", "ball_tolerance_um", "seed"]),
+    ("[connection.outer]\ntype = 'tube'\ninner_diameter_mm = 560.0\nouter_diameter_mm = 620.0\nlength_mm = 400.0\n"
+     "youngs_modulus_gpa = 210.0\npoisson_ratio = 0.3\nwall_thickness_mm = 30.0\n", "connection.outer",
+     "wall_thickness_mm", ["inner_diameter_mm", "outer_diameter_mm", "length_mm", "youngs_modulus_gpa",
+                           "axial_modulus_gpa", "hoop_modulus_gpa", "shear_modulus_gpa", "poisson_ratio"]),
+    ("[connection]\nouter_ring = 1\n", "connection", "outer_ring", ["outer", "inner"]),
 ])
 def test_bearing_file_table_refuses_unknown_key(tmp_path, extra, table, key, known):
     path = tmp_path / "bearing.toml"

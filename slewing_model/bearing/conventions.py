@@ -39,6 +39,8 @@ BEARING_TABLES = {
     "rings": ("gap_mm", "outer_ring_outer_diameter_mm", "inner_ring_bore_diameter_mm", "outer_ring_height_mm",
               "inner_ring_height_mm", "outer_ring_bolted_face", "inner_ring_bolted_face"),
     "errors": ("outer_ring_csv", "inner_ring_csv", "ball_diameters_csv", "synthetic"),
+    # sub-tables [connection.outer], [connection.inner]; their keys: bearing/connection.py
+    "connection": ("outer", "inner"),
 }
 
 

@@ -28,6 +28,7 @@ import numpy as np
 from .conventions import (BEARING_TABLES, CONTACTS, DIAGONALS, RING_CONTACTS,  # noqa: F401  (the conventions
                           BearingDefinitionError, check_known_keys, fail as _fail)  # belong to this interface)
 from .manufacturing import ManufacturingErrors, errors_from_table
+from .connection import connection_from_dict, connections_from_table
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
@@ -94,6 +95,9 @@ class Bearing:
         Ring cross-sections (documented defaults when the file gives none).
     errors : ManufacturingErrors or None
         Measured or synthetic manufacturing errors; None for the nominal bearing.
+    connection : dict or None
+        ``{"outer": ..., "inner": ...}`` (either or both): what each ring's bolted face is bolted
+        to (:mod:`.connection`, issue 29); None or {}: nothing (the superelement's ``bc`` applies).
     """
 
     name: str
@@ -110,6 +114,7 @@ class Bearing:
     outer_section: RingSection | None = None
     inner_section: RingSection | None = None
     errors: Any = None
+    connection: Any = None
     source: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     # ---- derived quantities -------------------------------------------------
@@ -163,6 +168,16 @@ class Bearing:
         """A copy carrying these manufacturing errors (None: nominal bearing)."""
         return _replace(self, errors=errors)
 
+    def with_connection(self, connection) -> "Bearing":
+        """A copy whose rings are bolted to ``connection`` ({ring: Adapter or ImportedStiffness});
+        None: to nothing (free, clamped or frictionless as the superelement's ``bc`` says)."""
+        connection = dict(connection) if connection else None
+        for ring, c in (connection or {}).items():
+            if ring not in RING_CONTACTS or getattr(c, "ring", None) != ring:
+                _fail(f"connection.{ring}", c, "keys must be 'outer' or 'inner', each holding that ring's "
+                      "Adapter or ImportedStiffness")
+        return _replace(self, connection=connection)
+
     def to_dict(self) -> dict:
         """The definition as plain SI data (for hashes, JSON and the FMU)."""
         d = {
@@ -182,6 +197,8 @@ class Bearing:
         }
         if self.errors is not None:
             d["errors"] = self.errors.to_dict()
+        if self.connection:     # absent when there is none: the hashes of unconnected bearings stay
+            d["connection"] = {r: self.connection[r].to_dict() for r in sorted(self.connection)}
         return d
 
     @classmethod
@@ -203,6 +220,8 @@ class Bearing:
             outer_section=RingSection(**d["outer_section"]),
             inner_section=RingSection(**d["inner_section"]),
             errors=errors,
+            connection={r: connection_from_dict(c) for r, c in d["connection"].items()} if d.get("connection")
+            else None,
         )
         validate(b)
         return b
@@ -303,9 +322,9 @@ def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
     Parameters
     ----------
     data : mapping
-        Tables ``[bearing]``, optional ``[material]``, ``[rings]``, ``[errors]``.
+        Tables ``[bearing]``, optional ``[material]``, ``[rings]``, ``[errors]``, ``[connection]``.
     base_dir : path
-        Folder against which CSV file names of ``[errors]`` are resolved.
+        Folder against which file names of ``[errors]`` and ``[connection]`` are resolved.
 
     Raises
     ------
@@ -373,12 +392,16 @@ def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
     errors = None
     if "errors" in data:
         errors = errors_from_table(_subtable(data, "errors"), base_dir=base_dir, ball_count=n)
+    connection = None
+    if "connection" in data:
+        connection = connections_from_table(data["connection"], {"outer": outer, "inner": inner},
+                                            base_dir=base_dir) or None
 
     bearing = Bearing(
         name=str(b.get("name", "bearing")), pitch_diameter=dm, ball_diameter=dw, groove_radius=rc,
         contact_angle=alpha * _DEG, ball_count=n, preload=preload, youngs_modulus=youngs,
         poisson_ratio=nu, moving_ring=moving, first_ball_angle=phi0,
-        outer_section=outer, inner_section=inner, errors=errors, source=dict(data),
+        outer_section=outer, inner_section=inner, errors=errors, connection=connection, source=dict(data),
     )
     validate(bearing)
     return bearing

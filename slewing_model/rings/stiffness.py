@@ -77,14 +77,19 @@ def _canonical(value):
 def ring_fields(bearing) -> dict:
     """The ring-relevant part of ``bearing.to_dict()`` (see :data:`RING_FIELDS`), canonical form."""
     d = bearing.to_dict() if hasattr(bearing, "to_dict") else dict(bearing)
-    return _canonical({k: d[k] for k in RING_FIELDS})
+    fields = {k: d[k] for k in RING_FIELDS}
+    if d.get("connection"):     # issue 29: what the rings are bolted to (absent: the hash is unchanged)
+        from ..bearing.connection import connection_key
+
+        fields["connection"] = {r: connection_key(c) for r, c in d["connection"].items()}
+    return _canonical(fields)
 
 
 def bearing_hash(bearing) -> str:
     """SHA-256 (hex, 16 characters) of the ring-relevant fields of a bearing.
 
-    Geometry, ring sections, material, ball count and first ball angle; not the
-    preload, the manufacturing errors, the moving ring or the name."""
+    Geometry, ring sections, material, ball count and first ball angle, and the connected
+    structures when there are any (``[connection]``); not the preload, the manufacturing errors, the moving ring or the name."""
     text = json.dumps(ring_fields(bearing), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

@@ -27,6 +27,7 @@ from . import condense as cd
 from . import coupling as cp
 from .harmonic import HarmonicRingModel
 from .section import MESH_PRESETS, MeshSize, mesh_section, ring_profile
+from .adapters import CONNECTED, connect
 from .supports import BOUNDARY_CONDITIONS, NULL_SPACE, SUPPORT_REMOVES, Support
 
 #: bump when the numbers a build produces change for the same inputs (invalidates caches)
@@ -116,7 +117,9 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
         docs/superelement.md) or ``"finer"``; or explicit :class:`MeshSize` fields.
     bc : str or dict
         ``"free"``, ``"clamped"`` or ``"frictionless"`` for both rings, or
-        ``{"outer": ..., "inner": ...}``.
+        ``{"outer": ..., "inner": ...}``. A ring the bearing connects (``bearing.connection``,
+        the bearing file's ``[connection.<ring>]``) takes its support from that connection
+        (``"connected"``) and ``bc`` applies to the other ring only.
     cache : bool
         Read and write the on-disk cache.
     cache_dir : path, optional
@@ -144,6 +147,8 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
     opts = {**DEFAULT_OPTIONS, **expert_options}
     mesh_name, size = _mesh_size(mesh)
     bcs = _bcs(bc)
+    for ring in bearing.connection or {}:      # issue 29: a connected ring's support is its connection
+        bcs[ring] = CONNECTED
     harmonics = {r: int(opts["harmonics"]) if opts["harmonics"] is not None
                  else auto_harmonics(bearing, r, opts["harmonic_factor"]) for r in ("outer", "inner")}
     key_options = {"mesh": asdict(size), "bc": bcs, "harmonics": harmonics,
@@ -225,7 +230,12 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     model = HarmonicRingModel(sm.mesh, e, nu)
     patches = cp.ring_patches(bearing, ring, sizes)
     loads, lams = cp.master_loads(model, sm.patch_facets, patches)
-    support = Support(bc, model, sm.bolted_facets)
+    connection_info = None
+    if bc == CONNECTED:                    # issue 29: the bolted face joined to a tube, plate or matrix
+        model, support, connection_info = connect(model, sm, bearing.connection[ring], size)
+        loads = model.pad(loads)
+    else:
+        support = Support(bc, model, sm.bolted_facets)
     if progress is not None:
         progress(1)
     t1 = time.perf_counter()
@@ -233,8 +243,11 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     t2 = time.perf_counter()
     c_hs = cd.halfspace_blocks(patches, lams, range(n_max + 1), e, nu)
     floor = _floor(bearing, ring, opts["compliance_floor"], opts["reference_pressure"])
-    info = {"mesh": {**sm.info, "dofs": int(model.ndofs)}, "patch_semi_axes_m": [list(s) for s in sizes],
+    info = {"mesh": {**sm.info, "dofs": int(getattr(model, "ring_ndofs", model.ndofs))},
+            "patch_semi_axes_m": [list(s) for s in sizes],
             "seconds": {"setup": t1 - t0, "harmonics": t2 - t1}}
+    if connection_info is not None:
+        info["connection"] = connection_info
     return RingHarmonics(ring, bc, patches, lams, c_fe, c_hs, floor, e, nu, info)
 
 
@@ -257,12 +270,12 @@ def condense_ring(h: RingHarmonics, ball_count: int, n_max: int | None = None,
     trunc = float(np.max(np.abs(diag - diag34) / np.abs(diag)))
     B = ball_count
     stiff = RingStiffness(h.ring, B, 0.5 * (row + row[(-np.arange(B)) % B].transpose(0, 2, 1)),
-                          NULL_SPACE[h.bc], h.bc)
+                          NULL_SPACE.get(h.bc, ()), h.bc)
     meta = {
         "contacts": list(RING_CONTACTS[h.ring]),
         "boundary_condition": h.bc,
-        "removed_modes": list(NULL_SPACE[h.bc]),
-        "support_removes": SUPPORT_REMOVES[h.bc],
+        "removed_modes": list(NULL_SPACE.get(h.bc, ())),
+        "support_removes": SUPPORT_REMOVES.get(h.bc) or h.info["connection"]["support"],
         "mesh": h.info["mesh"],
         "harmonics": n,
         "patch_semi_axes_m": h.info["patch_semi_axes_m"],
@@ -272,6 +285,8 @@ def condense_ring(h: RingHarmonics, ball_count: int, n_max: int | None = None,
         "diagonal_N_per_m": [float(x) for x in diag],
         "seconds": {**h.info["seconds"], "condensation": time.perf_counter() - t0},
     }
+    if "connection" in h.info:
+        meta["connection"] = h.info["connection"]
     return stiff, meta
 
 

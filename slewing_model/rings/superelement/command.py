@@ -24,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, help="output file (.npz)")
     parser.add_argument("--mesh", choices=list(MESH_PRESETS), default=DEFAULT_MESH, help=MESH_HELP)
     parser.add_argument("--bc", choices=BOUNDARY_CONDITIONS, default="free",
-                        help="boundary condition of both rings (free: the paper's idling model)")
+                        help="boundary condition of both rings (free: the paper's idling model); a ring the "
+                             "bearing file connects ([connection.<ring>]) is held by its connected structure instead")
     parser.add_argument("--bc-outer", choices=BOUNDARY_CONDITIONS, help="boundary condition of the outer ring only")
     parser.add_argument("--bc-inner", choices=BOUNDARY_CONDITIONS, help="boundary condition of the inner ring only")
     parser.add_argument("--harmonics", type=int, help="highest Fourier harmonic (not given: from the section)")
@@ -83,6 +84,10 @@ def summary(se, elapsed: float, path: str | None = None) -> str:
         lines.append(f"  {r:6} {rm['boundary_condition']:13} {null:18} {rm['mesh']['elements']:>8} "
                      f"{rm['mesh']['dofs']:>7} {100 * rm['truncation_change']:>7.2f}% "
                      f"{ph['clipped']:>4}/{ph['directions']:<4} {diag[0]:>9.3f} {diag[1]:>9.3f}")
+    for r in ("outer", "inner"):
+        conn = m["rings"][r].get("connection")
+        if conn:
+            lines.append(f"  {r} ring: {conn['support']}")
     lines.append("  trunc.: largest change of a diagonal entry when only 3/4 of the harmonics are kept; "
                  "clipped: harmonic directions with no compliance beyond Hertz's (floor applies)")
     return "\n".join(lines)
