@@ -90,16 +90,23 @@ def test_at_most_four_modules_of_its_own_beside_the_subpackages():
 
 
 def test_the_run_time_part_imports_numpy_and_the_standard_library_only():
-    """What the FMU carries (RUNTIME_MODULES): importing all of it loads no other package."""
+    """What the FMU carries (RUNTIME_MODULES): importing all of it loads no other package, and no
+    module of slewing_model that the list leaves out (the FMU would not find it)."""
     code = ("import importlib, sys\n"
             "from slewing_model import RUNTIME_MODULES\n"
             "for m in RUNTIME_MODULES:\n"
             "    importlib.import_module(('slewing_model.' + m.replace('/', '.')).removesuffix('.__init__'))\n"
-            "print(sorted({m.split('.')[0] for m in sys.modules} - set(sys.stdlib_module_names)))")
+            "print(sorted({m.split('.')[0] for m in sys.modules} - set(sys.stdlib_module_names)))\n"
+            "print(sorted(m for m in sys.modules if m.startswith('slewing_model')))")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
-    third_party = set(ast.literal_eval(out.stdout.strip())) - {"slewing_model", "__main__"}
+    packages, loaded = map(ast.literal_eval, out.stdout.strip().splitlines())
+    third_party = set(packages) - {"slewing_model", "__main__"}
     third_party = {m for m in third_party if not m.startswith(("_distutils_hack", "__editable__"))}
     assert third_party == {"numpy"}
+    from slewing_model import RUNTIME_MODULES
+
+    listed = {("slewing_model." + m.replace("/", ".")).removesuffix(".__init__") for m in RUNTIME_MODULES}
+    assert set(loaded) - listed == set()
 
 
 def test_the_runtime_list_names_every_run_time_module_that_exists():
