@@ -290,7 +290,8 @@ def main():
             friction_torque_min_Nm=float(res["torque"][name].min()),
             friction_torque_max_Nm=float(res["torque"][name].max()),
             L10_h=s["life_L10_h"], L10_map_h=s["life_map_L10_h"], L10_dg03_h=s["life_dg03_L10_h"],
-            dg03_ratio=s["life_dg03_ratio"], worst_track=s["life_worst_track"],
+            dg03_ratio=s["life_dg03_ratio"], worst_track=s["life_worst_track"], cycles=s["life_cycles"],
+            micro_cycles=s["life_micro_cycles"],
             track_damage=[float(x) for x in life.track_damage], step_time_s=res["seconds"][name])
     summary = dict(run=RUN.name, blade=1, steps=int(series.time.size), t_start_s=float(series.time[0]),
                    t_end_s=float(series.time[-1]), friction_coefficient=args.friction, mesh="coarse",
