@@ -40,7 +40,7 @@ from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
-              runtime="standalone", numba=None) -> Path:
+              runtime="standalone", numba=None, win64=True) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -62,6 +62,9 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     numba : bool, optional
         Carry numba and the compiled loops (steps about 4 times faster, the FMU about 4 times
         larger: 87 MB against 22 MB for the pitch bearing). Default: where numba is installed here.
+    win64 : bool
+        Also carry a standalone Windows binary (``binaries/win64``, FMI 3.0 ``binaries/x86_64-windows``:
+        :mod:`build_win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops.
     """
     if fmi_version not in (2, 3):
         raise ValueError(f"fmi_version = {fmi_version!r}: must be 2 or 3")
@@ -98,7 +101,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                 needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
             )
-    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba)
+    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64)
     if numba:
         ship_compiled_kernels(built)
     return Path(built)
@@ -252,7 +255,7 @@ def python_runtime() -> dict[str, str]:
             "environment": sys.prefix}
 
 
-def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False) -> dict:
+def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False, win64=True) -> dict:
     """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
     for a standalone FMU the Python runtime beside it.
 
@@ -260,13 +263,19 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
     identifier's name and starts the Python that ``resources/python_runtime.txt`` (written here)
     describes before it: the runtime the FMU carries (``binaries/<platform>/python``,
     :mod:`build_runtime`), or for ``runtime="host"`` the building Python. The file also states the
-    FMU's glibc floor: the newest glibc version any of its Linux binaries needs. The Windows
-    binary is left as pythonfmu wrote it. Returns what the file says, as a dict."""
+    FMU's glibc floor: the newest glibc version any of its Linux binaries needs.
+
+    With ``win64`` (the default) a standalone FMU also gets a standalone Windows binary
+    (:mod:`build_win64`: our layer cross-compiled with mingw-w64 in front of pythonfmu's DLL, the
+    embeddable CPython with numpy beside it); the file then also says ``win64_version``,
+    ``win64_library`` and ``win64_packages``. Otherwise, and for ``runtime="host"``, the Windows
+    binary is left as pythonfmu wrote it (a tool coupling DLL). Returns what the file says, as a dict."""
     if runtime not in RUNTIMES:
         raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
     fmu = Path(fmu)
     folder = LINUX_BINARIES[fmi_version]
     binary = f"{folder}/{model_identifier}.so"
+    win64 = bool(win64) and runtime == "standalone"
     with tempfile.TemporaryDirectory(prefix="slewing_shim_") as tmp:
         tmp = Path(tmp)
         shim = compile_shim(tmp / f"{model_identifier}.so", fmi_version)
@@ -281,10 +290,19 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                 from build_runtime import runtime as bundled_runtime
 
                 carried = bundled_runtime(folder, numba=numba)
-                shutil.copy2(carried.archive, rewritten)        # the runtime's entries, compressed once
                 described = {"runtime": "standalone", "folder": "python", "library": carried.library,
                              "version": carried.python,
                              "packages": " ".join(f"{k}=={v}" for k, v in carried.packages.items())}
+                base = carried.archive
+                if win64:
+                    import build_win64
+
+                    with zipfile.ZipFile(fmu) as stock:
+                        windows = build_win64.windows_entries(stock, model_identifier, fmi_version, tmp)
+                    base, win = build_win64.merged_archive(carried.archive, fmi_version)
+                    described.update({"platforms": "linux64 win64", "win64_version": win["version"],
+                                      "win64_library": win["library"], "win64_packages": win["packages"]})
+                shutil.copy2(base, rewritten)        # the runtimes' entries, compressed once
                 floor = {"glibc": carried.glibc, "glibcxx": carried.glibcxx}
             else:
                 described = {"runtime": "host", **python_runtime()}
@@ -302,9 +320,13 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                 for info in src.infolist():
                     if info.filename == binary:
                         dst.write(inner, f"{folder}/{INNER_BINARY}")
+                    elif win64 and info.filename in windows:
+                        continue                          # pythonfmu's DLL: written below, behind our layer
                     elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
                         dst.writestr(info, src.read(info.filename))
                 dst.write(shim, binary)
+                for name, path in (windows.items() if win64 else ()):
+                    dst.write(path, name)
                 dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}",
                              header + "".join(f"{k}={v}\n" for k, v in described.items()))
         shutil.move(str(rewritten), fmu)
@@ -323,8 +345,11 @@ def describe_fmu(fmu) -> str:
     r = runtime_of(fmu)
     floor = f"Linux x86-64 with glibc {r['glibc']} or newer (check: ldd --version)"
     if r.get("runtime") == "standalone":
+        windows = (f" Windows: 64-bit Windows 8.1 or newer, nothing else (it carries Python {r['win64_version']} "
+                   f"with {r['win64_packages'].replace(' ', ', ')} and the Visual C++ runtime; numpy's loops; "
+                   "tested under wine, not on Windows)." if r.get("win64_version") else " No standalone Windows binary.")
         return (f"standalone FMU: it carries Python {r['version']} with {r['packages'].replace(' ', ', ')}; "
-                f"the target needs {floor}, and no Python.")
+                f"the target needs {floor}, and no Python.{windows}")
     return (f"host FMU: it runs in Python {r['version']} with numpy, at {r['environment']} or where "
             f"{PYTHON_HOME_VARIABLE} names one; the target needs that and {floor}.")
 
@@ -343,6 +368,9 @@ def main(argv=None) -> int:
     parser.add_argument("--numba", action=argparse.BooleanOptionalAction, default=None,
                         help="carry numba and the compiled loops: steps about 4x faster, the FMU about 4x larger "
                              "(default: yes where numba is installed here)")
+    parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
+                        help="carry a standalone Windows (win64) binary beside the Linux one, built here with "
+                             "mingw-w64 from PyPI's embeddable CPython and numpy (default: yes; --no-win64 leaves it out)")
     parser.add_argument("--host-env", action="store_true",
                         help="only print the Python an FMU built here needs (C/C++ hosts need no environment)")
     args = parser.parse_args(argv)
@@ -357,7 +385,7 @@ def main(argv=None) -> int:
     if args.bearing is None:
         parser.error("the bearing definition is required")
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
-                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba)
+                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba, win64=args.win64)
     print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")
     print(describe_fmu(path))
     return 0
