@@ -1,0 +1,202 @@
+"""The standalone FMUs' Windows (win64) binary, under wine: no Windows machine, no Python on the "Windows" side
+but the FMU's own (build_win64.py).
+
+Each FMU (the FMI 2.0 and 3.0 bearing FMUs and the drive FMU) runs in
+(a) our C host (tests/c_host/host.c) cross-compiled with mingw-w64: steps, state get/set/serialize,
+    free, FreeLibrary and reload;
+(b) fmpy 0.3.32 on the official embeddable CPython 3.11.9 (a Python host: the FMU uses its interpreter);
+(c) fmusim v0.0.39 cross-compiled with mingw-w64 (tests/win64/build_fmusim.sh; skipped where it is not built);
+``SLEWING_WINE_RUNS`` times each (1 in ``make test``, 5 in ``tests/win64/run_all.sh``); every run exits 0 and gives
+fmpy's outputs on Linux within 1e-9 relative.
+
+The tolerance: the Windows half runs another numpy (1.26.4 with its OpenBLAS, against 2.x on Linux) and
+another C library's libm (wine's ucrtbase against glibc), so the last bits of the solver's
+floating-point results may differ; both Newton solvers converge to 1e-12 or better, and 3e-14 was
+measured. 1e-9 is what the Linux tests allow between machine codes (numba's generic loops).
+
+Wine (Debian's wine 8) and mingw-w64 are installed by ``make`` as root; the prefix and the Windows Python
+are kept in ``$SLEWING_WINE_DIR`` (default /var/cache/slewing-wine). Without root or without them the
+tests are skipped, saying why.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import win64_tools as w  # noqa: E402
+from host_output import parse_host_output  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = int(os.environ.get("SLEWING_WINE_RUNS", "1"))
+STEPS = 6
+FMPY_STEPS = ROOT / "tests" / "win64" / "fmpy_steps.py"
+BEARING_INPUTS = ["Fx", "Fy", "Fz", "Mx", "My", "psi", "omega"]
+BEARING_OUTPUTS = ["z", "rx", "friction_torque", "max_ball_load", "static_safety_factor"]
+#: the drive has three inputs: the C host's seven values assigned in order, the later one winning (load_moment
+#: -2.5e3 N.m, friction_torque 3e4 + 1e3 k N.m, command 0.05 rad)
+DRIVE_INPUTS = ["load_moment", "load_moment", "friction_torque", "load_moment", "load_moment", "command", "command"]
+DRIVE_OUTPUTS = ["psi", "omega", "motor_torque", "ring_torque"]
+#: case: (FMI version, model identifier, inputs, outputs)
+CASES = {"bearing2": (2, "SlewingBearing", BEARING_INPUTS, BEARING_OUTPUTS),
+         "bearing3": (3, "SlewingBearing3", BEARING_INPUTS, BEARING_OUTPUTS),
+         "drive": (2, "SlewingDrive", DRIVE_INPUTS, DRIVE_OUTPUTS)}
+REL = 1e-9
+
+pytestmark = [
+    pytest.mark.skipif(os.geteuid() != 0, reason="SKIPPED, not root: the win64 tests need wine and mingw-w64, "
+                       "which `make` installs as root, and keep wine's prefix in /var/cache (CI runs as root)"),
+    pytest.mark.skipif(bool(w.missing_tools()), reason=f"SKIPPED: {w.missing_tools()}"),
+]
+
+
+@pytest.fixture(scope="module")
+def drive_fmu(tmp_path_factory):
+    sys.path.insert(0, str(ROOT))
+    from build_drive_fmu import build_drive_fmu
+
+    return build_drive_fmu(ROOT / "examples" / "drives" / "pitch_drive.toml",
+                           tmp_path_factory.mktemp("drive") / "SlewingDrive_pitch.fmu")
+
+
+@pytest.fixture(scope="module")
+def fmus(table3_fmu, table3_fmu3, drive_fmu):
+    return {"bearing2": table3_fmu, "bearing3": table3_fmu3, "drive": drive_fmu}
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory):
+    return w.c_hosts(tmp_path_factory.mktemp("win_hosts"))
+
+
+def parse_steps(text: str) -> np.ndarray:
+    return np.array([[float(v) for v in line.split()[2:]] for line in text.splitlines() if line.startswith("step ")])
+
+
+_references = {}
+
+
+def reference(case, fmu) -> np.ndarray:
+    """Outputs of the first STEPS steps, fmpy on Linux (this machine's Python)."""
+    if case not in _references:
+        _, _, inputs, outputs = CASES[case]
+        run = subprocess.run([sys.executable, str(FMPY_STEPS), str(fmu), str(STEPS), ",".join(inputs),
+                              ",".join(outputs)], capture_output=True, text=True, timeout=300)
+        assert run.returncode == 0, run.stderr[-3000:]
+        _references[case] = parse_steps(run.stdout)
+    return _references[case]
+
+
+def refs_of(fmu):
+    from fmpy import read_model_description
+
+    md = read_model_description(str(fmu))
+    token = md.guid if md.fmiVersion.startswith("2") else md.instantiationToken
+    return token, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def run_c_host(host, fmu, case, folder, scenario="basic"):
+    version, identifier, inputs, outputs = CASES[case]
+    token, refs = refs_of(fmu)
+    vrs = [str(refs[n]) for n in inputs + outputs]
+    return w.wine(host, w.windows_path(folder), identifier, token, scenario, *vrs, timeout=600)
+
+
+def test_the_fmus_carry_a_standalone_win64_binary(fmus):
+    for case, fmu in fmus.items():
+        version, identifier, _, _ = CASES[case]
+        folder = "binaries/win64" if version == 2 else "binaries/x86_64-windows"
+        with zipfile.ZipFile(fmu) as z:
+            names = set(z.namelist())
+            described = z.read("resources/python_runtime.txt").decode()
+        for name in (f"{identifier}.dll", "pythonfmu-export.dll", "python/python311.dll", "python/python3.dll",
+                     "python/python311.zip", "python/vcruntime140.dll", "python/vcruntime140_1.dll",
+                     "python/msvcp140.dll", "python/Lib/site-packages/numpy/__init__.py"):
+            assert f"{folder}/{name}" in names, (case, name)
+        assert f"{folder}/python/python311._pth" not in names          # the layer sets the search path
+        assert "win64_version=3.11.9" in described and "win64_packages=numpy==1.26.4" in described
+
+
+def test_our_layer_needs_only_kernel32_and_msvcrt(fmus, tmp_path):
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    if objdump is None:
+        pytest.skip("binutils-mingw-w64-x86-64 is not installed")
+    for case, fmu in fmus.items():
+        version, identifier, _, _ = CASES[case]
+        folder = "binaries/win64" if version == 2 else "binaries/x86_64-windows"
+        with zipfile.ZipFile(fmu) as z:
+            (tmp_path / "layer.dll").write_bytes(z.read(f"{folder}/{identifier}.dll"))
+        imports = subprocess.run([objdump, "-p", str(tmp_path / "layer.dll")], capture_output=True, text=True).stdout
+        assert sorted(line.split()[-1] for line in imports.splitlines() if "DLL Name" in line) == \
+            ["KERNEL32.dll", "msvcrt.dll"], case
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_our_c_host_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus, hosts, tmp_path):
+    version = CASES[case][0]
+    fmu = fmus[case]
+    expected = reference(case, fmu)
+    folder = w.unpack(fmu, tmp_path / "fmu")
+    for run_index in range(RUNS):  # load, step, roll back, deserialize, free, FreeLibrary, reload, exit
+        run = run_c_host(hosts[version], fmu, case, folder)
+        assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), \
+            f"run {run_index}: exit {run.returncode}\n{run.stdout[-3000:]}{run.stderr[-3000:]}"
+        values, _, _, _ = parse_host_output(run.stdout)
+        for k in range(STEPS):
+            assert values["run"][k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
+            assert values["reload"][k] == values["run"][k]            # a reloaded binary starts afresh
+        for k in range(3, STEPS):
+            assert values["replay"][k] == values["run"][k]            # the state set back repeats the steps
+            assert values["deserialized"][k] == values["run"][k]
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(case, fmus):
+    python = w.windows_python()
+    _, _, inputs, outputs = CASES[case]
+    expected = reference(case, fmus[case])
+    for run_index in range(RUNS):
+        run = w.wine(python, w.windows_path(FMPY_STEPS), w.windows_path(fmus[case]), STEPS, ",".join(inputs),
+                     ",".join(outputs))
+        assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), \
+            f"run {run_index}: exit {run.returncode}\n{run.stdout[-3000:]}{run.stderr[-3000:]}"
+        got = parse_steps(run.stdout)
+        assert got.shape == expected.shape
+        for k in range(STEPS):
+            assert got[k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
+
+
+def test_a_missing_python_library_is_reported_through_the_hosts_logger(fmus, hosts, tmp_path):
+    folder = w.unpack(fmus["bearing2"], tmp_path / "broken")
+    (folder / "binaries" / "win64" / "python" / "python311.dll").unlink()
+    run = run_c_host(hosts[2], fmus["bearing2"], "bearing2", folder)
+    _, _, logs, _ = parse_host_output(run.stdout)
+    assert run.returncode == 1 and "error fmi2Instantiate" in run.stdout, run.stdout + run.stderr  # refused, no crash
+    assert any("the FMU's Python runtime is incomplete" in m and "python311.dll is missing" in m
+               for _, _, m in logs), run.stdout
+
+
+def test_the_win64_half_ignores_the_hosts_python_variables(fmus, hosts, tmp_path):
+    # an isolated start: PYTHONHOME and PYTHONPATH of the host pointing to nonsense change nothing
+    folder = w.unpack(fmus["bearing2"], tmp_path / "isolated")
+    token, refs = refs_of(fmus["bearing2"])
+    vrs = [str(refs[n]) for n in BEARING_INPUTS + BEARING_OUTPUTS]
+    run = w.wine(hosts[2], w.windows_path(folder), "SlewingBearing", token, "basic", *vrs,
+                 env={"PYTHONHOME": "C:\\nowhere", "PYTHONPATH": "C:\\nowhere", "WINEPATH": "C:\\nowhere"})
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+
+
+def test_without_wines_own_cpp_runtime_the_fmu_brings_its_own(fmus, hosts, tmp_path):
+    # wine's builtin msvcp140/vcruntime140 blocked: only the FMU's copies can serve (a Windows machine
+    # without the Visual C++ Redistributable)
+    folder = w.unpack(fmus["bearing3"], tmp_path / "no_vc")
+    token, refs = refs_of(fmus["bearing3"])
+    vrs = [str(refs[n]) for n in BEARING_INPUTS + BEARING_OUTPUTS]
+    run = w.wine(hosts[3], w.windows_path(folder), "SlewingBearing3", token, "basic", *vrs,
+                 env={"WINEDLLOVERRIDES": "mscoree,mshtml=;msvcp140,vcruntime140,vcruntime140_1=n"})
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
