@@ -200,3 +200,66 @@ def test_without_wines_own_cpp_runtime_the_fmu_brings_its_own(fmus, hosts, tmp_p
     run = w.wine(hosts[3], w.windows_path(folder), "SlewingBearing3", token, "basic", *vrs,
                  env={"WINEDLLOVERRIDES": "mscoree,mshtml=;msvcp140,vcruntime140,vcruntime140_1=n"})
     assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+
+
+# ---- fmusim cross-compiled with mingw (tests/win64/build_fmusim.sh) -----------------------------------------
+FMUSIM_SCRIPT = ROOT / "tests" / "win64" / "build_fmusim.sh"
+#: inputs per case for fmusim's CSV, one column each: the values the C host's order leaves (see DRIVE_INPUTS)
+FMUSIM_INPUTS = {"bearing2": BEARING_INPUTS, "bearing3": BEARING_INPUTS, "drive": ["command", "friction_torque",
+                                                                                    "load_moment"]}
+
+
+def fmusim_inputs(case, k):
+    u = [8e3, -3e3, 3e4 + 1e3 * k, 1.5e3, -2.5e3, 0.4 + 0.01 * k, 0.05]
+    return u if case != "drive" else [u[6], u[2], u[4]]
+
+
+@pytest.fixture(scope="module")
+def fmusim():
+    """fmusim.exe, built once per version of the build script and kept in $SLEWING_WINE_DIR. Building it the
+    first time (libxml2, sundials and minizip for mingw from Debian's sources) takes about 5 minutes: in
+    `make test` it is taken only when built already (tests/win64/run_all.sh builds it) or with
+    SLEWING_BUILD_FMUSIM=1."""
+    import hashlib
+
+    if not (ROOT.parent / "shared" / "vendor" / "fmusim-v0.0.39" / "build.sh").exists() \
+            and not os.environ.get("SLEWING_FMUSIM_SOURCE"):
+        pytest.skip("fmusim's source is not at ../shared/vendor/fmusim-v0.0.39")
+    key = hashlib.sha256(FMUSIM_SCRIPT.read_bytes()).hexdigest()[:12]
+    binary = w.WINE_DIR / f"fmusim-{key}.exe"
+    if not binary.exists():
+        if not os.environ.get("SLEWING_BUILD_FMUSIM"):
+            pytest.skip("SKIPPED: fmusim for mingw is not built yet (about 5 minutes): run tests/win64/run_all.sh, "
+                        "or set SLEWING_BUILD_FMUSIM=1")
+        run = subprocess.run(["bash", str(FMUSIM_SCRIPT), str(binary)], capture_output=True, text=True, timeout=3600)
+        assert run.returncode == 0 and binary.exists(), run.stdout[-3000:] + run.stderr[-3000:]
+    return binary
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_fmusim_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus, fmusim, tmp_path):
+    from fmpy import simulate_fmu
+
+    _, _, _, outputs = CASES[case]
+    names = FMUSIM_INPUTS[case]
+    t = np.round(np.arange(21) * 0.01, 10)
+    rows = ["time," + ",".join(names)] + [f"{tk:.2f}," + ",".join(repr(x) for x in fmusim_inputs(case, k))
+                                          for k, tk in enumerate(t)]
+    (tmp_path / "input.csv").write_text("\n".join(rows) + "\n")
+    data = np.zeros(len(t), dtype=[("time", float)] + [(n, float) for n in names])
+    data["time"] = t
+    for i, name in enumerate(names):
+        data[name] = [fmusim_inputs(case, k)[i] for k in range(len(t))]
+    expected = simulate_fmu(str(fmus[case]), stop_time=0.2, step_size=0.01, output_interval=0.01, input=data,
+                            output=outputs)
+    shutil.copy2(fmus[case], tmp_path / "model.fmu")
+    arguments = sum((["--output-variable", n] for n in outputs), [])
+    for run_index in range(RUNS):
+        out = tmp_path / f"out{run_index}.csv"
+        run = w.wine(fmusim, "--interface-type", "cs", "--stop-time", "0.2", "--output-interval", "0.01",
+                     "--input-file", w.windows_path(tmp_path / "input.csv"), *arguments,
+                     "--output-file", w.windows_path(out), w.windows_path(tmp_path / "model.fmu"))
+        assert run.returncode == 0, f"run {run_index}: exit {run.returncode}\n{run.stdout[-2000:]}{run.stderr[-2000:]}"
+        got = np.genfromtxt(out, delimiter=",", names=True)
+        for name in outputs:  # fmusim writes 16 significant digits
+            assert got[name] == pytest.approx(expected[name], rel=REL, abs=1e-300), (run_index, name)
