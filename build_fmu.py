@@ -312,7 +312,9 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
             described.update(floor)
             header = ("# The Python this FMU runs its model in (written by build_fmu.py).\n"
                       + ("# standalone: the runtime in binaries/<platform>/<folder>, found relative to the binary;\n"
-                         "# the machine needs Linux x86-64 with glibc >= the floor below, nothing else.\n"
+                         "# the machine needs Linux x86-64 with glibc >= the floor below, nothing else"
+                         + (", or 64-bit Windows\n# (binaries/win64: Python win64_version with win64_packages and the "
+                            "Visual C++ runtime).\n" if win64 else ".\n")
                          if runtime == "standalone" else
                          f"# host: on a machine where this Python lives elsewhere, set {PYTHON_HOME_VARIABLE} to a\n"
                          "# Python installation or virtual environment with numpy (same minor version).\n"))
@@ -345,7 +347,7 @@ def describe_fmu(fmu) -> str:
     r = runtime_of(fmu)
     floor = f"Linux x86-64 with glibc {r['glibc']} or newer (check: ldd --version)"
     if r.get("runtime") == "standalone":
-        windows = (f" Windows: 64-bit Windows 8.1 or newer, nothing else (it carries Python {r['win64_version']} "
+        windows = (f" Windows: 64-bit Windows 10 or 11 (8.1 with its Universal C Runtime update), nothing else (it carries Python {r['win64_version']} "
                    f"with {r['win64_packages'].replace(' ', ', ')} and the Visual C++ runtime; numpy's loops; "
                    "tested under wine, not on Windows)." if r.get("win64_version") else " No standalone Windows binary.")
         return (f"standalone FMU: it carries Python {r['version']} with {r['packages'].replace(' ', ', ')}; "

@@ -241,7 +241,7 @@ static int load_standalone(const char *binary_dir, const struct runtime_file *rt
     load_runtime_dll(whome, L"msvcp140.dll");
     if (!GetModuleHandleW(L"vcruntime140.dll")) {
         message(err, errsize, "cannot load vcruntime140.dll from the FMU's Python runtime %s (error %lu): the FMU "
-                "needs 64-bit Windows 8.1 or newer (or the Visual C++ 2015-2022 Redistributable, x64).", home,
+                "needs 64-bit Windows 10 or 11, or 8.1 with its Universal C Runtime update.", home,
                 GetLastError());
         return -1;
     }
@@ -252,7 +252,7 @@ static int load_standalone(const char *binary_dir, const struct runtime_file *rt
     HMODULE python = LoadLibraryExW(library, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
     if (!python) {
         message(err, errsize, "cannot load the FMU's Python library python%d%d.dll from %s (Windows error %lu; the "
-                "FMU needs 64-bit Windows 8.1 or newer).", major, m, home, GetLastError());
+                "FMU needs 64-bit Windows 10 or 11, or 8.1 with its Universal C Runtime update).", major, m, home, GetLastError());
         return -1;
     }
     void (*set_home)(const wchar_t *) = (void (*)(const wchar_t *))GetProcAddress(python, "Py_SetPythonHome");
