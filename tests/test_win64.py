@@ -263,3 +263,54 @@ def test_fmusim_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus, fm
         got = np.genfromtxt(out, delimiter=",", names=True)
         for name in outputs:  # fmusim writes 16 significant digits
             assert got[name] == pytest.approx(expected[name], rel=REL, abs=1e-300), (run_index, name)
+
+
+def fmpy_single(fmu, input_name, output_name, values):
+    """Outputs of fmpy on Linux stepping ``fmu`` with one input set to ``values`` in turn (tests/win64/two_fmus.c)."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(fmu))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    folder = extract(str(fmu))
+    try:
+        slave = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
+                          instanceName="single")
+        slave.instantiate()
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        out = []
+        for k, value in enumerate(values):
+            slave.setReal([refs[input_name]], [value])
+            slave.doStep(k * 0.01, 0.01)
+            out.append(slave.getReal([refs[output_name]])[0])
+        slave.terminate()
+        slave.freeInstance()
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    return out
+
+
+@pytest.mark.parametrize("first", ["bearing2", "drive"])
+def test_two_of_our_fmus_in_one_windows_c_process(first, fmus, tmp_path):
+    # the first FMU starts its Python; the second finds it running and uses it (its own folders appended)
+    program = w.mingw(tmp_path / "two_fmus.exe", [ROOT / "tests" / "win64" / "two_fmus.c"])
+    signals = {"bearing2": ("Fz", "z", 3e4, 1e3), "drive": ("command", "psi", 0.0, 0.01)}  # input, output, base, step
+    order = [first, "drive" if first == "bearing2" else "bearing2"]
+    arguments = []
+    for case in order:
+        _, identifier, _, _ = CASES[case]
+        token, refs = refs_of(fmus[case])
+        folder = w.unpack(fmus[case], tmp_path / case)
+        name_in, name_out, base, step = signals[case]
+        arguments += [w.windows_path(folder), identifier, token, str(refs[name_in]), str(refs[name_out]), repr(base),
+                      repr(step)]
+    run = w.wine(program, *arguments)
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+    rows = {(line.split()[0], int(line.split()[1])): float(line.split()[2]) for line in run.stdout.splitlines()
+            if line[:2] in ("a ", "b ")}
+    for label, case in zip("ab", order):
+        name_in, name_out, base, step = signals[case]
+        expected = fmpy_single(fmus[case], name_in, name_out, [base + step * k for k in range(4)])
+        assert [rows[label, k] for k in range(4)] == pytest.approx(expected, rel=REL, abs=1e-300), case
