@@ -314,3 +314,35 @@ def test_two_of_our_fmus_in_one_windows_c_process(first, fmus, tmp_path):
         name_in, name_out, base, step = signals[case]
         expected = fmpy_single(fmus[case], name_in, name_out, [base + step * k for k in range(4)])
         assert [rows[label, k] for k in range(4)] == pytest.approx(expected, rel=REL, abs=1e-300), case
+
+
+def test_the_ssps_four_fmus_carry_win64_and_run_together_in_fmpy_on_windows(table3_fmu, drive_fmu, tmp_path):
+    # the pitch system SSP of test_ssp.py (bearing, drive, two time tables), built as build_ssp.py builds it:
+    # every FMU carries its win64 binary; fmpy's simulate_ssp on the embeddable Windows Python runs all four
+    # in one process (the first starts the FMU's Python only where the host has none: here the host's is used)
+    sys.path.insert(0, str(ROOT / "examples" / "ssp"))
+    from build_ssp import build_ssp, step_command
+    from slewing_drives import LoadSeries
+    from ssp_hosts import COMPARED, run_fmpy
+
+    shipped = LoadSeries.read_csv(ROOT / "examples/loads/blade_root_loads.csv")
+    loads = LoadSeries(shipped.time, shipped.loads * np.array([0.02, 0.02, 0.02, 0.001, 0.001, 0.1]))
+    stop, dt = 0.3, 0.01
+    ssp = build_ssp(tmp_path / "pitch_system.ssp", table3_fmu, drive_fmu, loads, step_command(5.0, 0.1, 0.9),
+                    bearing_parameters={"load_frame": 2, "ring_model": 1, "preload": 10e-6}, stop_time=stop,
+                    step_size=dt)
+    with zipfile.ZipFile(ssp) as z:
+        for name in ("loads", "command", "drive", "bearing"):
+            (tmp_path / f"{name}.fmu").write_bytes(z.read(f"resources/{name}.fmu"))
+            with zipfile.ZipFile(tmp_path / f"{name}.fmu") as fmu:
+                names = fmu.namelist()
+            assert any(n.startswith("binaries/win64/python/python311.dll") for n in names), name
+            assert any(n.startswith("binaries/linux64/python/") for n in names), name
+    expected = run_fmpy(ssp, list(COMPARED), stop_time=stop, step_size=dt)
+    run = w.wine(w.windows_python(), w.windows_path(ROOT / "tests" / "win64" / "ssp_run.py"), w.windows_path(ssp),
+                 stop, dt)
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+    got = {line.split()[0]: np.array([float(v) for v in line.split()[1:]]) for line in run.stdout.splitlines()
+           if line.split() and line.split()[0] in ("time", *COMPARED)}
+    for name in ("time", *COMPARED):
+        assert got[name] == pytest.approx(np.asarray(expected[name]), rel=REL, abs=1e-12), name
