@@ -20,7 +20,8 @@
  *
  * A process that already runs a Python (fmpy on Windows, or a second FMU of ours) keeps it: where
  * it is of the FMU's version, the FMU's standard library and site-packages are appended to
- * sys.path, as on Linux. It needs only KERNEL32 and msvcrt; the messages name what is missing.
+ * sys.path, as on Linux. It needs only KERNEL32 and msvcrt; the messages name what is missing. At
+ * FreeLibrary (not at the process's exit) pythonfmu's interpreter holder is emptied (DllMain below).
  */
 #include "shim_platform.h"
 #include "python_runtime.h"
@@ -348,9 +349,14 @@ int python_runtime_load(const char *binary_dir, char *err, size_t errsize)
     return status;
 }
 
-/* At exit (this DLL's atexit list runs when it is detached: at the process's exit, or when the
- * host unloads it) pythonfmu's hold on the interpreter is released while its DLL is still
- * there, as on Linux: its static holder then finds nothing to tear down. */
+/* When the host unloads this DLL (FreeLibrary) while the process goes on, pythonfmu's hold on the
+ * interpreter is released while pythonfmu's DLL is still loaded (this DLL holds it), as on Linux.
+ *
+ * Not at the process's exit: Windows then detaches the DLLs in the reverse order of their
+ * initialisation, so pythonfmu's DLL (loaded after this one) has already destroyed its static
+ * holder, and emptying it again would write into freed memory (the fault the Linux layer avoids by
+ * running first). pythonfmu's own teardown is in order by itself there: its DLL_PROCESS_DETACH
+ * empties the holder before its static destructors run, or its static destructor releases it. */
 static void release_binary(void)
 {
     AcquireSRWLockExclusive(&lock);
@@ -377,8 +383,6 @@ void *python_runtime_open_binary(const char *binary_dir, const char *name, char 
             binary_handle = LoadLibraryExW(wpath, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
             if (!binary_handle)
                 message(err, errsize, "cannot load %s (Windows error %lu)", path, GetLastError());
-            else
-                atexit(release_binary);
         }
     }
     void *handle = binary_handle;
@@ -400,4 +404,13 @@ void *python_runtime_start(const void *symbol, const char *name, char *err, size
 int python_runtime_binary_open(void)
 {
     return binary_handle != NULL;
+}
+
+/* reserved is NULL for FreeLibrary, non-NULL at the process's exit (see release_binary) */
+BOOL WINAPI DllMain(HINSTANCE instance, DWORD reason, LPVOID reserved)
+{
+    (void)instance;
+    if (reason == DLL_PROCESS_DETACH && reserved == NULL)
+        release_binary();
+    return TRUE;
 }
