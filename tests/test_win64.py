@@ -346,3 +346,11 @@ def test_the_ssps_four_fmus_carry_win64_and_run_together_in_fmpy_on_windows(tabl
            if line.split() and line.split()[0] in ("time", *COMPARED)}
     for name in ("time", *COMPARED):
         assert got[name] == pytest.approx(np.asarray(expected[name]), rel=REL, abs=1e-12), name
+
+
+def test_a_non_ascii_folder_is_refused_with_a_message_not_a_crash(fmus, hosts, tmp_path):
+    # a known limit of pythonfmu's Windows DLL (docs/standalone_fmu.md): the instantiation fails, the host goes on
+    folder = w.unpack(fmus["bearing2"], tmp_path / "Lager für")
+    run = run_c_host(hosts[2], fmus["bearing2"], "bearing2", folder)
+    assert run.returncode == 1 and "error fmi2Instantiate" in run.stdout, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "Unhandled" not in run.stderr
