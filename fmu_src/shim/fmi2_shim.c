@@ -244,6 +244,13 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     if (!functions || !instanceName)
         return NULL;
     char err[2048] = "";
+#ifdef _WIN32
+    if (python_runtime_check_location(fmuResourceLocation, err, sizeof err) != 0) {
+        if (functions->logger)
+            functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError", "%s", err);
+        return NULL;
+    }
+#endif
     if (load_inner(err, sizeof err) != 0) {
         if (functions->logger)
             functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError", "%s", err);

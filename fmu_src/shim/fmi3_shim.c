@@ -156,6 +156,13 @@ FMI3_FORWARDED(FORWARD)
 
 FMI3_Export const char *fmi3GetVersion(void) { return fmi3Version; }
 
+/* Windows: a resource folder pythonfmu3's DLL cannot use is refused with a message (python_runtime.h) */
+#ifdef _WIN32
+#define LOCATION_REFUSED(path) (python_runtime_check_location((path), err, sizeof err) != 0)
+#else
+#define LOCATION_REFUSED(path) 0
+#endif
+
 static void report(fmi3InstanceEnvironment environment, fmi3LogMessageCallback log, const char *err)
 {
     if (log)
@@ -172,7 +179,7 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
     fmi3IntermediateUpdateCallback intermediateUpdate)
 {
     char err[2048] = "";
-    if (load_inner(err, sizeof err) != 0) {
+    if (LOCATION_REFUSED(resourcePath) || load_inner(err, sizeof err) != 0) {
         report(instanceEnvironment, logMessage, err);
         return NULL;
     }
@@ -188,7 +195,7 @@ FMI3_Export fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, f
                                                       fmi3LogMessageCallback logMessage)
 {
     char err[2048] = "";
-    if (load_inner(err, sizeof err) != 0) {
+    if (LOCATION_REFUSED(resourcePath) || load_inner(err, sizeof err) != 0) {
         report(instanceEnvironment, logMessage, err);
         return NULL;
     }
@@ -203,7 +210,7 @@ FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(
     fmi3UnlockPreemptionCallback unlockPreemption)
 {
     char err[2048] = "";
-    if (load_inner(err, sizeof err) != 0) {
+    if (LOCATION_REFUSED(resourcePath) || load_inner(err, sizeof err) != 0) {
         report(instanceEnvironment, logMessage, err);
         return NULL;
     }

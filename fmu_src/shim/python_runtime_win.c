@@ -31,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <wchar.h>
+#include <ctype.h>
 
 #define WPATH 4096
 
@@ -404,6 +405,23 @@ void *python_runtime_start(const void *symbol, const char *name, char *err, size
 int python_runtime_binary_open(void)
 {
     return binary_handle != NULL;
+}
+
+int python_runtime_check_location(const char *location, char *err, size_t errsize)
+{
+    if (!location)
+        return 0;
+    for (const unsigned char *p = (const unsigned char *)location; *p; p++) {
+        int escaped = p[0] == '%' && p[1] && p[2] && strchr("89abcdefABCDEF", p[1]) && isxdigit(p[2]);
+        if (*p >= 0x80 || escaped) {
+            message(err, errsize, "the FMU is unpacked in a folder whose path has a character beyond ASCII (%s): "
+                    "pythonfmu's Windows DLL, which this FMU runs on, cannot use it and would fail or crash. Unpack "
+                    "the FMU in a folder with an ASCII path (letters A-Z, digits, spaces, - and _), or set the "
+                    "host's temporary folder to one.", location);
+            return -1;
+        }
+    }
+    return 0;
 }
 
 /* reserved is NULL for FreeLibrary, non-NULL at the process's exit (see release_binary) */
