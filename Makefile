@@ -12,7 +12,10 @@ STAMP  := $(VENV)/.installed
 #   libtbb12: the ecos C++ co-simulation host of the FMU tests
 #   debootstrap: bare Debian systems without Python, where the tests run the standalone FMUs
 #   libxml2-dev libminizip-dev libsundials-dev zlib1g-dev: fmusim (built from ../shared/vendor), an independent FMI host
-DEBIAN_PACKAGES := gcc libc6-dev binutils libtbb12 debootstrap libxml2-dev libminizip-dev libsundials-dev zlib1g-dev
+#   gcc-mingw-w64-x86-64: build_fmu.py cross-compiles the FMU's standalone Windows binary (build_win64.py)
+#   wine wine64: tests/test_win64.py runs the win64 binary in Windows hosts (our C host, fmpy, fmusim)
+DEBIAN_PACKAGES := gcc libc6-dev binutils libtbb12 debootstrap libxml2-dev libminizip-dev libsundials-dev zlib1g-dev \
+                   gcc-mingw-w64-x86-64 wine wine64
 
 $(STAMP): pyproject.toml
 	@missing=$$(for p in $(DEBIAN_PACKAGES); do \
@@ -22,7 +25,8 @@ $(STAMP): pyproject.toml
 	    echo "installing Debian packages:" $$missing; \
 	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
 	  else echo "note: Debian packages missing and not root, so not installed:" $$missing; \
-	    echo "      (without gcc building the FMU fails; the tests that need the others are skipped, saying why)"; fi; \
+	    echo "      (without gcc building the FMU fails, without gcc-mingw-w64-x86-64 it needs --no-win64;"; \
+	    echo "       the tests that need the others are skipped, saying why)"; fi; \
 	fi
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip

@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT))
 from build_fmu import install_python_shim  # noqa: E402  (the FMU's Linux layer: no LD_PRELOAD in C hosts)
 
 
-def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5) -> Path:
+def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5, win64: bool = True) -> Path:
     """Build the FMU of ``drive_file`` (``examples/drives/*.toml``); returns the path of the ``.fmu``.
 
     Parameters
@@ -37,6 +37,8 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5) ->
         Motor torque per ampere, for the FMU's ``motor_current`` output only (the drive
         definitions have none; 1.5 N m/A is an illustrative servo-motor value). A tunable
         parameter of the FMU.
+    win64 : bool
+        Also carry the standalone Windows binary (default; ``build_win64.py``).
     """
     from pythonfmu import FmuBuilder
 
@@ -58,11 +60,12 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5) ->
                                      project_files=[package, tmp / "drive.json"],
                                      canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                                      needsExecutionTool=True, canHandleVariableCommunicationStepSize=True)
-    install_python_shim(built, "SlewingDrive")     # runs in C hosts without LD_PRELOAD (see build_fmu.py)
+    install_python_shim(built, "SlewingDrive", win64=win64)  # runs in C hosts without LD_PRELOAD (see build_fmu.py)
     return Path(built)
 
 
-def build_table_fmu(output, name: str, time, columns, values, *, interpolation: str = "linear") -> Path:
+def build_table_fmu(output, name: str, time, columns, values, *, interpolation: str = "linear",
+                    win64: bool = True) -> Path:
     """Build a time-table FMU (``fmu_src/TimeTable.py``); returns the path of the ``.fmu``.
 
     Parameters
@@ -77,6 +80,8 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
     values : array-like (len(time), len(columns))
     interpolation : {"linear", "previous"}
         Linear between rows, or each row's value held until the next row (a step table).
+    win64 : bool
+        Also carry the standalone Windows binary (default; ``build_win64.py``).
     """
     import numpy as np
     from pythonfmu import FmuBuilder
@@ -99,7 +104,7 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
         built = FmuBuilder.build_FMU(ROOT / "fmu_src" / "TimeTable.py", dest=output, project_files=[tmp / "table.json"],
                                      canGetAndSetFMUstate=True, canSerializeFMUstate=True, needsExecutionTool=True,
                                      canHandleVariableCommunicationStepSize=True)
-    install_python_shim(built, "TimeTable")
+    install_python_shim(built, "TimeTable", win64=win64)
     return Path(built)
 
 
@@ -109,8 +114,10 @@ def main(argv=None) -> int:
     parser.add_argument("-o", "--output", help="FMU file to write")
     parser.add_argument("--torque-constant", type=float, default=1.5, metavar="N.m/A",
                         help="motor torque constant, for the motor_current output (default 1.5)")
+    parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
+                        help="carry a standalone Windows (win64) binary (default: yes)")
     args = parser.parse_args(argv)
-    print(f"wrote {build_drive_fmu(args.drive, args.output, torque_constant=args.torque_constant)}")
+    print(f"wrote {build_drive_fmu(args.drive, args.output, torque_constant=args.torque_constant, win64=args.win64)}")
     return 0
 
 

@@ -40,7 +40,7 @@ from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
-              runtime="standalone", numba=None, stage=None) -> Path:
+              runtime="standalone", numba=None, win64=True, stage=None) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -63,6 +63,9 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     numba : bool, optional
         Carry numba and the compiled loops (steps about 4 times faster, the FMU about 4 times
         larger: 87 MB against 22 MB for the pitch bearing). Default: where numba is installed here.
+    win64 : bool
+        Also carry a standalone Windows binary (``binaries/win64``, FMI 3.0 ``binaries/x86_64-windows``:
+        :mod:`build_win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops.
     stage : callable, optional
         Called with one line as each stage of the build begins (e.g. ``print``): the build is
         silent for minutes otherwise on a fresh machine (the superelement, numba's compilation).
@@ -106,7 +109,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                 needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
             )
-    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, stage=say)
+    install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64,
+                        stage=say)
     if numba:
         say("compiling the loops with numba for this CPU and for any x86-64 CPU (about two minutes the "
             "first time on a machine, then read from numba's cache) ...")
@@ -262,7 +266,7 @@ def python_runtime() -> dict[str, str]:
             "environment": sys.prefix}
 
 
-def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False,
+def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False, win64=True,
                         stage=None) -> dict:
     """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
     for a standalone FMU the Python runtime beside it.
@@ -271,15 +275,21 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
     identifier's name and starts the Python that ``resources/python_runtime.txt`` (written here)
     describes before it: the runtime the FMU carries (``binaries/<platform>/python``,
     :mod:`build_runtime`), or for ``runtime="host"`` the building Python. The file also states the
-    FMU's glibc floor: the newest glibc version any of its Linux binaries needs. The Windows
-    binary is left as pythonfmu wrote it. Returns what the file says, as a dict. ``stage``, where
-    given, is called with one line as each stage begins (as in :func:`build_fmu`)."""
+    FMU's glibc floor: the newest glibc version any of its Linux binaries needs.
+
+    With ``win64`` (the default) a standalone FMU also gets a standalone Windows binary
+    (:mod:`build_win64`: our layer cross-compiled with mingw-w64 in front of pythonfmu's DLL, the
+    embeddable CPython with numpy beside it); the file then also says ``win64_version``,
+    ``win64_library`` and ``win64_packages``. Otherwise, and for ``runtime="host"``, the Windows
+    binary is left as pythonfmu wrote it (a tool coupling DLL). Returns what the file says, as a dict.
+    ``stage``, where given, is called with one line as each stage begins (as in :func:`build_fmu`)."""
     say = stage or (lambda line: None)
     if runtime not in RUNTIMES:
         raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
     fmu = Path(fmu)
     folder = LINUX_BINARIES[fmi_version]
     binary = f"{folder}/{model_identifier}.so"
+    win64 = bool(win64) and runtime == "standalone"
     with tempfile.TemporaryDirectory(prefix="slewing_shim_") as tmp:
         tmp = Path(tmp)
         say("compiling the FMU's Linux binary (C compiler) ...")
@@ -297,10 +307,21 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                 say(f"staging the FMU's Python runtime (the interpreter, its standard library, numpy"
                     f"{', numba' if numba else ''}; read from its cache when staged before) ...")
                 carried = bundled_runtime(folder, numba=numba)
-                shutil.copy2(carried.archive, rewritten)        # the runtime's entries, compressed once
                 described = {"runtime": "standalone", "folder": "python", "library": carried.library,
                              "version": carried.python,
                              "packages": " ".join(f"{k}=={v}" for k, v in carried.packages.items())}
+                base = carried.archive
+                if win64:
+                    import build_win64
+
+                    say("adding the Windows (win64) binary: our layer cross-compiled with mingw-w64, the "
+                        "embeddable CPython and numpy (read from its cache when staged before) ...")
+                    with zipfile.ZipFile(fmu) as stock:
+                        windows = build_win64.windows_entries(stock, model_identifier, fmi_version, tmp)
+                    base, win = build_win64.merged_archive(carried.archive, fmi_version)
+                    described.update({"platforms": "linux64 win64", "win64_version": win["version"],
+                                      "win64_library": win["library"], "win64_packages": win["packages"]})
+                shutil.copy2(base, rewritten)        # the runtimes' entries, compressed once
                 floor = {"glibc": carried.glibc, "glibcxx": carried.glibcxx}
             else:
                 described = {"runtime": "host", **python_runtime()}
@@ -310,7 +331,9 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
             described.update(floor)
             header = ("# The Python this FMU runs its model in (written by build_fmu.py).\n"
                       + ("# standalone: the runtime in binaries/<platform>/<folder>, found relative to the binary;\n"
-                         "# the machine needs Linux x86-64 with glibc >= the floor below, nothing else.\n"
+                         "# the machine needs Linux x86-64 with glibc >= the floor below, nothing else"
+                         + (", or 64-bit Windows\n# (binaries/win64: Python win64_version with win64_packages and the "
+                            "Visual C++ runtime).\n" if win64 else ".\n")
                          if runtime == "standalone" else
                          f"# host: on a machine where this Python lives elsewhere, set {PYTHON_HOME_VARIABLE} to a\n"
                          "# Python installation or virtual environment with numpy (same minor version).\n"))
@@ -318,9 +341,13 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                 for info in src.infolist():
                     if info.filename == binary:
                         dst.write(inner, f"{folder}/{INNER_BINARY}")
+                    elif win64 and info.filename in windows:
+                        continue                          # pythonfmu's DLL: written below, behind our layer
                     elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
                         dst.writestr(info, src.read(info.filename))
                 dst.write(shim, binary)
+                for name, path in (windows.items() if win64 else ()):
+                    dst.write(path, name)
                 dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}",
                              header + "".join(f"{k}={v}\n" for k, v in described.items()))
         shutil.move(str(rewritten), fmu)
@@ -339,8 +366,11 @@ def describe_fmu(fmu) -> str:
     r = runtime_of(fmu)
     floor = f"Linux x86-64 with glibc {r['glibc']} or newer (check: ldd --version)"
     if r.get("runtime") == "standalone":
+        windows = (f" Windows: 64-bit Windows 10 or 11 (8.1 with its Universal C Runtime update), nothing else (it carries Python {r['win64_version']} "
+                   f"with {r['win64_packages'].replace(' ', ', ')} and the Visual C++ runtime; numpy's loops; "
+                   "tested under wine, not on Windows)." if r.get("win64_version") else " No standalone Windows binary.")
         return (f"standalone FMU: it carries Python {r['version']} with {r['packages'].replace(' ', ', ')}; "
-                f"the target needs {floor}, and no Python.")
+                f"the target needs {floor}, and no Python.{windows}")
     return (f"host FMU: it runs in Python {r['version']} with numpy, at {r['environment']} or where "
             f"{PYTHON_HOME_VARIABLE} names one; the target needs that and {floor}.")
 
@@ -359,6 +389,9 @@ def main(argv=None) -> int:
     parser.add_argument("--numba", action=argparse.BooleanOptionalAction, default=None,
                         help="carry numba and the compiled loops: steps about 4x faster, the FMU about 4x larger "
                              "(default: yes where numba is installed here)")
+    parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
+                        help="carry a standalone Windows (win64) binary beside the Linux one, built here with "
+                             "mingw-w64 from PyPI's embeddable CPython and numpy (default: yes; --no-win64 leaves it out)")
     parser.add_argument("--host-env", action="store_true",
                         help="only print the Python an FMU built here needs (C/C++ hosts need no environment)")
     args = parser.parse_args(argv)
@@ -373,7 +406,7 @@ def main(argv=None) -> int:
     if args.bearing is None:
         parser.error("the bearing definition is required")
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
-                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba,
+                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba, win64=args.win64,
                      stage=lambda line: print(line, flush=True))
     print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")
     print(describe_fmu(path))

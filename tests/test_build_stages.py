@@ -17,13 +17,13 @@ def _stages(lines):
     """The stage each line names, by its first words."""
     names = {"building the ring superelement": "superelement", "packaging the FMU": "package",
              "compiling the FMU's Linux binary": "binary", "staging the FMU's Python runtime": "runtime",
-             "compiling the loops with numba": "numba"}
+             "compiling the loops with numba": "numba", "adding the Windows (win64) binary": "win64"}
     return [next((v for k, v in names.items() if line.startswith(k)), line) for line in lines]
 
 
 @pytest.mark.parametrize("runtime, expected", [
     ("host", ["superelement", "package", "binary"]),
-    ("standalone", ["superelement", "package", "binary", "runtime"]),
+    ("standalone", ["superelement", "package", "binary", "runtime", "win64"]),
 ])
 def test_build_names_each_stage_as_it_begins(tmp_path, runtime, expected):
     from build_fmu import build_fmu

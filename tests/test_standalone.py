@@ -406,12 +406,16 @@ def building_paths() -> set[str]:
 
 
 def assert_no_building_paths(fmu):
+    """No file of ``fmu`` (the Linux and the win64 binaries and runtimes alike) holds a path of this machine,
+    as UTF-8 or as the UTF-16 of Windows files, nor in the form wine gives it (Z:\\...)."""
     paths = building_paths()
     with zipfile.ZipFile(fmu) as z:
         for name in z.namelist():
             data = z.read(name)
             for path in paths:
-                assert path.encode() not in data, f"{fmu}: {name} holds {path}"
+                windows = "Z:" + path.replace("/", "\\")
+                for form in (path.encode(), path.encode("utf-16-le"), windows.encode(), windows.encode("utf-16-le")):
+                    assert form not in data, f"{fmu}: {name} holds {path}"
 
 
 @pytest.fixture(scope="module")
@@ -427,6 +431,8 @@ def test_no_file_inside_the_standalone_fmus_holds_a_path_of_the_building_machine
                                                                                  table_fmu):
     for fmu in (*standalone.values(), pitch_drive_fmu, table_fmu):
         assert runtime_of(fmu)["runtime"] == "standalone"
+        with zipfile.ZipFile(fmu) as z:  # the check covers the win64 binary and runtime too (build_win64.py)
+            assert any(n.startswith(("binaries/win64/python/", "binaries/x86_64-windows/python/")) for n in z.namelist())
         assert_no_building_paths(fmu)
 
 
@@ -455,3 +461,9 @@ def test_the_path_check_finds_a_path_written_into_an_fmu(standalone, tmp_path):
         z.writestr("resources/planted.txt", f"built in {ROOT}\n")
     with pytest.raises(AssertionError, match="planted.txt holds"):
         assert_no_building_paths(planted)
+    planted_wide = tmp_path / "planted_wide.fmu"          # and a Windows file's UTF-16 string
+    shutil.copy2(standalone[3], planted_wide)
+    with zipfile.ZipFile(planted_wide, "a") as z:
+        z.writestr("binaries/x86_64-windows/planted.dll", f"built in {ROOT}".encode("utf-16-le"))
+    with pytest.raises(AssertionError, match="planted.dll holds"):
+        assert_no_building_paths(planted_wide)

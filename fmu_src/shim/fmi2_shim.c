@@ -1,7 +1,8 @@
 /* The FMI 2.0 binary of the slewing bearing FMU on Linux: a thin layer in front of pythonfmu's.
  *
  * build_fmu.py compiles this file as binaries/linux64/<modelIdentifier>.so and moves
- * pythonfmu's binary beside it as pythonfmu-export.so. Every fmi2 function is forwarded to
+ * pythonfmu's binary beside it as pythonfmu-export.so; build_win64.py compiles it with mingw-w64 as
+ * binaries/win64/<modelIdentifier>.dll, with python_runtime_win.c, beside pythonfmu-export.dll. Every fmi2 function is forwarded to
  * pythonfmu's; this layer adds three things:
  *
  * 1. Python. Before pythonfmu's binary is loaded, python_runtime_load() makes the Python
@@ -25,20 +26,17 @@
  *
  * Our own declarations of the FMI 2.0 types (the standard's ABI, fmi2TypesPlatform "default").
  */
-#define _GNU_SOURCE
-#include "glibc_compat.h"
+#include "shim_platform.h"  /* first: glibc_compat.h on Linux, windows.h on Windows */
 #include "python_runtime.h"
 
-#include <dlfcn.h>
 #include <limits.h>
-#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define EXPORT __attribute__((visibility("default")))
-#define INNER_BINARY "pythonfmu-export.so"
+#define EXPORT SHIM_EXPORT
+#define INNER_BINARY SHIM_INNER_BINARY
 
 typedef void *fmi2Component;
 typedef void *fmi2ComponentEnvironment;
@@ -229,6 +227,7 @@ static fmi2Status finish(Instance *in, fmi2Status status, int discard_allowed)
     return status;
 }
 
+#undef IN  /* windows.h defines IN as nothing */
 #define IN ((Instance *)c)
 /* pythonfmu's binary is released at exit (python_runtime.c): a host that frees instances later
  * (from a static destructor) gets fmi2Error instead of a call into a torn-down binary */
@@ -245,6 +244,13 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     if (!functions || !instanceName)
         return NULL;
     char err[2048] = "";
+#ifdef _WIN32
+    if (python_runtime_check_location(fmuResourceLocation, err, sizeof err) != 0) {
+        if (functions->logger)
+            functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError", "%s", err);
+        return NULL;
+    }
+#endif
     if (load_inner(err, sizeof err) != 0) {
         if (functions->logger)
             functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError", "%s", err);

@@ -1,7 +1,8 @@
 /* The FMI 3.0 binary of our FMUs on Linux: a thin layer in front of pythonfmu3's.
  *
  * build_fmu.py compiles this file as binaries/x86_64-linux/<modelIdentifier>.so and moves
- * pythonfmu3's binary beside it as pythonfmu-export.so. It adds what the FMI 2.0 layer
+ * pythonfmu3's binary beside it as pythonfmu-export.so (build_win64.py: binaries/x86_64-windows/
+ * <modelIdentifier>.dll with python_runtime_win.c, beside pythonfmu-export.dll). It adds what the FMI 2.0 layer
  * (fmi2_shim.c) adds for Python, and forwards every fmi3 function unchanged:
  *
  * 1. Python. Before pythonfmu3's binary is loaded, python_runtime_load() starts the Python the
@@ -16,20 +17,17 @@
  *
  * The instance pointer is pythonfmu3's own: no state of ours per instance.
  */
-#define _GNU_SOURCE
-#include "glibc_compat.h"
+#include "shim_platform.h"  /* first: glibc_compat.h on Linux, windows.h on Windows */
 #include "python_runtime.h"
 
-#include <dlfcn.h>
 #include <limits.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
-#define FMI3_Export __attribute__((visibility("default")))
+#define FMI3_Export SHIM_EXPORT
 #include "fmi3/fmi3Functions.h"
 
-#define INNER_BINARY "pythonfmu-export.so"
+#define INNER_BINARY SHIM_INNER_BINARY
 
 /* The functions forwarded as they are: X(name, (parameters), (arguments)). */
 #define FMI3_FORWARDED(X) \
@@ -158,6 +156,13 @@ FMI3_FORWARDED(FORWARD)
 
 FMI3_Export const char *fmi3GetVersion(void) { return fmi3Version; }
 
+/* Windows: a resource folder pythonfmu3's DLL cannot use is refused with a message (python_runtime.h) */
+#ifdef _WIN32
+#define LOCATION_REFUSED(path) (python_runtime_check_location((path), err, sizeof err) != 0)
+#else
+#define LOCATION_REFUSED(path) 0
+#endif
+
 static void report(fmi3InstanceEnvironment environment, fmi3LogMessageCallback log, const char *err)
 {
     if (log)
@@ -174,7 +179,7 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
     fmi3IntermediateUpdateCallback intermediateUpdate)
 {
     char err[2048] = "";
-    if (load_inner(err, sizeof err) != 0) {
+    if (LOCATION_REFUSED(resourcePath) || load_inner(err, sizeof err) != 0) {
         report(instanceEnvironment, logMessage, err);
         return NULL;
     }
@@ -190,7 +195,7 @@ FMI3_Export fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, f
                                                       fmi3LogMessageCallback logMessage)
 {
     char err[2048] = "";
-    if (load_inner(err, sizeof err) != 0) {
+    if (LOCATION_REFUSED(resourcePath) || load_inner(err, sizeof err) != 0) {
         report(instanceEnvironment, logMessage, err);
         return NULL;
     }
@@ -205,7 +210,7 @@ FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(
     fmi3UnlockPreemptionCallback unlockPreemption)
 {
     char err[2048] = "";
-    if (load_inner(err, sizeof err) != 0) {
+    if (LOCATION_REFUSED(resourcePath) || load_inner(err, sizeof err) != 0) {
         report(instanceEnvironment, logMessage, err);
         return NULL;
     }

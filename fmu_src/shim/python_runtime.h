@@ -45,4 +45,11 @@ void *python_runtime_start(const void *symbol, const char *name, char *err, size
 /* 1 while that binary may be called: not after it was released at exit. */
 int python_runtime_binary_open(void);
 
+#ifdef _WIN32
+/* Windows: 0 where pythonfmu's DLL can use the resource location, -1 with a message where it holds a
+ * character beyond ASCII (raw or percent-encoded): pythonfmu's Windows DLL reads the path both as
+ * UTF-8 and in the ANSI code page, and fails or crashes the host with such a folder. */
+int python_runtime_check_location(const char *location, char *err, size_t errsize);
+#endif
+
 #endif

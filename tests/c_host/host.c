@@ -3,7 +3,8 @@
  *   host FMU_DIR MODEL_IDENTIFIER GUID SCENARIO VR... [CYCLES]
  *
  * Compiled as is it is an FMI 2.0 host; with -DFMI3 an FMI 3.0 host (GUID is then the
- * instantiation token, VR the Float64 scalars' value references). With tests/c_host/start.c
+ * instantiation token, VR the Float64 scalars' value references). Cross-compiled with mingw-w64
+ * it is a Windows host of the FMU's win64 binary (LoadLibrary; FMU_DIR a Windows path). With tests/c_host/start.c
  * and -nostartfiles it starts on any x86-64 glibc (see there).
  *
  * FMU_DIR is the unzipped FMU; VR are the value references of the inputs
@@ -22,7 +23,30 @@
  * prints "instantiate <s>" for loading, instantiation and initialisation, then "step <k> <s>"
  * for each set-inputs, doStep, get-outputs: benchmarks/bench_fmu_runtime.py).
  */
+#ifdef _WIN32
+/* Windows (cross-compiled with mingw-w64, tests/test_win64.py): LoadLibrary for dlopen */
+#define WIN32_LEAN_AND_MEAN
+#include <windows.h>
+#include <stdio.h>
+#define RTLD_NOW 0
+#define RTLD_LOCAL 0
+#define dlopen(path, flags) ((void *)LoadLibraryExA((path), NULL, LOAD_WITH_ALTERED_SEARCH_PATH))
+#define dlsym(handle, name) ((void *)GetProcAddress((HMODULE)(handle), (name)))
+#define dlclose(handle) (FreeLibrary((HMODULE)(handle)) ? 0 : -1)
+static const char *dlerror(void)
+{
+    static char text[64];
+    snprintf(text, sizeof text, "Windows error %lu", (unsigned long)GetLastError());
+    return text;
+}
+#ifndef PATH_MAX
+#define PATH_MAX 4096
+#endif
+#define BINARY_SUFFIX ".dll"
+#else
 #include <dlfcn.h>
+#define BINARY_SUFFIX ".so"
+#endif
 #include <limits.h>
 #include <stdbool.h>
 #include <math.h>
@@ -38,7 +62,11 @@ typedef unsigned int fmi2ValueReference;
 typedef int fmi2Status; /* 0 OK, 1 Warning, 2 Discard, 3 Error, 4 Fatal (FMI 3.0: the same numbers) */
 
 #ifndef FMI3
+#ifdef _WIN32
+#define PLATFORM "win64"
+#else
 #define PLATFORM "linux64"
+#endif
 typedef struct {
     void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
     void *(*allocateMemory)(size_t, size_t);
@@ -68,7 +96,11 @@ typedef struct {
     fmi2Status (*getRealStatus)(fmi2Component, int, double *);
 } Fmu;
 #else
+#ifdef _WIN32
+#define PLATFORM "x86_64-windows"
+#else
 #define PLATFORM "x86_64-linux"
+#endif
 typedef struct {
     void *handle;
     fmi2Component (*instantiate)(const char *, const char *, const char *, bool, bool, bool, bool,
@@ -405,6 +437,12 @@ static void stress(int cycles)
 #ifndef FMI3
 static double now(void)
 {
+#ifdef _WIN32
+    LARGE_INTEGER count, frequency;
+    QueryPerformanceCounter(&count);
+    QueryPerformanceFrequency(&frequency);
+    return (double)count.QuadPart / (double)frequency.QuadPart;
+#endif
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return t.tv_sec + 1e-9 * t.tv_nsec;
@@ -448,8 +486,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: host FMU_DIR MODEL_IDENTIFIER GUID SCENARIO VR_INPUTS(7) VR_OUTPUTS... [--cycles N]\n");
         return 2;
     }
-    snprintf(binary, sizeof binary, "%s/binaries/" PLATFORM "/%s.so", argv[1], argv[2]);
-#ifndef FMI3
+    snprintf(binary, sizeof binary, "%s/binaries/" PLATFORM "/%s" BINARY_SUFFIX, argv[1], argv[2]);
+#if defined(_WIN32) && !defined(FMI3)
+    {   /* FMI 2.0 on Windows: file:///C:/folder/resources */
+        char uri_path[PATH_MAX];
+        snprintf(uri_path, sizeof uri_path, "%s", argv[1]);
+        for (char *p = uri_path; *p; p++)
+            if (*p == '\\')
+                *p = '/';
+        snprintf(resources, sizeof resources, "file:///%s/resources", uri_path);
+    }
+#elif !defined(FMI3)
     snprintf(resources, sizeof resources, "file://%s/resources", argv[1]);
 #else
     snprintf(resources, sizeof resources, "%s/resources/", argv[1]);  /* FMI 3.0: a path, not a URI */

@@ -1,0 +1,156 @@
+"""The same FMU on Linux and on win64 under wine: size of each half, instantiation, doStep.
+
+Two builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0), each carrying
+both binaries (build_fmu.py's default, build_win64.py): the default (Linux half with numba; the win64
+half has no numba and runs numpy's loops) and ``--no-numba`` (both halves run numpy's loops). Each FMU
+is unpacked once and run by our C host (``tests/c_host/host.c``, scenario ``bench``): the Linux build with
+``PATH=/usr/bin:/bin``, the mingw build under wine 8 (``WINEDEBUG=-all``); a fresh process per run, the
+Linux and the wine runs alternating so that both see the same machine load. A run is the pitch case of
+``cases.py`` (the shipped blade-root series, pitching +-5 deg at 0.5 rad/s, flexible rings, friction on,
+10 ms steps); a step is set the 7 inputs, ``fmi2DoStep``, get 5 outputs; the first ``WARM`` steps are left
+out. Wine is not Windows: its timings say what the win64 half costs under wine on this machine, not on a
+Windows desktop.
+
+Run (root, with wine and mingw-w64: ``make`` installs them):
+    .venv/bin/python benchmarks/bench_win64.py [--steps 1000] [--runs 3]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from cases import CASES  # noqa: E402
+from timing import print_table  # noqa: E402
+
+import win64_tools as w  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
+OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
+VARIANTS = {"default (numba on Linux)": {"numba": True}, "--no-numba": {"numba": False}}
+WARM = 20
+
+
+def linux_host(folder: Path) -> Path:
+    binary = folder / "host"
+    subprocess.run(["cc", "-O2", "-include", str(ROOT / "fmu_src/shim/glibc_compat.h"), "-nostartfiles", "-o",
+                    str(binary), str(ROOT / "tests/c_host/start.c"), str(ROOT / "tests/c_host/host.c"),
+                    "-Wl,--no-as-needed", "-l:libdl.so.2", "-lm"], check=True)
+    return binary
+
+
+def run(platform: str, host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict):
+    """One run of the C host: (instantiation s, step times s, final outputs)."""
+    integers = sum((["--integer", str(refs[k]), str(v)] for k, v in parameters.items()), [])
+    if platform == "linux":
+        arguments = [str(folder), "SlewingBearing", refs["guid"], "bench", *(str(refs[n]) for n in INPUTS + OUTPUTS),
+                     "--inputs", str(inputs), *integers]
+        out = subprocess.run([str(host), *arguments], env={"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/root")},
+                             capture_output=True, text=True, timeout=3600)
+    else:
+        arguments = [w.windows_path(folder), "SlewingBearing", refs["guid"], "bench",
+                     *(str(refs[n]) for n in INPUTS + OUTPUTS), "--inputs", w.windows_path(inputs), *integers]
+        out = w.wine(host, *arguments, timeout=3600)
+    if out.returncode != 0 or "done" not in out.stdout:
+        raise RuntimeError(f"the {platform} C host failed on {folder}:\n{out.stdout[-3000:]}\n{out.stderr[-3000:]}")
+    steps, instantiation, final = [], None, None
+    for line in out.stdout.splitlines():
+        word, *rest = line.split() or [""]
+        if word == "instantiate":
+            instantiation = float(rest[0])
+        elif word == "step":
+            steps.append(float(rest[1]))
+        elif word == "final":
+            final = [float(x) for x in rest[1:]]
+    return instantiation, np.array(steps), final
+
+
+def sizes(fmu: Path) -> dict:
+    """Bytes per half of the FMU: zipped (compressed entries) and unpacked."""
+    out = {"linux": [0, 0], "win64": [0, 0], "shared": [0, 0]}
+    with zipfile.ZipFile(fmu) as z:
+        for info in z.infolist():
+            half = ("linux" if info.filename.startswith("binaries/linux64/") else
+                    "win64" if info.filename.startswith("binaries/win64/") else "shared")
+            out[half][0] += info.compress_size
+            out[half][1] += info.file_size
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=1000)
+    parser.add_argument("--runs", type=int, default=3)
+    args = parser.parse_args()
+    if w.missing_tools():
+        sys.exit(w.missing_tools())
+    from fmpy import read_model_description
+
+    from build_fmu import build_fmu
+
+    case = CASES["pitch"](args.steps)
+    with tempfile.TemporaryDirectory(prefix="bench_win64_") as tmp:
+        tmp = Path(tmp)
+        hosts = {"linux": linux_host(tmp), "win64": w.mingw(tmp / "host.exe", [ROOT / "tests/c_host/host.c"], "-O2")}
+        inputs = tmp / "inputs.txt"
+        np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
+        built, size_rows = {}, []
+        for name, variant in VARIANTS.items():
+            fmu = tmp / f"pitch_{variant['numba']}.fmu"
+            build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", fmu, **variant)
+            folder = tmp / fmu.stem
+            with zipfile.ZipFile(fmu) as z:
+                z.extractall(folder)
+            md = read_model_description(str(fmu))
+            refs = {v.name: v.valueReference for v in md.modelVariables}
+            refs["guid"] = md.guid
+            built[name] = (folder, refs)
+            s = sizes(fmu)
+            size_rows.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB",
+                              f"{s['linux'][0] / 1e6:.1f} MB / {s['linux'][1] / 1e6:.0f} MB",
+                              f"{s['win64'][0] / 1e6:.1f} MB / {s['win64'][1] / 1e6:.0f} MB",
+                              f"{s['shared'][0] / 1e6:.1f} MB / {s['shared'][1] / 1e6:.0f} MB",
+                              f"{(s['shared'][0] + s['linux'][0]) / 1e6:.1f} MB"])
+        times = {(n, p): [] for n in VARIANTS for p in hosts}
+        starts = {(n, p): [] for n in VARIANTS for p in hosts}
+        finals = {}
+        for _ in range(args.runs):
+            for name in VARIANTS:
+                for platform, host in hosts.items():          # interleaved: Linux, wine, Linux, wine...
+                    folder, refs = built[name]
+                    instantiation, steps, final = run(platform, host, folder, refs, inputs, case.parameters)
+                    starts[name, platform].append(instantiation)
+                    times[name, platform].append(steps[WARM:])
+                    finals[name, platform] = final
+    print(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU and platform, "
+          "our C host (Linux: PATH=/usr/bin:/bin; win64: mingw build under wine 8)")
+    print_table("The FMU's halves: zipped / unpacked", ["FMU", "zipped", "Linux half", "win64 half",
+                                                       "model files", "zipped without win64"], size_rows)
+    rows = []
+    for name in VARIANTS:
+        for platform in hosts:
+            t = np.concatenate(times[name, platform]) * 1e3
+            rows.append([name, "Linux" if platform == "linux" else "win64 under wine", "numba" if
+                         (platform == "linux" and VARIANTS[name]["numba"]) else "numpy",
+                         f"{np.median(starts[name, platform]):.2f} s", f"{np.median(t):.2f} ms",
+                         f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms"])
+    print_table("doStep in the C host (set inputs, doStep, get outputs)",
+                ["FMU", "platform", "loops", "instantiation", "median", "95th pct", "99th pct"], rows)
+    for name in VARIANTS:
+        a, b = np.array(finals[name, "linux"]), np.array(finals[name, "win64"])
+        print(f"{name}: final outputs, win64 under wine against Linux: largest relative difference "
+              f"{np.max(np.abs(a - b) / np.maximum(np.abs(a), 1e-300)):.1e}")
+
+
+if __name__ == "__main__":
+    main()

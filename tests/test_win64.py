@@ -1,0 +1,361 @@
+"""The standalone FMUs' Windows (win64) binary, under wine: no Windows machine, no Python on the "Windows" side
+but the FMU's own (build_win64.py).
+
+Each FMU (the FMI 2.0 and 3.0 bearing FMUs and the drive FMU) runs in
+(a) our C host (tests/c_host/host.c) cross-compiled with mingw-w64: steps, state get/set/serialize,
+    free, FreeLibrary and reload;
+(b) fmpy 0.3.32 on the official embeddable CPython 3.11.9 (a Python host: the FMU uses its interpreter);
+(c) fmusim v0.0.39 cross-compiled with mingw-w64 (tests/win64/build_fmusim.sh; skipped where it is not built);
+``SLEWING_WINE_RUNS`` times each (1 in ``make test``, 5 in ``tests/win64/run_all.sh``); every run exits 0 and gives
+fmpy's outputs on Linux within 1e-9 relative.
+
+The tolerance: the Windows half runs another numpy (1.26.4 with its OpenBLAS, against 2.x on Linux) and
+another C library's libm (wine's ucrtbase against glibc), so the last bits of the solver's
+floating-point results may differ; both Newton solvers converge to 1e-12 or better, and 3e-14 was
+measured. 1e-9 is what the Linux tests allow between machine codes (numba's generic loops).
+
+Wine (Debian's wine 8) and mingw-w64 are installed by ``make`` as root; the prefix and the Windows Python
+are kept in ``$SLEWING_WINE_DIR`` (default /var/cache/slewing-wine). Without root or without them the
+tests are skipped, saying why.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import win64_tools as w  # noqa: E402
+from host_output import parse_host_output  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = int(os.environ.get("SLEWING_WINE_RUNS", "1"))
+STEPS = 6
+FMPY_STEPS = ROOT / "tests" / "win64" / "fmpy_steps.py"
+BEARING_INPUTS = ["Fx", "Fy", "Fz", "Mx", "My", "psi", "omega"]
+BEARING_OUTPUTS = ["z", "rx", "friction_torque", "max_ball_load", "static_safety_factor"]
+#: the drive has three inputs: the C host's seven values assigned in order, the later one winning (load_moment
+#: -2.5e3 N.m, friction_torque 3e4 + 1e3 k N.m, command 0.05 rad)
+DRIVE_INPUTS = ["load_moment", "load_moment", "friction_torque", "load_moment", "load_moment", "command", "command"]
+DRIVE_OUTPUTS = ["psi", "omega", "motor_torque", "ring_torque"]
+#: case: (FMI version, model identifier, inputs, outputs)
+CASES = {"bearing2": (2, "SlewingBearing", BEARING_INPUTS, BEARING_OUTPUTS),
+         "bearing3": (3, "SlewingBearing3", BEARING_INPUTS, BEARING_OUTPUTS),
+         "drive": (2, "SlewingDrive", DRIVE_INPUTS, DRIVE_OUTPUTS)}
+REL = 1e-9
+
+pytestmark = [
+    pytest.mark.skipif(os.geteuid() != 0, reason="SKIPPED, not root: the win64 tests need wine and mingw-w64, "
+                       "which `make` installs as root, and keep wine's prefix in /var/cache (CI runs as root)"),
+    pytest.mark.skipif(bool(w.missing_tools()), reason=f"SKIPPED: {w.missing_tools()}"),
+]
+
+
+@pytest.fixture(scope="module")
+def drive_fmu(tmp_path_factory):
+    sys.path.insert(0, str(ROOT))
+    from build_drive_fmu import build_drive_fmu
+
+    return build_drive_fmu(ROOT / "examples" / "drives" / "pitch_drive.toml",
+                           tmp_path_factory.mktemp("drive") / "SlewingDrive_pitch.fmu")
+
+
+@pytest.fixture(scope="module")
+def fmus(table3_fmu, table3_fmu3, drive_fmu):
+    return {"bearing2": table3_fmu, "bearing3": table3_fmu3, "drive": drive_fmu}
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory):
+    return w.c_hosts(tmp_path_factory.mktemp("win_hosts"))
+
+
+def parse_steps(text: str) -> np.ndarray:
+    return np.array([[float(v) for v in line.split()[2:]] for line in text.splitlines() if line.startswith("step ")])
+
+
+_references = {}
+
+
+def reference(case, fmu) -> np.ndarray:
+    """Outputs of the first STEPS steps, fmpy on Linux (this machine's Python)."""
+    if case not in _references:
+        _, _, inputs, outputs = CASES[case]
+        run = subprocess.run([sys.executable, str(FMPY_STEPS), str(fmu), str(STEPS), ",".join(inputs),
+                              ",".join(outputs)], capture_output=True, text=True, timeout=300)
+        assert run.returncode == 0, run.stderr[-3000:]
+        _references[case] = parse_steps(run.stdout)
+    return _references[case]
+
+
+def refs_of(fmu):
+    from fmpy import read_model_description
+
+    md = read_model_description(str(fmu))
+    token = md.guid if md.fmiVersion.startswith("2") else md.instantiationToken
+    return token, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def run_c_host(host, fmu, case, folder, scenario="basic"):
+    version, identifier, inputs, outputs = CASES[case]
+    token, refs = refs_of(fmu)
+    vrs = [str(refs[n]) for n in inputs + outputs]
+    return w.wine(host, w.windows_path(folder), identifier, token, scenario, *vrs, timeout=600)
+
+
+def test_the_fmus_carry_a_standalone_win64_binary(fmus):
+    for case, fmu in fmus.items():
+        version, identifier, _, _ = CASES[case]
+        folder = "binaries/win64" if version == 2 else "binaries/x86_64-windows"
+        with zipfile.ZipFile(fmu) as z:
+            names = set(z.namelist())
+            described = z.read("resources/python_runtime.txt").decode()
+        for name in (f"{identifier}.dll", "pythonfmu-export.dll", "python/python311.dll", "python/python3.dll",
+                     "python/python311.zip", "python/vcruntime140.dll", "python/vcruntime140_1.dll",
+                     "python/msvcp140.dll", "python/Lib/site-packages/numpy/__init__.py"):
+            assert f"{folder}/{name}" in names, (case, name)
+        assert f"{folder}/python/python311._pth" not in names          # the layer sets the search path
+        assert "win64_version=3.11.9" in described and "win64_packages=numpy==1.26.4" in described
+
+
+def test_our_layer_needs_only_kernel32_and_msvcrt(fmus, tmp_path):
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    if objdump is None:
+        pytest.skip("binutils-mingw-w64-x86-64 is not installed")
+    for case, fmu in fmus.items():
+        version, identifier, _, _ = CASES[case]
+        folder = "binaries/win64" if version == 2 else "binaries/x86_64-windows"
+        with zipfile.ZipFile(fmu) as z:
+            (tmp_path / "layer.dll").write_bytes(z.read(f"{folder}/{identifier}.dll"))
+        imports = subprocess.run([objdump, "-p", str(tmp_path / "layer.dll")], capture_output=True, text=True).stdout
+        assert sorted(line.split()[-1] for line in imports.splitlines() if "DLL Name" in line) == \
+            ["KERNEL32.dll", "msvcrt.dll"], case
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_our_c_host_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus, hosts, tmp_path):
+    version = CASES[case][0]
+    fmu = fmus[case]
+    expected = reference(case, fmu)
+    folder = w.unpack(fmu, tmp_path / "fmu")
+    for run_index in range(RUNS):  # load, step, roll back, deserialize, free, FreeLibrary, reload, exit
+        run = run_c_host(hosts[version], fmu, case, folder)
+        assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), \
+            f"run {run_index}: exit {run.returncode}\n{run.stdout[-3000:]}{run.stderr[-3000:]}"
+        values, _, _, _ = parse_host_output(run.stdout)
+        for k in range(STEPS):
+            assert values["run"][k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
+            assert values["reload"][k] == values["run"][k]            # a reloaded binary starts afresh
+        for k in range(3, STEPS):
+            assert values["replay"][k] == values["run"][k]            # the state set back repeats the steps
+            assert values["deserialized"][k] == values["run"][k]
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(case, fmus):
+    python = w.windows_python()
+    _, _, inputs, outputs = CASES[case]
+    expected = reference(case, fmus[case])
+    for run_index in range(RUNS):
+        run = w.wine(python, w.windows_path(FMPY_STEPS), w.windows_path(fmus[case]), STEPS, ",".join(inputs),
+                     ",".join(outputs))
+        assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), \
+            f"run {run_index}: exit {run.returncode}\n{run.stdout[-3000:]}{run.stderr[-3000:]}"
+        got = parse_steps(run.stdout)
+        assert got.shape == expected.shape
+        for k in range(STEPS):
+            assert got[k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
+
+
+def test_a_missing_python_library_is_reported_through_the_hosts_logger(fmus, hosts, tmp_path):
+    folder = w.unpack(fmus["bearing2"], tmp_path / "broken")
+    (folder / "binaries" / "win64" / "python" / "python311.dll").unlink()
+    run = run_c_host(hosts[2], fmus["bearing2"], "bearing2", folder)
+    _, _, logs, _ = parse_host_output(run.stdout)
+    assert run.returncode == 1 and "error fmi2Instantiate" in run.stdout, run.stdout + run.stderr  # refused, no crash
+    assert any("the FMU's Python runtime is incomplete" in m and "python311.dll is missing" in m
+               for _, _, m in logs), run.stdout
+
+
+def test_the_win64_half_ignores_the_hosts_python_variables(fmus, hosts, tmp_path):
+    # an isolated start: PYTHONHOME and PYTHONPATH of the host pointing to nonsense change nothing
+    folder = w.unpack(fmus["bearing2"], tmp_path / "isolated")
+    token, refs = refs_of(fmus["bearing2"])
+    vrs = [str(refs[n]) for n in BEARING_INPUTS + BEARING_OUTPUTS]
+    run = w.wine(hosts[2], w.windows_path(folder), "SlewingBearing", token, "basic", *vrs,
+                 env={"PYTHONHOME": "C:\\nowhere", "PYTHONPATH": "C:\\nowhere", "WINEPATH": "C:\\nowhere"})
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+
+
+def test_without_wines_own_cpp_runtime_the_fmu_brings_its_own(fmus, hosts, tmp_path):
+    # wine's builtin msvcp140/vcruntime140 blocked: only the FMU's copies can serve (a Windows machine
+    # without the Visual C++ Redistributable)
+    folder = w.unpack(fmus["bearing3"], tmp_path / "no_vc")
+    token, refs = refs_of(fmus["bearing3"])
+    vrs = [str(refs[n]) for n in BEARING_INPUTS + BEARING_OUTPUTS]
+    run = w.wine(hosts[3], w.windows_path(folder), "SlewingBearing3", token, "basic", *vrs,
+                 env={"WINEDLLOVERRIDES": "mscoree,mshtml=;msvcp140,vcruntime140,vcruntime140_1=n"})
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+
+
+# ---- fmusim cross-compiled with mingw (tests/win64/build_fmusim.sh) -----------------------------------------
+FMUSIM_SCRIPT = ROOT / "tests" / "win64" / "build_fmusim.sh"
+#: inputs per case for fmusim's CSV, one column each: the values the C host's order leaves (see DRIVE_INPUTS)
+FMUSIM_INPUTS = {"bearing2": BEARING_INPUTS, "bearing3": BEARING_INPUTS, "drive": ["command", "friction_torque",
+                                                                                    "load_moment"]}
+
+
+def fmusim_inputs(case, k):
+    u = [8e3, -3e3, 3e4 + 1e3 * k, 1.5e3, -2.5e3, 0.4 + 0.01 * k, 0.05]
+    return u if case != "drive" else [u[6], u[2], u[4]]
+
+
+@pytest.fixture(scope="module")
+def fmusim():
+    """fmusim.exe, built once per version of the build script and kept in $SLEWING_WINE_DIR. Building it the
+    first time (libxml2, sundials and minizip for mingw from Debian's sources) takes about 5 minutes: in
+    `make test` it is taken only when built already (tests/win64/run_all.sh builds it) or with
+    SLEWING_BUILD_FMUSIM=1."""
+    import hashlib
+
+    if not (ROOT.parent / "shared" / "vendor" / "fmusim-v0.0.39" / "build.sh").exists() \
+            and not os.environ.get("SLEWING_FMUSIM_SOURCE"):
+        pytest.skip("fmusim's source is not at ../shared/vendor/fmusim-v0.0.39")
+    key = hashlib.sha256(FMUSIM_SCRIPT.read_bytes()).hexdigest()[:12]
+    binary = w.WINE_DIR / f"fmusim-{key}.exe"
+    if not binary.exists():
+        if not os.environ.get("SLEWING_BUILD_FMUSIM"):
+            pytest.skip("SKIPPED: fmusim for mingw is not built yet (about 5 minutes): run tests/win64/run_all.sh, "
+                        "or set SLEWING_BUILD_FMUSIM=1")
+        run = subprocess.run(["bash", str(FMUSIM_SCRIPT), str(binary)], capture_output=True, text=True, timeout=3600)
+        assert run.returncode == 0 and binary.exists(), run.stdout[-3000:] + run.stderr[-3000:]
+    return binary
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_fmusim_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus, fmusim, tmp_path):
+    from fmpy import simulate_fmu
+
+    _, _, _, outputs = CASES[case]
+    names = FMUSIM_INPUTS[case]
+    t = np.round(np.arange(21) * 0.01, 10)
+    rows = ["time," + ",".join(names)] + [f"{tk:.2f}," + ",".join(repr(x) for x in fmusim_inputs(case, k))
+                                          for k, tk in enumerate(t)]
+    (tmp_path / "input.csv").write_text("\n".join(rows) + "\n")
+    data = np.zeros(len(t), dtype=[("time", float)] + [(n, float) for n in names])
+    data["time"] = t
+    for i, name in enumerate(names):
+        data[name] = [fmusim_inputs(case, k)[i] for k in range(len(t))]
+    expected = simulate_fmu(str(fmus[case]), stop_time=0.2, step_size=0.01, output_interval=0.01, input=data,
+                            output=outputs)
+    shutil.copy2(fmus[case], tmp_path / "model.fmu")
+    arguments = sum((["--output-variable", n] for n in outputs), [])
+    for run_index in range(RUNS):
+        out = tmp_path / f"out{run_index}.csv"
+        run = w.wine(fmusim, "--interface-type", "cs", "--stop-time", "0.2", "--output-interval", "0.01",
+                     "--input-file", w.windows_path(tmp_path / "input.csv"), *arguments,
+                     "--output-file", w.windows_path(out), w.windows_path(tmp_path / "model.fmu"))
+        assert run.returncode == 0, f"run {run_index}: exit {run.returncode}\n{run.stdout[-2000:]}{run.stderr[-2000:]}"
+        got = np.genfromtxt(out, delimiter=",", names=True)
+        for name in outputs:  # fmusim writes 16 significant digits
+            assert got[name] == pytest.approx(expected[name], rel=REL, abs=1e-300), (run_index, name)
+
+
+def fmpy_single(fmu, input_name, output_name, values):
+    """Outputs of fmpy on Linux stepping ``fmu`` with one input set to ``values`` in turn (tests/win64/two_fmus.c)."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(fmu))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    folder = extract(str(fmu))
+    try:
+        slave = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
+                          instanceName="single")
+        slave.instantiate()
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        out = []
+        for k, value in enumerate(values):
+            slave.setReal([refs[input_name]], [value])
+            slave.doStep(k * 0.01, 0.01)
+            out.append(slave.getReal([refs[output_name]])[0])
+        slave.terminate()
+        slave.freeInstance()
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    return out
+
+
+@pytest.mark.parametrize("first", ["bearing2", "drive"])
+def test_two_of_our_fmus_in_one_windows_c_process(first, fmus, tmp_path):
+    # the first FMU starts its Python; the second finds it running and uses it (its own folders appended)
+    program = w.mingw(tmp_path / "two_fmus.exe", [ROOT / "tests" / "win64" / "two_fmus.c"])
+    signals = {"bearing2": ("Fz", "z", 3e4, 1e3), "drive": ("command", "psi", 0.0, 0.01)}  # input, output, base, step
+    order = [first, "drive" if first == "bearing2" else "bearing2"]
+    arguments = []
+    for case in order:
+        _, identifier, _, _ = CASES[case]
+        token, refs = refs_of(fmus[case])
+        folder = w.unpack(fmus[case], tmp_path / case)
+        name_in, name_out, base, step = signals[case]
+        arguments += [w.windows_path(folder), identifier, token, str(refs[name_in]), str(refs[name_out]), repr(base),
+                      repr(step)]
+    run = w.wine(program, *arguments)
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+    rows = {(line.split()[0], int(line.split()[1])): float(line.split()[2]) for line in run.stdout.splitlines()
+            if line[:2] in ("a ", "b ")}
+    for label, case in zip("ab", order):
+        name_in, name_out, base, step = signals[case]
+        expected = fmpy_single(fmus[case], name_in, name_out, [base + step * k for k in range(4)])
+        assert [rows[label, k] for k in range(4)] == pytest.approx(expected, rel=REL, abs=1e-300), case
+
+
+def test_the_ssps_four_fmus_carry_win64_and_run_together_in_fmpy_on_windows(table3_fmu, drive_fmu, tmp_path):
+    # the pitch system SSP of test_ssp.py (bearing, drive, two time tables), built as build_ssp.py builds it:
+    # every FMU carries its win64 binary; fmpy's simulate_ssp on the embeddable Windows Python runs all four
+    # in one process (the first starts the FMU's Python only where the host has none: here the host's is used)
+    sys.path.insert(0, str(ROOT / "examples" / "ssp"))
+    from build_ssp import build_ssp, step_command
+    from slewing_drives import LoadSeries
+    from ssp_hosts import COMPARED, run_fmpy
+
+    shipped = LoadSeries.read_csv(ROOT / "examples/loads/blade_root_loads.csv")
+    loads = LoadSeries(shipped.time, shipped.loads * np.array([0.02, 0.02, 0.02, 0.001, 0.001, 0.1]))
+    stop, dt = 0.3, 0.01
+    ssp = build_ssp(tmp_path / "pitch_system.ssp", table3_fmu, drive_fmu, loads, step_command(5.0, 0.1, 0.9),
+                    bearing_parameters={"load_frame": 2, "ring_model": 1, "preload": 10e-6}, stop_time=stop,
+                    step_size=dt)
+    with zipfile.ZipFile(ssp) as z:
+        for name in ("loads", "command", "drive", "bearing"):
+            (tmp_path / f"{name}.fmu").write_bytes(z.read(f"resources/{name}.fmu"))
+            with zipfile.ZipFile(tmp_path / f"{name}.fmu") as fmu:
+                names = fmu.namelist()
+            assert any(n.startswith("binaries/win64/python/python311.dll") for n in names), name
+            assert any(n.startswith("binaries/linux64/python/") for n in names), name
+    expected = run_fmpy(ssp, list(COMPARED), stop_time=stop, step_size=dt)
+    run = w.wine(w.windows_python(), w.windows_path(ROOT / "tests" / "win64" / "ssp_run.py"), w.windows_path(ssp),
+                 stop, dt)
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+    got = {line.split()[0]: np.array([float(v) for v in line.split()[1:]]) for line in run.stdout.splitlines()
+           if line.split() and line.split()[0] in ("time", *COMPARED)}
+    for name in ("time", *COMPARED):
+        assert got[name] == pytest.approx(np.asarray(expected[name]), rel=REL, abs=1e-12), name
+
+
+def test_a_non_ascii_folder_is_refused_with_a_message_not_a_crash(fmus, hosts, tmp_path):
+    # a known limit of pythonfmu's Windows DLL (docs/standalone_fmu.md): given such a folder it fails or crashes
+    # the host, so our layer refuses it first, saying why; the host goes on
+    for case in ("bearing2", "bearing3"):
+        folder = w.unpack(fmus[case], tmp_path / f"Lager für {case}")
+        run = run_c_host(hosts[CASES[case][0]], fmus[case], case, folder)
+        _, _, logs, _ = parse_host_output(run.stdout)
+        assert run.returncode == 1 and "error fmi2Instantiate" in run.stdout, run.stdout[-3000:] + run.stderr[-3000:]
+        assert any("a character beyond ASCII" in m and "Unpack the FMU in a folder with an ASCII path" in m
+                   for _, _, m in logs), run.stdout[-3000:]
+        assert "Unhandled" not in run.stderr
