@@ -460,10 +460,10 @@ def main() -> int:
                       f"diagonals 1, 2: 3-D {zone_ref}, model {zone_mod}; largest per-contact difference "
                       f"{100 * diff:.2f} % of the peak; residual {res:.1e}", flush=True)
                 if hs:
-                    print(f"    half-space of the two patches {c_hs[0] * 1e9:.3f} m/N x 1e-9; "
-                          f"ball loads 3-D [kN] diagonal 1: {np.round(q[0] / 1e3, 2).tolist()}", flush=True)
-                    print(f"    model                          diagonal 1: {np.round(qm_half[0] / 1e3, 2).tolist()}",
-                          flush=True)
+                    print(f"    half-space of the two patches {c_hs[0] * 1e9:.3f} m/N x 1e-9", flush=True)
+                    for d in range(2):
+                        print(f"    ball loads 0..{B // 2} [kN], diagonal {d + 1}: 3-D   {np.round(q[d] / 1e3, 2).tolist()}\n"
+                              f"                                 model {np.round(qm_half[d] / 1e3, 2).tolist()}", flush=True)
     print(f"\ntotal {time.perf_counter() - t_start:.0f} s")
     return 0
 
