@@ -29,6 +29,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from bench_fmu_runtime import compile_host  # noqa: E402  (our C host for Linux, as that benchmark builds it)
 from cases import CASES  # noqa: E402
 from timing import print_table  # noqa: E402
 
@@ -39,14 +40,6 @@ INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 VARIANTS = {"default (numba on Linux)": {"numba": True}, "--no-numba": {"numba": False}}
 WARM = 20
-
-
-def linux_host(folder: Path) -> Path:
-    binary = folder / "host"
-    subprocess.run(["cc", "-O2", "-include", str(ROOT / "fmu_src/shim/glibc_compat.h"), "-nostartfiles", "-o",
-                    str(binary), str(ROOT / "tests/c_host/start.c"), str(ROOT / "tests/c_host/host.c"),
-                    "-Wl,--no-as-needed", "-l:libdl.so.2", "-lm"], check=True)
-    return binary
 
 
 def run(platform: str, host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict):
@@ -101,7 +94,7 @@ def main() -> None:
     case = CASES["pitch"](args.steps)
     with tempfile.TemporaryDirectory(prefix="bench_win64_") as tmp:
         tmp = Path(tmp)
-        hosts = {"linux": linux_host(tmp), "win64": w.mingw(tmp / "host.exe", [ROOT / "tests/c_host/host.c"], "-O2")}
+        hosts = {"linux": compile_host(tmp), "win64": w.mingw(tmp / "host.exe", [ROOT / "tests/c_host/host.c"], "-O2")}
         inputs = tmp / "inputs.txt"
         np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
         built, size_rows = {}, []

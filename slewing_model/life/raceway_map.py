@@ -110,6 +110,8 @@ class RacewayMap:
         self.scale = 1.0 / (np.asarray(capacities, float) ** 3 * np.asarray(passes, float) * 1e6)
         self.slices = int(slices)
         self.moving = np.array([r == moving_ring for r in TRACK_RINGS])
+        #: the tracks of the fixed ring and of the moving ring
+        self._tracks = {ring_moving: np.flatnonzero(self.moving == ring_moving) for ring_moving in (False, True)}
         self.reset()
 
     def reset(self) -> None:
@@ -126,8 +128,7 @@ class RacewayMap:
         q3 = np.maximum(contact_load, 0.0) ** 3
         if self._angle is not None:
             mean = 0.5 * (q3 + self._q3) * self.scale
-            for ring_moving in (False, True):
-                tracks = np.flatnonzero(self.moving == ring_moving)
+            for ring_moving, tracks in self._tracks.items():
                 shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)
                 ball, where = crossed_slices(self._angle - shift_old, ball_angle - shift_new, self.slices)
                 if ball.size and tracks.size:
