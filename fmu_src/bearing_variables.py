@@ -55,7 +55,14 @@ LIFE_OUTPUTS = [
                                "the Hertz patch width (smallest over the loaded tracks; < 1: the patch is never "
                                "uncovered; 0 until the first half-cycle is completed)"),
 ]
-OUTPUTS = OUTPUTS + LIFE_OUTPUTS
+#: the solver's account of the step
+SOLVER_OUTPUTS = [
+    ("equilibrium_residual", "1", "largest force residual of the answered load distribution over the load scale: "
+                                  "at most the parameter tolerance where the step reached equilibrium; above it only "
+                                  "where step_work = bounded stopped a step before (its outputs are then the last "
+                                  "Newton iterate, and the next steps go on from it)"),
+]
+OUTPUTS = OUTPUTS + LIFE_OUTPUTS + SOLVER_OUTPUTS
 
 #: integer output (FMI 2.0 Integer, FMI 3.0 Int32): name, description
 COUNT_OUTPUT = ("balls_in_four_point_contact", "number of balls loaded on both diagonals")
@@ -75,6 +82,7 @@ RING_MODELS = {1: "rigid", 2: "flexible"}
 MOVING_RINGS = {1: "inner", 2: "outer"}
 LOAD_FRAMES = {1: "fixed", 2: "rotating"}
 LIFE = {0: "off", 1: "on"}
+STEP_WORK = {1: "complete", 2: "bounded"}
 
 #: integer parameters: name, choices, description (the choices are listed after it)
 INTEGER_PARAMETERS = [
@@ -82,6 +90,10 @@ INTEGER_PARAMETERS = [
     ("moving_ring", MOVING_RINGS, "ring the loads act on and that turns"),
     ("load_frame", LOAD_FRAMES, "frame of the input loads"),
     ("life", LIFE, "life and wear accumulators (outputs life_damage, life_travel_ratio)"),
+    ("step_work", STEP_WORK, "work of a step: complete solves every step to the tolerance, however long a sudden "
+                             "load change makes it; bounded (real time) caps a step's Newton iterations and ring "
+                             "operator work (README, Speed) and carries the rest over to the next steps, flagged by "
+                             "equilibrium_residual above tolerance"),
 ]
 
 #: per-ball results: FMI 3.0 array name, unit, columns (FMI 2.0 scalar suffixes), description,
@@ -275,6 +287,7 @@ def scalar_outputs(result, simulator=None) -> dict:
                   max_ball_load=d.max_ball_load, max_contact_pressure=d.max_contact_pressure,
                   static_safety_factor=min(d.static_safety_factor, 1e300))
     values[COUNT_OUTPUT[0]] = d.balls_in_four_point_contact
+    values["equilibrium_residual"] = float(d.residual)
     life = getattr(simulator, "life", None)
     ratio = math.nan if life is None else life.last_ratio
     values.update(life_damage=0.0 if life is None else life.worst_damage,

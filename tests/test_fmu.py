@@ -182,6 +182,49 @@ def test_a_static_safety_factor_below_one_is_logged_as_a_warning_when_it_starts(
     assert "t = 0.01" in warned[0] and "t = 0.04" in warned[1]
 
 
+def test_bounded_steps_answer_as_the_library_and_flag_what_they_carry_over(table3_fmu):
+    """step_work = 2 (bounded): a tilting moment reversed in one step is answered over several
+    steps, each flagged by equilibrium_residual above the tolerance until the equilibrium is
+    reached; the values are the library's bounded simulator's (the FMU holds no physics)."""
+    from slewing_model.rings.superelement import build_superelement
+
+    fmu, refs, _, unzipped = _slave(table3_fmu)
+    names = ["equilibrium_residual", "z", "rx", "max_ball_load", "friction_torque", "ball[20].Q2"]
+    inputs = ["Fz", "Mx", "My", "psi", "omega"]
+    forward, reversed_ = [1e5, 1.5e4, 5e4, 0.4, 0.05], [1e5, -1.5e4, -5e4, 0.4, 0.05]
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.setInteger([refs["step_work"]], [2])
+    fmu.setReal([refs[n] for n in inputs], forward)                  # the inputs at the start, as hosts set them
+    fmu.exitInitializationMode()
+    bearing = load_bearing(BEARING)
+    sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"),
+                           SimulatorSettings(step_work="bounded", friction_kernel="numpy", contact_kernel="numpy"))
+    sim.step(Loads(Fz=forward[0], Mx=forward[1], My=forward[2]), forward[3], forward[4])
+    residuals = []
+    try:
+        for k in range(10):
+            values = forward if k < 2 else reversed_
+            fmu.setReal([refs[n] for n in inputs], values)
+            assert fmu.fmi2DoStep(fmu.component, 0.01 * k, 0.01, 1) == 0
+            out = dict(zip(names, fmu.getReal([refs[n] for n in names])))
+            r = sim.step(Loads(Fz=values[0], Mx=values[1], My=values[2]), values[3], values[4])
+            d = r.distribution
+            expected = {"equilibrium_residual": d.residual, "z": d.displacement[2], "rx": d.displacement[3],
+                        "max_ball_load": d.max_ball_load, "friction_torque": r.friction_torque,
+                        "ball[20].Q2": d.contact_load[19, 1]}
+            for name, value in expected.items():
+                assert out[name] == pytest.approx(value, rel=1e-9, abs=1e-15), (k, name)
+            residuals.append(out["equilibrium_residual"])
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+    tolerance = 1e-7                                        # the parameter's default
+    assert max(residuals[:2]) <= tolerance < residuals[2]    # the reversal's step is flagged ...
+    assert residuals[-1] <= tolerance                       # ... and the equilibrium reached within 8 steps
+
+
 def test_rollback_repeats_steps_exactly(slave):
     fmu, refs, _ = slave
     for k in range(3):

@@ -64,8 +64,8 @@ from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors be
 from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
-    APPROXIMATE_TURN, NUMPY_ARITHMETIC, PendingOperator, ReducedOperator, advance_operator, assemble_operator,
-    complete_operator, start_operator, turned_operator, update_operator,
+    APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, PendingOperator, ReducedOperator, advance_operator,
+    assemble_operator, complete_operator, start_operator, turned_operator, update_operator,
 )
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
@@ -81,6 +81,15 @@ FINISH_ITERATIONS = 3
 #: with the one it has (:class:`slewing_model.rings.reduced_operator.PendingOperator`); all at once when an
 #: iteration past this many in one solve is still slow (docs/speed.md)
 SPREAD_ITERATIONS = 8
+#: what a bounded warm solve (``step_work="bounded"``) may spend: the ring operator's work, in
+#: inversions of ``W = (A^-1 + M)_aa`` (a stage of a spread inversion is half of one; bordering ``r``
+#: new rows onto ``n`` is ``3 r / n``: ``4 n^2 r`` flops against about ``n^3``, measured 1.8 against
+#: 2.5 ms for 90 rows onto 368) ...
+BOUNDED_INVERSIONS = 1.0
+#: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
+#: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Bounded steps")
+BOUNDED_ITERATIONS = 12
+STEP_WORK = ("complete", "bounded")
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
 INNER_CONTACT = CONTACT_RING == "inner"
@@ -120,11 +129,21 @@ class BimeSolver:
         same iterations, and results to round-off. Default numpy: a
         few solves do not repay numba's import (0.5 s); the co-simulation's simulator
         takes "auto" (``SimulatorSettings.contact_kernel``).
+    step_work : {"complete", "bounded"}
+        How much a warm solve may do. "complete": Newton to ``rtol``, however many iterations
+        and ring operator inversions that takes (a moment reversed in one step: about 20 and
+        4). "bounded" (real time): at most :data:`BOUNDED_ITERATIONS` iterations and
+        :data:`BOUNDED_INVERSIONS` of the operator's work; a solve that would need more returns
+        its last iterate with ``converged=False`` and its ``residual``, keeps its operator
+        (and one being inverted), and the next warm solve goes on from there. A cold solve
+        (no ``initial``) is always complete.
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
                  rtol: float = 1e-10, max_iterations: int = 200, pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT,
-                 kernel: str = "numpy"):
+                 kernel: str = "numpy", step_work: str = "complete"):
+        if step_work not in STEP_WORK:
+            raise ValueError(f"step_work = {step_work!r}: must be one of {', '.join(map(repr, STEP_WORK))}")
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
             raise ValueError(f"superelement has {superelement.outer.ball_count} balls, "
                              f"the bearing ball_count = {bearing.ball_count}")
@@ -135,6 +154,8 @@ class BimeSolver:
         self.max_iterations = max_iterations
         self.pressure_limit = pressure_limit
         self.kernel = kernel
+        self.step_work = step_work
+        self._work_left = math.inf   # per solve: the ring operator's work still allowed (inversions)
         self._compiled = use_compiled(kernel, "kernel")    # the per-contact work as compiled loops
         self._arithmetic = COMPILED_ARITHMETIC if self._compiled else NUMPY_ARITHMETIC     # the operator's too
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
@@ -328,6 +349,9 @@ class BimeSolver:
         trust = 0.02 * dw
         mu = 1e-12 * self.reference_stiffness
         iterations = 0
+        bounded = self.step_work == "bounded" and initial is not None
+        self._work_left = BOUNDED_INVERSIONS if bounded else math.inf
+        limit = min(self.max_iterations, BOUNDED_ITERATIONS) if bounded else self.max_iterations
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
         if initial is None:
@@ -344,7 +368,9 @@ class BimeSolver:
                                          f"({residual}) after {iterations} Newton iterations")
             if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
-            if iterations >= self.max_iterations:
+            if iterations >= limit:
+                if bounded:                               # the rest is the next solve's
+                    return self._result(loads, point, iterations, residual, converged=False)
                 raise NoEquilibriumError(
                     f"no convergence after {iterations} Newton iterations (relative residual {residual:.2e}) "
                     f"for loads {loads}")
@@ -356,7 +382,7 @@ class BimeSolver:
                     # the iterations that keep the operator, in one compiled loop, as far as they go; the
                     # one it stopped before is this loop's (handed_back)
                     done, point, last_residual = self._kept_iterations(point, f_scaled, load_scale, trust,
-                                                                       last_residual, iterations)
+                                                                       last_residual, iterations, limit)
                     handed_back = True
                     if done:
                         iterations += done
@@ -367,7 +393,10 @@ class BimeSolver:
             if flexible:
                 fresh = _refresh_due(residual, last_residual, self.rtol)
                 last_residual = residual
-                dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
+                try:
+                    dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
+                except _WorkSpent:                        # a bounded solve: the rest is the next solve's
+                    return self._result(loads, point, iterations - 1, residual, converged=False)
                 m_dy = self._ring_times(dy)       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
                 slope = float(grad_q @ dq) - float(mismatch @ m_dy)
             else:
@@ -422,7 +451,7 @@ class BimeSolver:
                 and not (self.pending_operator is not None and self._stage_due))
 
     def _kept_iterations(self, p: "_Point", f_scaled: np.ndarray, load_scale: float, trust: float,
-                         last_residual: float, iterations: int):
+                         last_residual: float, iterations: int, limit: int):
         """The iterations with the kept operator from ``p`` in one compiled loop
         (:func:`slewing_model.distribution.kernel._kept_iterations`: the steps of :meth:`solve`, up
         to the first that needs more than the operator's product): the iterations done, the point
@@ -436,7 +465,7 @@ class BimeSolver:
             self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
             np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
             op.schur_inverse, op.active, *self._product_operands, p.qs, p.y, p.ring_motion, p.e, p.delta, p.q,
-            p.force, p.n, p.length, p.gradient, p.mismatch, p.loaded, terms, rules, iterations, self.max_iterations)
+            p.force, p.n, p.length, p.gradient, p.mismatch, p.loaded, terms, rules, iterations, limit)
         if not done:
             return 0, p, last_residual
         total, energy_scale, peak_force, peak_residual, n_loaded = terms
@@ -509,46 +538,78 @@ class BimeSolver:
         solve, and all at once when an iteration past :data:`SPREAD_ITERATIONS` of one solve
         is still slow or the kept operator cannot follow the contacts that closed.
         """
-        active = p.loaded
         if not p.any_loaded:
             self._reduced = self.pending_operator = None
             return np.linalg.solve(mu * np.eye(5), f_scaled), -p.y
+        try:
+            op = self._step_operator(p, mu, fresh, iterations)
+        except _WorkSpent:
+            # a bounded solve ends here; that the next goes further, a new operator at this iterate
+            # has its first stage now, if that is left and none is on its way
+            if self.pending_operator is None and self._work_left >= 1.0 / len(SPREAD_STAGES) - 1e-12:
+                self._work_left -= 1.0 / len(SPREAD_STAGES)
+                self.pending_operator = start_operator(p, self.compliance, self.assembly.stiffness, p.loaded,
+                                                       self._arithmetic)
+                self._stage_due = False
+            raise
+        dq, y_new = self._arithmetic.step(op, p, f_scaled)
+        return dq, y_new - p.y
+
+    def _step_operator(self, p: "_Point", mu: float, fresh: bool, iterations: int) -> ReducedOperator:
+        """The reduced operator of this iteration (:meth:`_flexible_direction`), kept as the solver's."""
+        active = p.loaded
         stiffness, op, pending = self.assembly.stiffness, self._reduced, self.pending_operator
         if pending is not None:
             if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
+                self._spend(_stages_left(pending) / len(SPREAD_STAGES))
                 pending = complete_operator(pending, self.jacobian, mu, self._arithmetic)
             elif self._stage_due:                                              # one stage a solve
+                self._spend(1.0 / len(SPREAD_STAGES))
                 pending = advance_operator(pending, self.jacobian, mu, self._arithmetic)
             self._stage_due = False
             if isinstance(pending, ReducedOperator):     # inverted: its coupling is that of the Jacobian now
                 op, pending, fresh = pending, None, False
-                self._reduced_jacobian = self._jacobian_rows
+                self._reduced, self._reduced_jacobian = op, self._jacobian_rows
             else:
                 fresh = False
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
+            self._spend(1.0 / len(SPREAD_STAGES))
             pending = start_operator(p, self.compliance, stiffness, active, self._arithmetic)
             fresh = self._stage_due = False
         self.pending_operator = pending
 
         def bordered(op):                      # contacts closed: bordered in (those that opened stay)
-            closed = np.any(active & ~op.active)
-            if not closed:
+            closed = active & ~op.active
+            if not np.any(closed):
                 return op
+            new_rows = 2 * int(np.count_nonzero(closed))
+            if new_rows <= 0.25 * op.rows.size:                # else update_operator declines: no work
+                self._spend(3.0 * new_rows / op.rows.size)
             return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
 
         if not fresh and op is not None:
             op = bordered(self._turned(op, mu))
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
-                op = bordered(complete_operator(self.pending_operator, self.jacobian, mu, self._arithmetic))
-                self.pending_operator = None
+                self._spend(_stages_left(self.pending_operator) / len(SPREAD_STAGES))
+                op = complete_operator(self.pending_operator, self.jacobian, mu, self._arithmetic)
+                self._reduced, self._reduced_jacobian, self.pending_operator = op, self._jacobian_rows, None
+                op = bordered(op)
         if fresh or op is None:
+            self._spend(1.0)
             op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
-        dq, y_new = self._arithmetic.step(op, p, f_scaled)
-        return dq, y_new - p.y
+        return op
 
-    def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float) -> LoadDistribution:
+    def _spend(self, inversions: float) -> None:
+        """Take ``inversions`` of the ring operator's work from what the solve may still do
+        (``step_work``); :class:`_WorkSpent` where it is not left (nothing is done then)."""
+        if inversions > self._work_left + 1e-12:
+            raise _WorkSpent
+        self._work_left -= inversions
+
+    def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float,
+                converged: bool = True) -> LoadDistribution:
         a = self.assembly
         qs, y, e, delta, q = p.qs, p.y, p.e, p.delta, p.q
         b = self.bearing
@@ -574,13 +635,13 @@ class BimeSolver:
             off = tuple(map(int, beyond[0])) if beyond.size else None
             # edge loading: the ellipse runs over the groove edge (reported, see LoadDistribution.truncated)
             truncated = loaded & (contact_angle + semi_a / a.groove_radius >= self.edge_angle[None, :])
-        if off is not None:
+        if off is not None and converged:        # an iterate on its way is not checked (step_work)
             ball, contact = off
             raise LoadCapacityError(
                 f"loads {loads} are beyond what the bearing can carry: at ball {ball + 1} the contact angle of "
                 f"contact {contact + 1} would be {math.degrees(contact_angle[ball, contact]):.1f} deg, past the "
                 f"groove edge at {math.degrees(self.edge_angle[contact]):.1f} deg (load {contact_load[ball, contact]:.4g} N)")
-        if pressure.max() > self.pressure_limit:
+        if pressure.max() > self.pressure_limit and converged:
             ball, contact = np.unravel_index(int(np.argmax(pressure)), pressure.shape)
             raise LoadCapacityError(
                 f"loads {loads} are beyond what the bearing can carry: the contact pressure of ball {ball + 1}, "
@@ -594,8 +655,17 @@ class BimeSolver:
             contact_load=contact_load, contact_angle=contact_angle, interference=delta.copy(),
             contact_deflection=deflection, semi_axis_a=semi_a, semi_axis_b=semi_b,
             contact_pressure=pressure, truncated=truncated, energy=p.total, iterations=iterations, residual=residual,
-            state=np.concatenate([qs, y]), rings=self.ring_compliance,
+            state=np.concatenate([qs, y]), rings=self.ring_compliance, converged=converged,
         )
+
+
+class _WorkSpent(Exception):
+    """A bounded solve has not the work left for what its next iteration needs (``step_work``)."""
+
+
+def _stages_left(pending: PendingOperator) -> int:
+    """Stages of a pending operator's inverse still to run (:data:`SPREAD_STAGES`)."""
+    return max(len(SPREAD_STAGES) - pending.stage, 0)
 
 
 def _refresh_due(residual: float, last_residual: float | None, rtol: float) -> bool:

@@ -41,6 +41,7 @@ import numpy as np
 from ..bearing.contact import _E_TABLE, _F_TABLE, _LOG_KAPPA, effective_modulus
 from ..numerics.compiled import compile_loop, loop_factory
 from ..rings.reduced_operator import OperatorArithmetic
+from ..rings.reduced_operator import bordered_inverse as _numpy_bordered_inverse
 
 _TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
                     "f8[:, :], f8[:], f8[:], b1[:], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:], f8[:], "
@@ -729,9 +730,18 @@ def column_turn(old, new, coupling, mu, tolerance=0.0):
     return (coupling, schur_inverse, jacobian) if found else None
 
 
+#: from this many new rows on, bordering is numpy's (BLAS's products): the compiled loop sums
+#: ``W^-1 B`` and ``X S X^T`` without blocking, 7.5 ms against 1.8 ms for 90 rows onto 368,
+#: 0.65 against 0.55 ms for 16 (benchmarks/bench_operator.py --border)
+BORDER_BLAS_ROWS = 12
+
+
 def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
     """:func:`slewing_model.rings.reduced_operator.bordered_inverse` by the compiled loop (a singular
-    complement, not met, raises numpy's LinAlgError as the numpy one does)."""
+    complement, not met, raises numpy's LinAlgError as the numpy one does); by numpy's from
+    :data:`BORDER_BLAS_ROWS` new rows on."""
+    if b_mat.shape[1] >= BORDER_BLAS_ROWS:
+        return _numpy_bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
     bordered, new_coupling, schur_inverse = compiled_bordered_inverse()(
         np.ascontiguousarray(inverse), b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
     if bordered.size == 0:

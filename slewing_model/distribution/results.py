@@ -131,6 +131,12 @@ class LoadDistribution:
         The rings' compliances at the groove centres (flexible model,
         :func:`slewing_model.rings.compliance.ring_compliances`), from which
         ``ring_displacement`` follows; or those displacements, (B, 4, 2).
+    converged : bool
+        True: ``residual`` is within the solver's tolerance. False only where a bounded solve
+        (``step_work="bounded"`` of :class:`~slewing_model.distribution.bime.BimeSolver`) spent its
+        work first: then the result is the last Newton iterate, not an equilibrium (its ball loads
+        are the Hertz forces there; the load capacity is not checked), and the next warm solve goes
+        on from it.
     """
 
     model: str
@@ -150,6 +156,7 @@ class LoadDistribution:
     residual: float
     state: np.ndarray = field(repr=False)
     rings: dict | np.ndarray | None = field(default=None, repr=False, compare=False)
+    converged: bool = True
 
     @functools.cached_property
     def ring_displacement(self) -> np.ndarray | None:
@@ -199,6 +206,9 @@ class LoadDistribution:
         'static safety factor 0.269 is below 1: the '
         """
         out = []
+        if not self.converged:
+            out.append(f"not in equilibrium: a bounded step spent its work with a relative force residual of "
+                       f"{self.residual:.2g}; the next steps go on from here (step_work = bounded)")
         s = self.static_safety_factor
         if s < 1.0:
             out.append(f"static safety factor {s:.3g} is below 1: the largest contact pressure "

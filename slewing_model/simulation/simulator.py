@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..distribution.bime import BimeSolver, LoadDistribution, Loads
+from ..distribution.bime import STEP_WORK, BimeSolver, LoadDistribution, Loads
 from ..numerics.blas import blas_threads
 from ..friction.torque import friction_torque, regularised_torque
 from ..friction.kernel import compile_all, use_compiled
@@ -77,6 +77,14 @@ class SimulatorSettings:
     contact_kernel : {"auto", "numpy", "compiled"}
         The same for the load distribution's loops (its per-contact work and the reduced ring
         operator's: ``kernel`` of :class:`slewing_model.distribution.bime.BimeSolver`).
+    step_work : {"complete", "bounded"}
+        How much a step may do (``step_work`` of :class:`slewing_model.distribution.bime.BimeSolver`):
+        "complete" solves every step to ``tolerance``, however long a sudden change of the loads
+        makes it (a moment reversed in one step: tens of ms); "bounded" (real time) caps a step's
+        work at a few Newton iterations and one inversion of the ring operator, and a step that
+        would need more answers with its last iterate, ``distribution.converged`` False and its
+        ``distribution.residual``, and carries the rest over to the next steps. The first step
+        is complete.
     life : bool
         Accumulate the raceway life and wear step by step (:class:`slewing_model.life.LifeAccumulator`
         as ``BearingSimulator.life``, default :class:`slewing_model.life.LifeSettings`): the
@@ -95,12 +103,14 @@ class SimulatorSettings:
     blas_threads: int | None = 1
     friction_kernel: str = "auto"
     contact_kernel: str = "auto"
+    step_work: str = "complete"
     life: bool = False
 
     def __post_init__(self):
         _choice("ring_model", self.ring_model, RING_MODELS)
         _choice("moving_ring", self.moving_ring, ("inner", "outer"))
         _choice("load_frame", self.load_frame, LOAD_FRAMES)
+        _choice("step_work", self.step_work, STEP_WORK)
         use_compiled(self.friction_kernel, "friction_kernel")
         use_compiled(self.contact_kernel, "contact_kernel")
         for name in ("friction_coefficient", "seal_torque", "tolerance", "omega_regularisation", "friction_tolerance"):
@@ -175,7 +185,7 @@ class BearingSimulator:
             bearing = bearing.with_preload(s.preload)
         self.bearing = bearing
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
-                                 rtol=s.tolerance, kernel=s.contact_kernel)
+                                 rtol=s.tolerance, kernel=s.contact_kernel, step_work=s.step_work)
         friction, contact = use_compiled(s.friction_kernel, "friction_kernel"), use_compiled(s.contact_kernel,
                                                                                              "contact_kernel")
         if friction or contact:
@@ -240,7 +250,9 @@ class BearingSimulator:
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         if self.life is not None:
             self.life.step(None, psi, distribution)
-        self._previous, self._warm = self._warm, distribution.state
+        # an iterate on its way (a bounded step) is no point of the trajectory to extrapolate from
+        self._previous = self._warm if distribution.converged else None
+        self._warm = distribution.state
         self._psi = psi
         self.last = StepResult(distribution, signed, magnitude)
         return self.last

@@ -1,0 +1,144 @@
+"""A bounded step (``step_work="bounded"``, issue 31): a warm solve's work is capped, what it could
+not do is flagged and carried over to the next solves, and where it arrives is the complete answer.
+
+The case is the one that made the slowest steps: a tilting moment reversed in one step, which
+flips the loaded diagonal of most balls (table1, 100 balls, rings of a known stiffness,
+:mod:`synthetic_rings`; its reduced operator has about 240 rows, so its inverse is spread over
+stages as on the pitch bearing)."""
+import numpy as np
+import pytest
+
+from slewing_model import BimeSolver, Loads
+from slewing_model.distribution import bime
+from slewing_model.distribution.bime import BOUNDED_INVERSIONS, BOUNDED_ITERATIONS
+from slewing_model.distribution.kernel import BORDER_BLAS_ROWS, bordered_inverse as compiled_bordered_inverse
+from slewing_model.numerics.compiled import AVAILABLE
+from slewing_model.rings.reduced_operator import LEAF, SPREAD_STAGES, bordered_inverse
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+from statics import load_on_moving_ring
+from synthetic_rings import synthetic_superelement
+
+FORWARD = Loads(Fx=2e4, Fz=3e5, Mx=1e5, My=4e5)
+REVERSED = Loads(Fx=2e4, Fz=3e5, Mx=-1e5, My=-4e5)
+TOLERANCE = 1e-7
+
+
+@pytest.fixture(scope="module")
+def rings(table1):
+    return synthetic_superelement(table1.ball_count)
+
+
+class OperatorWork:
+    """What each solve asked of the ring operator, counted at the calls the solver makes, in
+    inversions: a stage of a spread inverse is ``1 / len(SPREAD_STAGES)`` of one, an inverse at once
+    is one, bordering ``r`` rows onto ``n`` is ``3 r / n`` (its ``4 n^2 r`` flops against ``n^3``)."""
+
+    def __init__(self, monkeypatch):
+        self.work = 0.0
+        stage = 1.0 / len(SPREAD_STAGES)
+
+        def counted(name, cost):
+            original = getattr(bime, name)
+
+            def call(*args, **kwargs):
+                self.work += cost(*args)
+                return original(*args, **kwargs)
+            monkeypatch.setattr(bime, name, call)
+
+        counted("start_operator", lambda *a: stage)
+        counted("advance_operator", lambda pending, *a: stage if pending.stage < len(SPREAD_STAGES) else 0.0)
+        counted("complete_operator", lambda pending, *a: stage * max(len(SPREAD_STAGES) - pending.stage, 0))
+        counted("assemble_operator", lambda *a: 1.0)
+
+        def bordering(op, point, compliance, stiffness, jacobian, active, *rest):
+            new_rows = 2 * np.count_nonzero(active & ~op.active)
+            return 3.0 * new_rows / op.rows.size if new_rows <= 0.25 * op.rows.size else 0.0
+        counted("update_operator", bordering)
+
+    def take(self) -> float:
+        work, self.work = self.work, 0.0
+        return work
+
+
+def reversal(table1, rings, step_work, work=None, steps=40):
+    """Forward load solved (cold), then the moment reversed and held: the results and the ring
+    operator's work of each warm solve."""
+    sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
+                                                           step_work=step_work))
+    sim.step(FORWARD, 0.0, 0.0)
+    results, spent = [], []
+    if work is not None:
+        work.take()
+    for _ in range(steps):
+        results.append(sim.step(REVERSED, 0.0, 0.0).distribution)
+        spent.append(None if work is None else work.take())
+    return results, spent
+
+
+def test_a_bounded_step_does_at_most_its_share_of_the_work(table1, rings, monkeypatch):
+    work = OperatorWork(monkeypatch)
+    complete, complete_work = reversal(table1, rings, "complete", work, steps=2)
+    results, spent = reversal(table1, rings, "bounded", work)
+    # the complete solve of the reversal inverts the operator more than once: the case discriminates
+    assert complete_work[0] > 1.0 and complete[0].iterations > BOUNDED_ITERATIONS
+    assert max(spent) <= BOUNDED_INVERSIONS + 1e-12
+    assert max(r.iterations for r in results) <= BOUNDED_ITERATIONS
+    assert not results[0].converged
+
+
+def test_a_bounded_step_flags_what_it_carries_over_and_arrives_at_the_complete_answer(table1, rings):
+    results, _ = reversal(table1, rings, "bounded")
+    for r in results:                       # the flag says what the residual says
+        assert r.converged == (r.residual <= TOLERANCE)
+        assert any("not in equilibrium" in w for w in r.warnings()) == (not r.converged)
+    first = next(k for k, r in enumerate(results) if r.converged)
+    assert 1 <= first < 20 and all(r.converged for r in results[first:])
+    reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)           # cold, to round-off
+    arrived = results[-1]
+    # both within 1e-7 of the load scale: the displacements agree to about 1e-6
+    assert np.allclose(arrived.displacement, reference.displacement, rtol=2e-6, atol=1e-6 * np.abs(
+        reference.displacement).max())
+    assert arrived.max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
+    # statics, independent of the solver: the contacts balance the applied load (ring deformation
+    # moves the groove centres by micrometres: 1e-4 of the load)
+    balance = load_on_moving_ring(table1, arrived)
+    assert np.allclose(balance, REVERSED.as_array(), atol=1e-4 * 4e5)
+
+
+def test_an_iterate_on_its_way_is_not_refused_for_capacity(table1, rings):
+    """Its contact angles are those of an iterate: the capacity check waits for the equilibrium."""
+    results, _ = reversal(table1, rings, "bounded", steps=1)
+    assert not results[0].converged and results[0].residual > 10 * TOLERANCE
+
+
+def test_a_cold_solve_is_complete_whatever_the_step_work(table1, rings, monkeypatch):
+    work = OperatorWork(monkeypatch)
+    bounded = BimeSolver(table1, rings, rtol=TOLERANCE, step_work="bounded").solve(REVERSED)
+    assert bounded.converged and work.take() > BOUNDED_INVERSIONS
+    complete = BimeSolver(table1, rings, rtol=TOLERANCE).solve(REVERSED)
+    assert np.array_equal(bounded.state, complete.state)
+
+
+def test_unknown_step_work_is_refused_with_its_name(table1):
+    with pytest.raises(ValueError, match="step_work = 'fast': must be one of 'complete', 'bounded'"):
+        SimulatorSettings(step_work="fast")
+    with pytest.raises(ValueError, match="step_work = 'fast'"):
+        BimeSolver(table1, step_work="fast")
+
+
+@pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
+@pytest.mark.parametrize("new_rows", [2, BORDER_BLAS_ROWS + 8])
+def test_bordered_inverse_is_the_inverse_of_the_bordered_matrix(new_rows):
+    """Compiled (few new rows) or by BLAS (many): against LAPACK's inverse of the whole matrix."""
+    rng = np.random.default_rng(new_rows)
+    n = 3 * LEAF
+    a = rng.standard_normal((n + new_rows, n + new_rows))
+    w = a @ a.T + (n + new_rows) * np.eye(n + new_rows)
+    inverse = np.linalg.inv(w[:n, :n])
+    jacobian, new_jacobian = rng.standard_normal((n, 5)), rng.standard_normal((new_rows, 5))
+    args = (0.5 * (inverse + inverse.T), w[:n, n:], w[n:, n:], jacobian, inverse @ jacobian, new_jacobian, 1e-9)
+    expected = np.linalg.inv(w)
+    for bordering in (compiled_bordered_inverse, bordered_inverse):
+        bordered, coupling, _ = bordering(*args)
+        assert np.allclose(bordered, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+        assert np.allclose(coupling, expected @ np.vstack([jacobian, new_jacobian]), atol=1e-12)
