@@ -64,9 +64,11 @@ def rss_mb() -> float:
         return int(fh.read().split()[1]) * resource.getpagesize() / 1e6
 
 
-def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = None, outputs=OUTPUTS) -> None:
+def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = None, outputs=OUTPUTS,
+           trace: str | None = None) -> None:
     """Instantiate the FMU (the case's integer parameters, then ``integers``), then answer lines
-    ``first count`` on stdin with the step times and the last ``outputs`` (JSON)."""
+    ``first count`` on stdin with the step times and the last ``outputs`` (JSON); with ``trace``, the
+    value of that output after every step too."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
@@ -87,9 +89,10 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
     inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in outputs]
     compiled = "numba" in sys.modules
     print(json.dumps({"instantiate": instantiate, "compiled": compiled}), flush=True)
+    traced = refs[trace] if trace else None
     for line in sys.stdin:
         first, count = map(int, line.split())
-        times = []
+        times, values_traced = [], []
         for k in range(first, first + count):
             values = [*map(float, case.loads[k]), float(case.psi[k]), float(case.omega[k])]
             t0 = time.perf_counter()
@@ -97,7 +100,9 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
             fmu.doStep(k * DT, DT)                      # fmpy raises on a status other than OK
             last = fmu.getReal(outputs)
             times.append(time.perf_counter() - t0)
-        print(json.dumps({"times": times, "rss_mb": rss_mb(), "last": last}), flush=True)
+            if traced is not None:
+                values_traced.append(fmu.getReal([traced])[0])
+        print(json.dumps({"times": times, "rss_mb": rss_mb(), "last": last, "trace": values_traced}), flush=True)
     fmu.terminate()
     fmu.freeInstance()
     shutil.rmtree(unzipped, ignore_errors=True)
@@ -107,9 +112,10 @@ class Worker:
     """The parent's handle on a worker process."""
 
     def __init__(self, fmu_path: Path, case_name: str, steps: int, without_numba: bool = False,
-                 integers: dict | None = None, outputs=OUTPUTS):
+                 integers: dict | None = None, outputs=OUTPUTS, trace: str | None = None):
         command = [sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps),
-                   "--worker-options", json.dumps({"integers": integers or {}, "outputs": list(outputs)})]
+                   "--worker-options", json.dumps({"integers": integers or {}, "outputs": list(outputs),
+                                                   "trace": trace})]
         if without_numba:
             command.append("--without-numba")
         self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)

@@ -8,7 +8,13 @@ matrix products) and by ``np.linalg.inv`` (LU, then triangular solves), alternat
 BLAS thread as in a step; it prints the median and tail of each, their ratio, and the
 residual ``|X W - I|`` of both.
 
-Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30]
+With ``--border``: bordering a kept inverse of 368 rows (the pitch bearing's) by ``r`` new rows,
+the compiled loop (:func:`slewing_model.distribution.kernel._bordered_inverse`) against numpy's
+products (:func:`slewing_model.rings.reduced_operator.bordered_inverse`), alternately, beside an
+inversion of the whole: where the kernel hands bordering to numpy
+(:data:`slewing_model.distribution.kernel.BORDER_BLAS_ROWS`) and what a bounded step counts it as.
+
+Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border]
 """
 from __future__ import annotations
 
@@ -60,11 +66,48 @@ def formed_operators(case_name: str, steps: int) -> list[np.ndarray]:
     return formed
 
 
+def bordering(runs: int, n: int = 368) -> None:
+    """Bordering ``r`` rows onto an inverse of ``n`` rows: compiled loop against numpy's products."""
+    from slewing_model.distribution.bime import bordering_work
+    from slewing_model.distribution.kernel import compiled_bordered_inverse
+
+    rng = np.random.default_rng(0)
+    rows = []
+    with blas_threads(1):
+        for r in (2, 4, 8, 12, 16, 32, 64, 92):
+            a = rng.standard_normal((n + r, n + r))
+            w = a @ a.T + (n + r) * np.eye(n + r)
+            inverse = np.linalg.inv(w[:n, :n])
+            inverse = 0.5 * (inverse + inverse.T)
+            jacobian, new_jacobian = rng.standard_normal((n, 5)), rng.standard_normal((r, 5))
+            args = (inverse, np.ascontiguousarray(w[:n, n:]), np.ascontiguousarray(w[n:, n:]), jacobian,
+                    inverse @ jacobian, new_jacobian, 1e-9)
+            methods = {"compiled": compiled_bordered_inverse(), "numpy": reduced_operator.bordered_inverse,
+                       "inversion": lambda *_: reduced_operator.spd_inverse(w[:n, :n])}
+            times = {m: [] for m in methods}
+            for _ in range(runs):
+                for m, f in methods.items():
+                    start = time.perf_counter()
+                    f(*args)
+                    times[m].append(time.perf_counter() - start)
+            med = {m: float(np.median(t)) * 1e3 for m, t in times.items()}
+            rows.append([str(r), f"{med['compiled']:.2f}", f"{med['numpy']:.2f}", f"{med['inversion']:.2f}",
+                         f"{med['compiled'] / med['numpy']:.2f}", f"{med['numpy'] / med['inversion']:.2f}",
+                         f"{bordering_work(r, n):.2f}"])
+    print_table(f"Bordering r rows onto an inverse of {n} rows, one BLAS thread, medians of {runs} runs, "
+                "methods alternating [ms]",
+                ["r", "compiled", "numpy", f"inversion of {n}", "compiled / numpy", "numpy / inversion",
+                 "counted (bordering_work)"], rows)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--runs", type=int, default=30, help="inversions of each operator by each method")
     parser.add_argument("--steps", type=int, default=200, help="steps of each case that form the operators")
+    parser.add_argument("--border", action="store_true", help="time bordering instead (compiled against numpy)")
     args = parser.parse_args()
+    if args.border:
+        return bordering(args.runs)
     rows = []
     for name in ("pitch", "yaw"):
         operators = formed_operators(name, args.steps)

@@ -11,9 +11,12 @@ friction and life on: the FMU's defaults) with its loads in the blade-root frame
 4. ``feather``: an emergency feather at 8 deg/s for 4 s and back, under the mean load;
 5. ``turbulence``: the mean load varying by ±30 % at 0.6 Hz plus ±10 % at 3 Hz (every component).
 
-Each FMU (this tree's and a baseline revision's, built by that revision's own build_fmu.py) runs
-in a worker process of its own through fmpy (``bench_fmu.Worker``); their runs of each scenario
-alternate in blocks, so both see the same machine load. A step is ``setReal`` of the 7 inputs,
+Three versions: this tree's FMU as built (``step_work`` = 1, complete: every step solved to the
+tolerance), the same FMU with ``step_work`` = 2 (bounded: a step's work capped, what it could not do
+carried over and flagged by ``equilibrium_residual`` above the tolerance; the table counts those
+steps), and a baseline revision's (built by that revision's own build_fmu.py). Each runs in a
+worker process of its own through fmpy (``bench_fmu.Worker``); their runs of each scenario
+alternate in blocks, so all see the same machine load. A step is ``setReal`` of the 7 inputs,
 ``doStep`` (10 ms) and ``getReal`` of 5 outputs. "first step" is the first ``doStep`` after
 instantiation (the FMU solved its start values, zero loads, when leaving initialization).
 
@@ -45,6 +48,8 @@ PARAMETERS = {"ring_model": 2, "load_frame": 2}
 #: the revision before issue 31's work (main at the start of that turn)
 DEFAULT_BASELINE = "f1ef800"
 SCENARIOS = ("nrel", "reversal", "jump", "feather", "turbulence")
+#: the FMU's default tolerance: a step whose equilibrium_residual is above it was stopped by step_work = 2
+TOLERANCE = 1e-7
 
 
 def nrel_series() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -101,7 +106,9 @@ def main() -> None:
 
     with tempfile.TemporaryDirectory(prefix="bench_realtime_") as tmp:
         tmp = Path(tmp)
-        fmus = {"current": Path(build_fmu(BEARING, tmp / "current.fmu"))}
+        current = Path(build_fmu(BEARING, tmp / "current.fmu"))
+        fmus = {"complete": current, "bounded": current}
+        integers = {"bounded": {"step_work": 2}}
         if args.baseline != "none":
             fmus["baseline"] = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",))["pitch_bearing"]
         rows, medians = [], {}
@@ -109,12 +116,17 @@ def main() -> None:
             case = scenario(name)
             path = save(case, tmp / f"{name}.npz")
             block = case.steps // args.blocks
-            workers = {v: Worker(fmu, str(path), case.steps, outputs=OUTPUTS) for v, fmu in fmus.items()}
+            workers = {v: Worker(fmu, str(path), case.steps, outputs=OUTPUTS, integers=integers.get(v),
+                                 trace=None if v == "baseline" else "equilibrium_residual")
+                       for v, fmu in fmus.items()}
             times = {v: [] for v in fmus}
+            flagged = {v: 0 for v in fmus}
             first = {}
             for b in range(args.blocks):
                 for v, w in workers.items():
-                    t = w.run(b * block, block)["times"]
+                    answer = w.run(b * block, block)
+                    t = answer["times"]
+                    flagged[v] += sum(r > TOLERANCE for r in answer["trace"])
                     if b == 0:
                         first[v] = t[0]
                         t = t[1:]
@@ -124,18 +136,19 @@ def main() -> None:
                 t = np.array(times[v]) * 1e3
                 medians[name, v] = float(np.median(t))
                 rows.append([name, v, f"{first[v] * 1e3:.1f}", f"{np.median(t):.2f}", f"{np.percentile(t, 99):.2f}",
-                             f"{t.max():.1f}", f"{first[v] * 1e3 / np.median(t):.0f}"])
+                             f"{t.max():.1f}", f"{first[v] * 1e3 / np.median(t):.0f}",
+                             "–" if v == "baseline" else str(flagged[v])])
             print(f"  {name}: {case.description} ({case.steps} steps)", flush=True)
         for row in rows:
             name, v = row[0], row[1]
             ratio = medians[name, v] / medians[name, "baseline"] if "baseline" in fmus else math.nan
-            slowest = float(row[5]) / medians.get(("nrel", v), math.nan)
+            slowest = float(row[5]) / medians.get(("nrel", "complete"), math.nan)
             row += [f"{ratio:.2f}", f"{slowest:.1f}"]
         print_table("Pitch bearing FMU through fmpy (flexible rings, friction and life on), one step = setReal + "
                     f"doStep ({DT * 1e3:.0f} ms) + getReal; {args.blocks} alternating blocks per scenario; "
                     f"baseline {args.baseline}",
                     ["scenario", "version", "first step [ms]", "median [ms]", "p99 [ms]", "slowest [ms]",
-                     "first / median", "median / baseline's", "slowest / NREL median"], rows)
+                     "first / median", "flagged steps", "median / baseline's", "slowest / NREL median"], rows)
 
 
 if __name__ == "__main__":

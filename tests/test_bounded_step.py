@@ -31,7 +31,7 @@ def rings(table1):
 class OperatorWork:
     """What each solve asked of the ring operator, counted at the calls the solver makes, in
     inversions: a stage of a spread inverse is ``1 / len(SPREAD_STAGES)`` of one, an inverse at once
-    is one, bordering ``r`` rows onto ``n`` is ``3 r / n`` (its ``4 n^2 r`` flops against ``n^3``)."""
+    is one, bordering ``r`` rows onto ``n`` is :func:`~slewing_model.distribution.bime.bordering_work`."""
 
     def __init__(self, monkeypatch):
         self.work = 0.0
@@ -52,7 +52,7 @@ class OperatorWork:
 
         def bordering(op, point, compliance, stiffness, jacobian, active, *rest):
             new_rows = 2 * np.count_nonzero(active & ~op.active)
-            return 3.0 * new_rows / op.rows.size if new_rows <= 0.25 * op.rows.size else 0.0
+            return bime.bordering_work(new_rows, op.rows.size) if new_rows <= 0.25 * op.rows.size else 0.0
         counted("update_operator", bordering)
 
     def take(self) -> float:

@@ -82,9 +82,8 @@ FINISH_ITERATIONS = 3
 #: iteration past this many in one solve is still slow (docs/speed.md)
 SPREAD_ITERATIONS = 8
 #: what a bounded warm solve (``step_work="bounded"``) may spend: the ring operator's work, in
-#: inversions of ``W = (A^-1 + M)_aa`` (a stage of a spread inversion is half of one; bordering ``r``
-#: new rows onto ``n`` is ``3 r / n``: ``4 n^2 r`` flops against about ``n^3``, measured 1.8 against
-#: 2.5 ms for 90 rows onto 368) ...
+#: inversions of ``W = (A^-1 + M)_aa`` (a stage of a spread inversion is half of one; bordering:
+#: :func:`bordering_work`) ...
 BOUNDED_INVERSIONS = 1.0
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Bounded steps")
@@ -584,7 +583,7 @@ class BimeSolver:
                 return op
             new_rows = 2 * int(np.count_nonzero(closed))
             if new_rows <= 0.25 * op.rows.size:                # else update_operator declines: no work
-                self._spend(3.0 * new_rows / op.rows.size)
+                self._spend(bordering_work(new_rows, op.rows.size))
             return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
 
         if not fresh and op is not None:
@@ -657,6 +656,13 @@ class BimeSolver:
             contact_pressure=pressure, truncated=truncated, energy=p.total, iterations=iterations, residual=residual,
             state=np.concatenate([qs, y]), rings=self.ring_compliance, converged=converged,
         )
+
+
+def bordering_work(new_rows: int, kept_rows: int) -> float:
+    """Bordering ``new_rows`` onto a kept operator of ``kept_rows``, in inversions of the kept one:
+    ``3.5 r / n`` (``4 n^2 r`` flops against about ``n^3``; measured on one BLAS thread, 368 rows: 0.85
+    of an inversion for 92 new rows, 0.34 for 32; ``benchmarks/bench_operator.py --border``)."""
+    return 3.5 * new_rows / kept_rows
 
 
 class _WorkSpent(Exception):

@@ -731,8 +731,8 @@ def column_turn(old, new, coupling, mu, tolerance=0.0):
 
 
 #: from this many new rows on, bordering is numpy's (BLAS's products): the compiled loop sums
-#: ``W^-1 B`` and ``X S X^T`` without blocking, 7.5 ms against 1.8 ms for 90 rows onto 368,
-#: 0.65 against 0.55 ms for 16 (benchmarks/bench_operator.py --border)
+#: ``W^-1 B`` and ``X S X^T`` without blocking: 7.3 ms against 2.0 ms for 92 rows onto 368, 0.75
+#: against 0.60 ms for 16, 0.52 against 0.58 for 12 (benchmarks/bench_operator.py --border)
 BORDER_BLAS_ROWS = 12
 
 
