@@ -224,8 +224,11 @@ def build_simulator(slave, error) -> bool:
         slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
         from slewing_model.numerics.compiled import use_compiled
 
-        slave.log(f"{slave.instance_name}: loops " + (f"compiled by numba for {numba_target()}" if use_compiled(kernels)
-                                                      else "run by numpy"))
+        from slewing_model.numerics.compiled import aot_kernels
+
+        compiled = ("compiled ahead of time (generic x86-64)" if aot_kernels() is not None
+                    else f"compiled by numba for {numba_target()}")
+        slave.log(f"{slave.instance_name}: loops " + (compiled if use_compiled(kernels) else "run by numpy"))
         return True
     except ValueError as exc:
         slave.log(f"{slave.instance_name}: {exc}", error)

@@ -694,10 +694,13 @@ _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric
             "_trial_point", "_newton_step", "_ring_times", "_schur_inverse")
 
 
+#: numpy's floating-point semantics: a division by zero gives inf or NaN as the numpy code does,
+#: instead of raising
+ERROR_MODEL = "numpy"
+
+
 def _compile(function, signature):
-    """Compiled with numpy's floating-point semantics: a division by zero gives inf or NaN as the
-    numpy code does, instead of raising."""
-    return compile_loop(function, signature, _HELPERS, error_model="numpy")
+    return compile_loop(function, signature, _HELPERS, error_model=ERROR_MODEL)
 
 
 #: (factory, Python function) of each compiled loop of the load distribution

@@ -422,8 +422,12 @@ _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evalua
             "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results")
 
 
+#: numba's error model of these loops (Python's: a division by zero raises)
+ERROR_MODEL = "python"
+
+
 def _compile(function, signature):
-    return compile_loop(function, signature, _HELPERS)
+    return compile_loop(function, signature, _HELPERS, error_model=ERROR_MODEL)
 
 
 _CONTACT_SET_SIGNATURE = ("Tuple((i8, i8, i8[:], i8[:], i8[:], i8[:], i8[:], f8[:, :], b1[:], f8[:]))("

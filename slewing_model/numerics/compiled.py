@@ -5,11 +5,50 @@ numba is optional (it is not part of the FMU's run-time requirements): without i
 round-off. A kernel module enters each loop with :func:`loop_factory` in its own ``KERNELS`` list;
 the loop is compiled when first asked for (or loaded from numba's on-disk cache, ``__pycache__``
 beside the kernel's source, keyed by the source's content).
+
+The same loops compiled ahead of time (``build_aot.py``: numba's ``pycc``, an extension module
+named :data:`AOT_MODULE` that needs numpy only) take the place of numba where that module can be
+imported and was compiled from these sources (:func:`kernel_source_hash`): an FMU built with
+``--aot`` carries it instead of numba and llvmlite. A module of other sources is not used.
 """
 from __future__ import annotations
 
 import functools
+import hashlib
+import importlib
 import importlib.util
+from pathlib import Path
+
+#: the extension module of the loops compiled ahead of time (build_aot.py)
+AOT_MODULE = "slewing_kernels"
+#: the sources the loops are compiled from: the kernels, what they take from other modules, this registry
+KERNEL_SOURCES = ("distribution/kernel.py", "friction/kernel.py", "bearing/contact.py", "numerics/compiled.py")
+
+
+def kernel_source_hash() -> int:
+    """A 62-bit hash of :data:`KERNEL_SOURCES`: what an ahead-of-time module was compiled from."""
+    digest = hashlib.sha256()
+    package = Path(__file__).resolve().parents[1]
+    for name in KERNEL_SOURCES:
+        digest.update((package / name).read_bytes().replace(b"\r\n", b"\n"))
+    return int.from_bytes(digest.digest()[:8], "little") >> 2
+
+
+def aot_name(function) -> str:
+    """The name of ``function``'s loop in the ahead-of-time module: ``<subpackage>_<name>``
+    (``distribution__trial_point``)."""
+    return f"{function.__module__.split('.')[-2]}_{function.__name__}"
+
+
+@functools.lru_cache(maxsize=1)
+def aot_kernels():
+    """The ahead-of-time module where it can be imported and its ``source_hash()`` is
+    :func:`kernel_source_hash`; None otherwise."""
+    try:
+        module = importlib.import_module(AOT_MODULE)
+        return module if module.source_hash() == kernel_source_hash() else None
+    except (ImportError, AttributeError, OSError):
+        return None
 
 
 def _numba_installed() -> bool:
@@ -21,7 +60,7 @@ def _numba_installed() -> bool:
 
 #: numba can be imported here (it is imported, and the loop compiled, only when first asked for:
 #: importing numba also imports scipy, which the run-time part does not otherwise need)
-AVAILABLE = _numba_installed()
+AVAILABLE = aot_kernels() is not None or _numba_installed()
 
 #: how the friction model may run its loops (``kernel`` of ``friction_torque``)
 KERNEL_CHOICES = ("auto", "numpy", "compiled")
@@ -34,7 +73,8 @@ def use_compiled(kernel: str, name: str = "kernel") -> bool:
     if kernel not in KERNEL_CHOICES:
         raise ValueError(f"{name} = {kernel!r}: must be 'auto', 'numpy' or 'compiled'")
     if kernel == "compiled" and not AVAILABLE:
-        raise ValueError(f"{name} = 'compiled' needs numba, which is not installed in this Python "
+        raise ValueError(f"{name} = 'compiled' needs numba, which is not installed in this Python, or the "
+                         f"loops compiled ahead of time ({AOT_MODULE}, build_aot.py) "
                          "(pip install numba, or use 'auto' or 'numpy')")
     return AVAILABLE and kernel != "numpy"
 
@@ -50,11 +90,18 @@ def compile_loop(function, signature: str, helpers: tuple = (), error_model: str
     NaN as numpy does, instead of raising."""
     import numba
 
-    module = function.__globals__
+    compile_helpers(function.__globals__, helpers, error_model)
+    return numba.njit(signature, cache=True, nogil=True, error_model=error_model)(function)
+
+
+def compile_helpers(module: dict, helpers: tuple, error_model: str = "python") -> None:
+    """Each of ``helpers`` (names in the globals ``module``) compiled in place of its Python
+    definition, once (:func:`compile_loop`; ``build_aot.py`` before it exports the loops)."""
+    import numba
+
     for name in helpers:
         if not hasattr(module[name], "py_func"):          # not compiled yet
             module[name] = numba.njit(cache=True, nogil=True, error_model=error_model)(module[name])
-    return numba.njit(signature, cache=True, nogil=True, error_model=error_model)(function)
 
 
 def loop_factory(registry: list, compile_function, function, signature: str):
@@ -65,8 +112,13 @@ def loop_factory(registry: list, compile_function, function, signature: str):
     step, and ``build_fmu.py`` ships their cache."""
     @functools.lru_cache(maxsize=1)
     def factory():
+        aot = aot_kernels()
+        if aot is not None:
+            return getattr(aot, aot_name(function))
         return compile_function(function, signature)
 
-    factory.__doc__ = f"The compiled :func:`{function.__name__}` (numba, eager signature, numba's on-disk cache)."
+    factory.__doc__ = (f"The compiled :func:`{function.__name__}` (ahead of time where its module is here; else "
+                       f"numba, eager signature, numba's on-disk cache).")
+    factory.signature = signature
     registry.append((factory, function))
     return factory

@@ -1,0 +1,138 @@
+"""The compiled loops ahead of time (build time only; used by ``build_fmu.py --aot``).
+
+The load distribution's and the friction's loops (``slewing_model/distribution/kernel.py``,
+``slewing_model/friction/kernel.py``: every entry of their ``KERNELS``) are compiled once here, by
+numba's ahead-of-time compiler (``numba.pycc``), into one CPython extension module,
+:data:`slewing_model.numerics.compiled.AOT_MODULE`, for a generic x86-64 CPU. That module needs
+numpy only, not numba or llvmlite (LLVM, 179 of a numba FMU's 270 MB unpacked), and starts
+without compiling or reading a cache. Each loop is exported under
+:func:`~slewing_model.numerics.compiled.aot_name` with its eager signature and its module's
+error model; ``source_hash()`` returns the hash of the sources it was compiled from, which the
+registry checks before it takes the module (:func:`slewing_model.numerics.compiled.aot_kernels`).
+
+The compilation (about a minute) runs in a child process, since it compiles the kernels'
+helpers in place in their modules; its product is cached under
+``$SLEWING_CACHE_DIR/aot/<key>/`` (key: the sources' hash, numba's version, the Python ABI).
+
+numba's ``pycc`` is pending deprecation ("replacement technology is being developed"); it is in
+the pinned numba 0.68.1 and gives the same numbers as numba's JIT, bit for bit, on the benchmark
+cases (docs/speed.md, "Ahead of time"). Linux only: the win64 half of an FMU runs numpy's loops.
+
+Run: .venv/bin/python build_aot.py [-o FOLDER]    (prints the module's path)
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import warnings
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent
+#: the modules whose KERNELS are compiled
+KERNEL_MODULES = ("slewing_model.distribution.kernel", "slewing_model.friction.kernel")
+
+
+def module_file_name() -> str:
+    """The extension module's file name for this Python (``slewing_kernels.cpython-311-x86_64-linux-gnu.so``)."""
+    from slewing_model.numerics.compiled import AOT_MODULE
+
+    return AOT_MODULE + sysconfig.get_config_var("EXT_SUFFIX")
+
+
+def cache_key() -> str:
+    import numba
+
+    from slewing_model.numerics.compiled import kernel_source_hash
+
+    return f"{kernel_source_hash():016x}-numba{numba.__version__}-{sysconfig.get_config_var('SOABI')}"
+
+
+def aot_cache_dir() -> Path:
+    """``$SLEWING_CACHE_DIR/aot``, else ``~/.cache/slewing_model/aot``."""
+    from slewing_model.rings.superelement.build import default_cache_dir
+
+    return Path(default_cache_dir()) / "aot"
+
+
+def build_kernels(output_dir=None, stage=None) -> Path:
+    """The ahead-of-time module of this tree's loops (compiled, or taken from the cache); copied
+    into ``output_dir`` where given. Returns its path."""
+    say = stage or (lambda line: None)
+    cached = aot_cache_dir() / cache_key() / module_file_name()
+    if not cached.exists():
+        say("compiling the loops ahead of time with numba's pycc (about a minute, once per change of the "
+            "kernels) ...")
+        with tempfile.TemporaryDirectory(prefix="slewing_aot_") as tmp:
+            run = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--compile", tmp], cwd=ROOT,
+                                 capture_output=True, text=True)
+            built = Path(tmp) / module_file_name()
+            if run.returncode != 0 or not built.exists():
+                raise RuntimeError(f"compiling the loops ahead of time failed (exit {run.returncode}):\n"
+                                   f"{run.stdout[-3000:]}\n{run.stderr[-3000:]}")
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            partial = cached.with_suffix(".partial")
+            shutil.copy2(built, partial)
+            os.replace(partial, cached)
+    if output_dir is None:
+        return cached
+    Path(output_dir).mkdir(parents=True, exist_ok=True)
+    target = Path(output_dir) / cached.name
+    shutil.copy2(cached, target)
+    return target
+
+
+def _compile(output_dir: str) -> None:
+    """In the child process: export every loop of :data:`KERNEL_MODULES` and ``source_hash``."""
+    warnings.simplefilter("ignore")                      # pycc's pending deprecation
+    import numba
+    import numba.pycc.compiler as pycc_compiler
+    from numba.pycc import CC
+
+    from slewing_model.numerics.compiled import AOT_MODULE, aot_name, compile_helpers, kernel_source_hash
+
+    cc = CC(AOT_MODULE)
+    cc.output_dir = output_dir
+    cc.verbose = False
+    error_models = {}
+    for name in KERNEL_MODULES:
+        module = importlib.import_module(name)
+        compile_helpers(vars(module), module._HELPERS, module.ERROR_MODEL)
+        for factory, function in module.KERNELS:
+            cc.export(aot_name(function), factory.signature)(function)
+            error_models[function] = module.ERROR_MODEL
+    source_hash = kernel_source_hash()
+    cc.export("source_hash", "i8()")(lambda: source_hash)
+
+    # pycc compiles every export with one set of flags: give each loop its module's error model
+    original = pycc_compiler.compile_extra
+
+    def compile_extra(typingctx, targetctx, func, args, return_type, flags, locals, **kwargs):
+        flags.error_model = error_models.get(func, "python")
+        return original(typingctx, targetctx, func, args, return_type, flags, locals, **kwargs)
+
+    pycc_compiler.compile_extra = compile_extra
+    cc.compile()
+    print(numba.__version__)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("-o", "--output", help="copy the module into this folder")
+    parser.add_argument("--compile", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    sys.path.insert(0, str(ROOT))
+    if args.compile:
+        _compile(args.compile)
+        return 0
+    print(build_kernels(args.output, stage=print))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,119 @@
+"""The loops compiled ahead of time (``build_aot.py``, issue 31): a module that needs numpy only,
+equal to numba's JIT, used only where it was compiled from these sources, and an FMU that
+carries it instead of numba and runs in a C host."""
+import json
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from slewing_model.numerics import compiled
+
+ROOT = Path(__file__).resolve().parents[1]
+BEARING = ROOT / "examples" / "bearings" / "table3_errors.toml"
+STEPS = 60
+
+pytestmark = pytest.mark.skipif(not compiled._numba_installed(), reason="numba (its pycc) is not installed here")
+
+#: a step series of table3 with errors, flexible rings, friction and life on, printed as JSON; with
+#: "aot", numba and llvmlite cannot be imported and the module's folder comes first on the path
+SERIES = r'''
+import json, sys
+if sys.argv[1] == "aot":
+    sys.modules["numba"] = sys.modules["llvmlite"] = None
+    sys.path.insert(0, sys.argv[2])
+sys.path.insert(0, sys.argv[3])
+from slewing_model import Loads, load_bearing
+from slewing_model.numerics import compiled
+from slewing_model.rings.superelement import build_superelement
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+bearing = load_bearing(sys.argv[4])
+settings = SimulatorSettings(life=True, contact_kernel="compiled", friction_kernel="compiled")
+sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"), settings)
+out = []
+for k in range(int(sys.argv[5])):
+    r = sim.step(Loads(8e3, -3e3, 3e4 + 1e3 * k, 1.5e3 * (-1) ** (k // 20), -2.5e3), 0.4 + 0.01 * k, 0.05)
+    d = r.distribution
+    out.append([*d.displacement, d.max_ball_load, r.friction_torque, d.contact_load[19, 1], sim.life.worst_damage])
+print(json.dumps({"aot": compiled.aot_kernels() is not None, "numba": sys.modules.get("numba") is not None,
+                  "out": out}))
+'''
+
+
+@pytest.fixture(scope="module")
+def aot_folder(tmp_path_factory):
+    sys.path.insert(0, str(ROOT))
+    import build_aot
+
+    return build_aot.build_kernels(tmp_path_factory.mktemp("aot")).parent
+
+
+def _series(mode, folder):
+    run = subprocess.run([sys.executable, "-c", SERIES, mode, str(folder), str(ROOT), str(BEARING), str(STEPS)],
+                         capture_output=True, text=True, timeout=900)
+    assert run.returncode == 0, run.stderr[-3000:]
+    return json.loads(run.stdout.splitlines()[-1])
+
+
+def test_loops_compiled_ahead_of_time_equal_numbas_without_numba(aot_folder):
+    jit, aot = _series("jit", aot_folder), _series("aot", aot_folder)
+    assert not jit["aot"] and jit["numba"]
+    assert aot["aot"] and not aot["numba"]            # numba could not be imported, nor was it needed
+    # the same LLVM code for another CPU target: equal, observed bit for bit
+    assert np.allclose(aot["out"], jit["out"], rtol=1e-12, atol=0)
+
+
+def test_a_module_of_other_sources_is_not_used(aot_folder, monkeypatch):
+    monkeypatch.syspath_prepend(str(aot_folder))
+    compiled.aot_kernels.cache_clear()
+    try:
+        assert compiled.aot_kernels() is not None
+        monkeypatch.setattr(compiled, "kernel_source_hash", lambda: 12345)
+        compiled.aot_kernels.cache_clear()
+        assert compiled.aot_kernels() is None
+    finally:                                              # the other tests run numba's loops
+        monkeypatch.undo()
+        sys.modules.pop(compiled.AOT_MODULE, None)
+        compiled.aot_kernels.cache_clear()
+    assert compiled.aot_kernels() is None                 # the tests' own path has no such module
+
+
+def test_fmu_with_loops_compiled_ahead_of_time_runs_in_a_c_host_without_numba(aot_folder, tmp_path, table3_fmu):
+    """The FMU built with aot=True carries the module and no numba; in our C host (no Python of
+    this machine, a bare environment) it says so and answers as the numpy FMU does."""
+    from fmpy import read_model_description
+
+    from build_fmu import build_fmu
+    from host_output import parse_host_output
+
+    fmu = build_fmu(BEARING, tmp_path / "aot.fmu", mesh="coarse", bc="free", aot=True, win64=False)
+    names = zipfile.ZipFile(fmu).namelist()
+    assert any(n.startswith("resources/slewing_kernels") for n in names)
+    assert not any("/site-packages/numba/" in n or "/site-packages/llvmlite/" in n for n in names)
+    assert fmu.stat().st_size < 1.15 * table3_fmu.stat().st_size     # numpy's FMU and a 1.5 MB module
+    host = tmp_path / "host"
+    subprocess.run(["cc", "-O1", "-o", str(host), str(ROOT / "tests/c_host/host.c"), "-ldl", "-lm"], check=True)
+    values, logs = {}, {}
+    for name, path in (("aot", fmu), ("numpy", table3_fmu)):
+        folder = tmp_path / name
+        with zipfile.ZipFile(path) as z:
+            z.extractall(folder)
+        md = read_model_description(str(path))
+        refs = {v.name: v.valueReference for v in md.modelVariables}
+        vrs = [str(refs[n]) for n in ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega", "z", "rx", "friction_torque",
+                                      "max_ball_load")]
+        run = subprocess.run([str(host), str(folder), "SlewingBearing", md.guid, "basic", *vrs], capture_output=True,
+                             text=True, timeout=600, env={"PATH": "/usr/bin:/bin"})
+        assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+        values[name], _, log_lines, errors = parse_host_output(run.stdout)
+        assert not errors, errors
+        logs[name] = " ".join(message for _, _, message in log_lines)
+    assert "loops compiled ahead of time" in logs["aot"] and "run by numpy" in logs["numpy"]
+    assert values["aot"].keys() == values["numpy"].keys() and values["aot"]
+    for label, steps in values["aot"].items():           # compiled loops against numpy's: round-off
+        for k, outputs in steps.items():
+            assert np.allclose(outputs, values["numpy"][label][k], rtol=1e-9, atol=1e-15), (label, k)
