@@ -7,6 +7,8 @@ all made in this run by this checkout's ``build_fmu.py``:
   23): it runs in this machine's Python and venv, with numba and its shipped cache. The baseline.
 - ``standalone``: the default; it carries its Python and numpy, and runs the numpy loops.
 - ``standalone + numba``: ``--numba``; it also carries numba and llvmlite, and the compiled loops' cache.
+- ``standalone + aot``: ``--aot``; it carries the loops compiled ahead of time (``build_aot.py``)
+  instead of numba: its cold build includes that compilation (the module's cache emptied).
 
 Each FMU is run by our C host (``tests/c_host/host.c``, scenario ``bench``) in the environment of
 a desktop session (``PATH=/usr/bin:/bin``, nothing else), as a user's C host would run it: a fresh
@@ -46,7 +48,8 @@ INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 VARIANTS = {"host + numba": {"runtime": "host", "numba": True},
             "standalone": {"runtime": "standalone", "numba": False},
-            "standalone + numba": {"runtime": "standalone", "numba": True}}
+            "standalone + numba": {"runtime": "standalone", "numba": True},
+            "standalone + aot": {"runtime": "standalone", "numba": False, "aot": True}}
 BASELINE = "host + numba"
 WARM = 20
 
@@ -68,6 +71,10 @@ def build(variant: dict, output: Path, cold: bool) -> float:
         key = build_runtime.runtime_key(variant["numba"], LINUX_BINARIES[2])
         for f in build_runtime.runtime_cache_dir().glob(f"runtime-{key}.*"):
             f.unlink()
+    if cold and variant.get("aot"):
+        import build_aot
+
+        shutil.rmtree(build_aot.aot_cache_dir() / build_aot.cache_key(), ignore_errors=True)
     start = time.perf_counter()
     build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", output, **variant)
     return time.perf_counter() - start
