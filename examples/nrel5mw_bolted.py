@@ -44,6 +44,9 @@ BOLTED = ROOT / "examples/bearings/pitch_bearing_nrel5mw.toml"
 
 # ---- sources -----------------------------------------------------------------------------------
 # Jonkman, Butterfield, Musial, Scott 2009, NREL/TP-500-38060 (NREL 5MW reference turbine)
+# (checked in NREL's FAST input files of the turbine, github.com/old-NWTC/FAST CertTest/5MW_Baseline:
+# NRELOffshrBsline5MW_Onshore_ElastoDyn.dat TipRad 63, HubRad 1.5, HubMass 56780; NRELOffshrBsline5MW_
+# AeroDyn_blade.dat BlChord 3.542 at the root; docs/connected_structures.md)
 BLADE_LENGTH = 61.5               # m
 ROOT_DIAMETER = 3.542             # m, chord at the blade root (a cylinder)
 HUB_DIAMETER = 3.0                # m
