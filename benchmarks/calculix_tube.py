@@ -33,6 +33,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from references.calculix.tube_mesh import c3d20_tube, nset  # noqa: E402
+
 RI, RO, LENGTH = 0.760, 0.805, 0.300          # m
 EZ, ET, ER, G, NU = 40e9, 15e9, 15e9, 5e9, 0.3   # Pa
 N_R, N_T, N_Z = 2, 96, 12
@@ -41,40 +43,10 @@ D = 1e-3                                       # mm, the face's amplitude in the
 
 def deck(z_face: float, n: int, kind: str) -> str:
     """The CalculiX input (mm, N, MPa) of one pattern; the tube runs from z_face downwards."""
-    ids = {}
-    lines = ["*NODE"]
-
-    def node(i, j, k):          # half-step indices: i 0..2 N_R, j 0..2 N_T - 1 (periodic), k 0..2 N_Z
-        key = (i, j % (2 * N_T), k)
-        if key not in ids:
-            ids[key] = len(ids) + 1
-            r = (RI + (RO - RI) * i / (2 * N_R)) * 1e3
-            t = 2 * math.pi * key[1] / (2 * N_T)
-            z = (z_face - LENGTH * k / (2 * N_Z)) * 1e3
-            lines.append(f"{ids[key]},{r * math.cos(t):.9f},{r * math.sin(t):.9f},{z:.9f}")
-        return ids[key]
-
-    elements = []
-    for i in range(N_R):
-        for j in range(N_T):
-            for k in range(N_Z):
-                a, b, c = 2 * i, 2 * j, 2 * k
-                # local axes (r, theta, -z) would be left-handed: the bottom face is the far (lower) one
-                lo, hi = c + 2, c
-                corners = [(a, b, lo), (a + 2, b, lo), (a + 2, b + 2, lo), (a, b + 2, lo),
-                           (a, b, hi), (a + 2, b, hi), (a + 2, b + 2, hi), (a, b + 2, hi)]
-                mids = [(a + 1, b, lo), (a + 2, b + 1, lo), (a + 1, b + 2, lo), (a, b + 1, lo),
-                        (a + 1, b, hi), (a + 2, b + 1, hi), (a + 1, b + 2, hi), (a, b + 1, hi),
-                        (a, b, c + 1), (a + 2, b, c + 1), (a + 2, b + 2, c + 1), (a, b + 2, c + 1)]
-                elements.append([node(*p) for p in corners + mids])
+    lines, ids, _ = c3d20_tube(RI, RO, LENGTH, z_face, N_R, N_T, N_Z, number_format=".9f")
     face = sorted({v for (i, j, k), v in ids.items() if k == 0})
     far = sorted({v for (i, j, k), v in ids.items() if k == 2 * N_Z})
-    out = lines + ["*ELEMENT,TYPE=C3D20,ELSET=TUBE"]
-    for e, conn in enumerate(elements, start=1):
-        out.append(f"{e}," + ",".join(map(str, conn[:15])) + ",")
-        out.append(",".join(map(str, conn[15:])))
-    out += ["*NSET,NSET=FACE"] + [",".join(map(str, face[s:s + 12])) for s in range(0, len(face), 12)]
-    out += ["*NSET,NSET=FAR"] + [",".join(map(str, far[s:s + 12])) for s in range(0, len(far), 12)]
+    out = lines + nset("FACE", face) + nset("FAR", far)
     nu12, nu13, nu23 = NU * ER / ET, NU * ER / EZ, NU * ET / EZ   # S_12 = -NU/ET, S_13 = S_23 = -NU/EZ
     out += ["*ORIENTATION,NAME=CYL,SYSTEM=CYLINDRICAL", "0.,0.,0.,0.,0.,1.",
             "*MATERIAL,NAME=LAMINATE", "*ELASTIC,TYPE=ENGINEERING CONSTANTS",

@@ -37,3 +37,20 @@ def test_bearing_file_holds_the_derived_hub_and_blade_root():
     assert bolted.with_connection(None).name == bolted.name          # the same bearing otherwise
     for key in ("pitch_diameter", "ball_count", "ball_diameter", "preload"):
         assert getattr(bolted, key) == getattr(plain, key)
+
+
+def test_nrel5mw_study_runs_the_bearing_as_it_is_bolted():
+    """The NREL 5MW study's default bearing is the bolted one (issue 29): every case runs flexible
+    rings on the bearing file that holds the hub and blade root, the rings' support left to them."""
+    from slewing_model.study import load_study
+
+    m = _script()
+    study = load_study(ROOT / "examples" / "studies" / "nrel5mw_pitch.toml")
+    cases = study.cases()
+    assert len(cases) == 10                              # FAST v8 blade 1 + 3 OC3-Hywind runs x 3 blades
+    assert study.simulation["bc"] == "free"              # the tubes hold the rings, as the script's bolted case
+    for case in cases:
+        assert Path(case.variant["file"]).resolve() == m.BOLTED.resolve()
+        assert case.variant["ring_model"] == "flexible"
+        bearing = load_bearing(case.variant["file"])
+        assert set(bearing.connection) == {"inner", "outer"}

@@ -42,45 +42,17 @@ import scipy.sparse.linalg as spla
 ROOT = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(ROOT))
 
+from references.calculix.tube_mesh import c3d20_tube, nset  # noqa: E402
+
 RI, RO, LENGTH = 0.760, 0.805, 0.300          # m
 E, NU = 210e9, 0.3                             # Pa
 
 
 def tube_deck(z_face: float, n_r: int, n_t: int, n_z: int) -> tuple[str, dict]:
     """CalculiX input (mm, N, MPa): the tube from z_face downwards, C3D20, far end clamped, one
-    matrix-storage frequency step. Returns the deck and {node id: (r, theta, z) mm/rad}."""
-    ids, where = {}, {}
-    lines = ["*NODE"]
-
-    def node(i, j, k):          # half-step indices: i 0..2 n_r, j periodic 0..2 n_t - 1, k 0..2 n_z
-        key = (i, j % (2 * n_t), k)
-        if key not in ids:
-            ids[key] = len(ids) + 1
-            r = (RI + (RO - RI) * i / (2 * n_r)) * 1e3
-            t = 2 * math.pi * key[1] / (2 * n_t)
-            z = (z_face - LENGTH * k / (2 * n_z)) * 1e3
-            where[ids[key]] = (r, t, z, k)
-            lines.append(f"{ids[key]},{r * math.cos(t):.12g},{r * math.sin(t):.12g},{z:.12g}")
-        return ids[key]
-
-    elements = []
-    for i in range(n_r):
-        for j in range(n_t):
-            for k in range(n_z):
-                a, b, c = 2 * i, 2 * j, 2 * k
-                lo, hi = c + 2, c
-                corners = [(a, b, lo), (a + 2, b, lo), (a + 2, b + 2, lo), (a, b + 2, lo),
-                           (a, b, hi), (a + 2, b, hi), (a + 2, b + 2, hi), (a, b + 2, hi)]
-                mids = [(a + 1, b, lo), (a + 2, b + 1, lo), (a + 1, b + 2, lo), (a, b + 1, lo),
-                        (a + 1, b, hi), (a + 2, b + 1, hi), (a + 1, b + 2, hi), (a, b + 1, hi),
-                        (a, b, c + 1), (a + 2, b, c + 1), (a + 2, b + 2, c + 1), (a, b + 2, c + 1)]
-                elements.append([node(*p) for p in corners + mids])
-    far = sorted(v for (i, j, k), v in ids.items() if k == 2 * n_z)
-    out = lines + ["*ELEMENT,TYPE=C3D20,ELSET=TUBE"]
-    for e, conn in enumerate(elements, start=1):
-        out.append(f"{e}," + ",".join(map(str, conn[:15])) + ",")
-        out.append(",".join(map(str, conn[15:])))
-    out += ["*NSET,NSET=FAR"] + [",".join(map(str, far[s:s + 12])) for s in range(0, len(far), 12)]
+    matrix-storage frequency step. Returns the deck and {node id: (r mm, theta rad, z mm, k)} (k = 0: the face)."""
+    lines, ids, where = c3d20_tube(RI, RO, LENGTH, z_face, n_r, n_t, n_z)
+    out = lines + nset("FAR", sorted(v for (i, j, k), v in ids.items() if k == 2 * n_z))
     out += ["*MATERIAL,NAME=STEEL", "*ELASTIC", f"{E / 1e6:.6g},{NU}", "*DENSITY", "7.85e-9",
             "*SOLID SECTION,ELSET=TUBE,MATERIAL=STEEL",
             "*BOUNDARY", "FAR,1,3",
