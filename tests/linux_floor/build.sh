@@ -139,6 +139,11 @@ if [ ! -f "$EXPORT_OUT/libpythonfmu-export.so" ]; then
   in_build sh -c "cd /tmp/pythonfmu/pythonfmu/pythonfmu-export/src && g++ -std=c++17 -O3 -DNDEBUG -fPIC -shared -I. \
       -I$prefix/include/python3.11 -o /tmp/pythonfmu/libpythonfmu-export.so pythonfmu/fmi2.cpp pythonfmu/PySlaveInstance.cpp \
       -static-libstdc++ -static-libgcc -Wl,--exclude-libs,ALL -lpthread" >&2
+  # the same FMI 2.0 functions as the library pythonfmu 0.7.0 ships (in the venv)
+  shipped=$("$VENV_PY" -c "import pythonfmu, pathlib; print(pathlib.Path(pythonfmu.__file__).parent / 'resources/binaries/linux64/libpythonfmu-export.so')")
+  diff <(nm -D --defined-only "$shipped" | awk '{print $3}' | grep '^fmi2' | sort) \
+       <(nm -D --defined-only "$BUILD/tmp/pythonfmu/libpythonfmu-export.so" | awk '{print $3}' | grep '^fmi2' | sort) >&2 \
+    || { echo "the rebuilt export library's fmi2 functions differ from pythonfmu's ($shipped)" >&2; exit 1; }
   rm -rf "$EXPORT_OUT.partial"; mkdir -p "$EXPORT_OUT.partial"
   cp "$BUILD/tmp/pythonfmu/libpythonfmu-export.so" "$EXPORT_OUT.partial/"
   strip --strip-unneeded "$EXPORT_OUT.partial/libpythonfmu-export.so"
