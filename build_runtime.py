@@ -1,7 +1,7 @@
 """The Python runtime a standalone FMU carries (build time only; used by ``build_fmu.py``).
 
 A standalone FMU runs its model on a machine that has no Python: it carries the building
-interpreter's shared library, the part of the standard library a numpy model uses, numpy and,
+interpreter's (or another one's: ``build_fmu.py --runtime-python``, ``--linux-floor``) shared library, the part of the standard library a numpy model uses, numpy and,
 as the user chooses, numba with llvmlite. The tree is laid out as a Python prefix,
 
     binaries/<platform>/python/lib/libpython3.X.so.1.0
@@ -257,7 +257,8 @@ PACKAGES = ("numpy", "numba", "llvmlite")
 
 
 def _is_running(python) -> bool:
-    return python is None or os.path.realpath(python) == os.path.realpath(sys.executable)
+    # not resolved: a virtual environment's python links to its base interpreter, which has other packages
+    return python is None or os.path.abspath(python) == os.path.abspath(sys.executable)
 
 
 def interpreter(python=None) -> dict:

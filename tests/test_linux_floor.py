@@ -54,7 +54,7 @@ def floor_dir():
         found = linux_floor(FLOOR_DIR)
     except RuntimeError:
         pytest.skip(f"SKIPPED: the floor-lowered runtime is not built in {FLOOR_DIR} (CPython in a Debian 11 "
-                    "chroot, about 6 minutes): run tests/linux_floor/run_all.sh, or set SLEWING_BUILD_LINUX_FLOOR=1")
+                    "chroot, 2 to 4 minutes): run tests/linux_floor/run_all.sh, or set SLEWING_BUILD_LINUX_FLOOR=1")
     from importlib.metadata import version
     import build_runtime
 

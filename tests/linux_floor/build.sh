@@ -50,12 +50,13 @@ if [ ! -f "$BUILD/.slewing-build-tools" ]; then
   rm -rf "$BUILD.partial"
   if [ -d "$CHROOTS/bullseye/usr/bin" ]; then
     cp -a "$CHROOTS/bullseye" "$BUILD.partial"            # the bare system as made by debootstrap, copied
+    find "$BUILD.partial/tmp" -mindepth 1 -delete          # without what the tests left in its /tmp
   else
     debootstrap --variant=minbase bullseye "$BUILD.partial" >&2
   fi
   cp /etc/resolv.conf "$BUILD.partial/etc/resolv.conf"
   chroot "$BUILD.partial" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root DEBIAN_FRONTEND=noninteractive \
-    sh -c "apt-get update -qq && apt-get install -y -qq --no-install-recommends $BUILD_PACKAGES >/dev/null"
+    sh -c "apt-get update -qq && apt-get install -y -qq --no-install-recommends $BUILD_PACKAGES >/dev/null && apt-get clean"
   echo "$BUILD_PACKAGES" > "$BUILD.partial/.slewing-build-tools"
   rm -rf "$BUILD"; mv "$BUILD.partial" "$BUILD"
   log "build chroot made in $((SECONDS - t0)) s"
@@ -166,6 +167,7 @@ if [ ! -x "$FMUSIM" ] && [ -f "$vendor/build.sh" ]; then
   log "fmusim built in Debian 11: $FMUSIM"
 fi
 
+rm -rf "$BUILD/opt/slewing-floor"                     # the interpreter's copy in the chroot (kept in $OUT)
 ln -sfn "$(basename "$PY_OUT")" "$OUT/python"
 ln -sfn "$(basename "$EXPORT_OUT")" "$OUT/pythonfmu-export"
 echo "$OUT"
