@@ -184,19 +184,20 @@ static int compare_versions(const char *a, const char *b)
     return 0;
 }
 
-/* Systems that qualify for a glibc floor, for the messages: the oldest three at or above it. */
+/* Systems that qualify for a glibc floor, for the messages: the oldest release of each family at or above it. */
 static void systems_for(const char *glibc, char *out, size_t size)
 {
-    static const struct { const char *glibc, *name; } systems[] = {
-        {"2.28", "Debian 10"}, {"2.28", "RHEL 8"}, {"2.31", "Debian 11"}, {"2.31", "Ubuntu 20.04"},
-        {"2.34", "RHEL 9"}, {"2.35", "Ubuntu 22.04"}, {"2.36", "Debian 12"}, {"2.39", "Ubuntu 24.04"},
-        {"2.39", "RHEL 10"}, {"2.41", "Debian 13"}};
-    size_t n = 0, count = 0;
+    static const struct { const char *glibc, *family, *name; } systems[] = {
+        {"2.28", "D", "Debian 10"}, {"2.28", "R", "RHEL 8"}, {"2.31", "D", "Debian 11"}, {"2.31", "U", "Ubuntu 20.04"},
+        {"2.34", "R", "RHEL 9"}, {"2.35", "U", "Ubuntu 22.04"}, {"2.36", "D", "Debian 12"}, {"2.39", "U", "Ubuntu 24.04"},
+        {"2.39", "R", "RHEL 10"}, {"2.41", "D", "Debian 13"}};
+    char seen[8] = "";
+    size_t n = 0;
     out[0] = '\0';
-    for (size_t i = 0; i < sizeof systems / sizeof systems[0] && count < 3; i++)
-        if (compare_versions(systems[i].glibc, glibc) >= 0 && n < size) {
-            n += snprintf(out + n, size - n, "%s%s", count ? ", " : "", systems[i].name);
-            count++;
+    for (size_t i = 0; i < sizeof systems / sizeof systems[0]; i++)
+        if (compare_versions(systems[i].glibc, glibc) >= 0 && !strstr(seen, systems[i].family) && n < size) {
+            n += snprintf(out + n, size - n, "%s%s", *seen ? ", " : "", systems[i].name);
+            strcat(seen, systems[i].family);
         }
 }
 
