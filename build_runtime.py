@@ -1,7 +1,7 @@
 """The Python runtime a standalone FMU carries (build time only; used by ``build_fmu.py``).
 
 A standalone FMU runs its model on a machine that has no Python: it carries the building
-interpreter's shared library, the part of the standard library a numpy model uses, numpy and,
+interpreter's (or another one's: ``build_fmu.py --runtime-python``, ``--linux-floor``) shared library, the part of the standard library a numpy model uses, numpy and,
 as the user chooses, numba with llvmlite. The tree is laid out as a Python prefix,
 
     binaries/<platform>/python/lib/libpython3.X.so.1.0
@@ -43,7 +43,6 @@ import sysconfig
 import tempfile
 import zipfile
 from dataclasses import dataclass, field
-from importlib import metadata
 from pathlib import Path
 
 #: the folder of the runtime inside ``binaries/<platform>/``
@@ -223,13 +222,71 @@ def building_machine_paths() -> set[str]:
     return {p.rstrip("/") for p in candidates if p and p.startswith("/") and len(p.rstrip("/")) > 5}
 
 
+# ---- the interpreter whose runtime is staged ------------------------------------------------------
+#: what staging needs to know of an interpreter, asked of it (standard library only: it runs in that Python)
+PROBE = r"""
+import json, os, site, sys, sysconfig
+from importlib import metadata
+
+def probe(names):
+    libdir, soname = sysconfig.get_config_var("LIBDIR") or "", sysconfig.get_config_var("INSTSONAME") or ""
+    if not os.path.isfile(os.path.join(libdir, soname)):   # an installation moved since it was built: its prefix
+        libdir = os.path.join(sys.base_prefix, "lib")
+    packages, files = {}, {}
+    for name in names:
+        try:
+            dist = metadata.distribution(name)
+        except metadata.PackageNotFoundError:
+            continue
+        packages[name] = dist.version
+        files[name] = [(str(dist.locate_file(f)), str(f)) for f in dist.files or ()]
+    paths = [sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix, *site.getsitepackages(),
+             os.path.dirname(sys.executable)] + [sysconfig.get_config_var(k) or "" for k in
+                                                   ("prefix", "exec_prefix", "LIBDIR", "abs_builddir", "abs_srcdir")]
+    return {"executable": sys.executable, "version": sys.version.split()[0], "sys_version": sys.version,
+            "minor": "%d.%d" % sys.version_info[:2], "base_prefix": sys.base_prefix,
+            "stdlib": sysconfig.get_path("stdlib"), "libdir": libdir, "soname": soname,
+            "packages": packages, "files": files, "paths": paths}
+
+if __name__ == "__main__":
+    print(json.dumps(probe(json.loads(sys.argv[1]))))
+"""
+
+#: the distributions a runtime can carry
+PACKAGES = ("numpy", "numba", "llvmlite")
+
+
+def _is_running(python) -> bool:
+    # not resolved: a virtual environment's python links to its base interpreter, which has other packages
+    return python is None or os.path.abspath(python) == os.path.abspath(sys.executable)
+
+
+def interpreter(python=None) -> dict:
+    """What staging needs to know of the interpreter ``python`` (a path; None: the running one): its
+    version, standard library, shared library, the numpy/numba/llvmlite it has and their files, and
+    its prefixes. Another interpreter is asked in a subprocess (it may be built elsewhere, e.g. in a
+    Debian 11 chroot by ``tests/linux_floor/build.sh``, and need not be able to import this file)."""
+    if _is_running(python):
+        namespace = {"__name__": "slewing_probe"}
+        exec(PROBE, namespace)
+        info = namespace["probe"](PACKAGES)
+        info["running"] = True
+        return info
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    run = subprocess.run([str(python), "-I", "-c", PROBE, json.dumps(PACKAGES)], capture_output=True, text=True,
+                         env=env)
+    if run.returncode != 0:
+        raise RuntimeError(f"the runtime's interpreter {python} does not run here: {run.stderr.strip()[-600:]}")
+    info = json.loads(run.stdout)
+    info["running"] = False
+    return info
+
+
 # ---- the staged tree --------------------------------------------------------------------------
-def _distribution_files(name: str):
+def _distribution_files(name: str, python: dict):
     """(path on this machine, path relative to site-packages) of an installed distribution's files."""
-    dist = metadata.distribution(name)
-    for f in dist.files or ():
-        source = Path(dist.locate_file(f))
-        relative = str(f)
+    for source, relative in python["files"][name]:
+        source = Path(source)
         if relative.startswith("..") or not source.is_file():
             continue
         yield source, relative
@@ -241,9 +298,13 @@ def _strip(path: Path) -> None:
         subprocess.run([strip, "--strip-unneeded", str(path)], capture_output=True)
 
 
-def _library_path(name: str) -> Path | None:
-    """Where the dynamic loader finds library ``name`` on this machine (``ldconfig -p``, in /sbin
-    when it is not on PATH)."""
+def _library_path(name: str, python: dict | None = None) -> Path | None:
+    """Where library ``name`` is taken from: for the running interpreter where the dynamic loader
+    finds it on this machine (``ldconfig -p``, in /sbin when it is not on PATH); for another one
+    (``python``) only beside its libpython, where its builder put the libraries of its own system."""
+    if python is not None and not python["running"]:
+        found = Path(python["libdir"], name)
+        return found if found.is_file() else None
     ldconfig = shutil.which("ldconfig") or next((p for p in ("/sbin/ldconfig", "/usr/sbin/ldconfig")
                                                   if os.path.exists(p)), None)
     if ldconfig:
@@ -255,39 +316,42 @@ def _library_path(name: str) -> Path | None:
     return None
 
 
-def python_library() -> Path:
-    """The shared library of this interpreter (libpython3.X.so.1.0)."""
-    library = Path(sysconfig.get_config_var("LIBDIR") or "", sysconfig.get_config_var("INSTSONAME") or "")
+def python_library(python: dict | None = None) -> Path:
+    """The shared library of the interpreter ``python`` (:func:`interpreter`; default this one): libpython3.X.so.1.0."""
+    python = python or interpreter()
+    library = Path(python["libdir"], python["soname"])
     if not library.is_file():
-        raise RuntimeError(f"this Python ({sys.base_prefix}) has no shared library ({library}): a standalone FMU "
+        raise RuntimeError(f"this Python ({python['base_prefix']}) has no shared library ({library}): a standalone FMU "
                            "needs a CPython built with --enable-shared (Debian's python3, pyenv with "
                            "PYTHON_CONFIGURE_OPTS=--enable-shared, the official Docker images), or build with "
                            "--runtime host")
     return library
 
 
-def bundled_packages(numba: bool) -> dict[str, str]:
-    """The distributions a runtime carries, with their installed versions."""
+def bundled_packages(numba: bool, python: dict | None = None) -> dict[str, str]:
+    """The distributions a runtime carries, with their versions installed in ``python`` (default this one)."""
+    python = python or interpreter()
     names = ["numpy"] + (["numba", "llvmlite"] if numba else [])
     versions = {}
     for name in names:
-        try:
-            versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            raise RuntimeError(f"{name} is not installed in this Python ({sys.prefix}): a runtime with "
+        if name in python["packages"]:
+            versions[name] = python["packages"][name]
+        else:
+            raise RuntimeError(f"{name} is not installed in the Python {python['executable']}: a runtime with "
                                f"{'numba' if numba else 'numpy'} cannot be bundled; pip install {name}"
                                + ("" if name == "numpy" else ", or build without numba")) from None
     return versions
 
 
-def stage_runtime(target: Path, numba: bool) -> dict:
-    """Copy this interpreter's runtime into ``target`` (a Python prefix); returns its description
-    (python, packages, glibc, glibcxx, library)."""
-    minor = f"{sys.version_info[0]}.{sys.version_info[1]}"
-    packages = bundled_packages(numba)
+def stage_runtime(target: Path, numba: bool, python=None) -> dict:
+    """Copy the runtime of the interpreter ``python`` (a path; default this one) into ``target`` (a
+    Python prefix); returns its description (python, packages, glibc, glibcxx, library)."""
+    python = interpreter(python) if python is None or isinstance(python, (str, os.PathLike)) else python
+    minor = python["minor"]
+    packages = bundled_packages(numba, python)
     lib = target / "lib"
     stdlib_target = lib / f"python{minor}"
-    stdlib = Path(sysconfig.get_path("stdlib"))
+    stdlib = Path(python["stdlib"])
     stdlib_target.mkdir(parents=True)
     # the standard library
     for entry in stdlib.iterdir():
@@ -303,12 +367,12 @@ def stage_runtime(target: Path, numba: bool) -> dict:
         if DYNLOAD_EXCLUDED.match(so.name):
             so.unlink()
     # libpython
-    library = python_library()
+    library = python_library(python)
     shutil.copy2(library, lib / library.name)
     # the packages
     site_packages = stdlib_target / "site-packages"
     for name in packages:
-        for source, relative in _distribution_files(name):
+        for source, relative in _distribution_files(name, python):
             if PACKAGE_EXCLUDED.search(relative) or relative.endswith((".dist-info/RECORD", "direct_url.json",
                                                                         "INSTALLER", "REQUESTED")):
                 continue
@@ -324,7 +388,7 @@ def stage_runtime(target: Path, numba: bool) -> dict:
         for name in needed_libraries(elf):
             if name in bundled or SYSTEM_LIBRARIES.match(name):
                 continue
-            found = _library_path(name)
+            found = _library_path(name, python)
             if found is None:
                 continue            # a library the module needs that this machine lacks: the module fails alike
             copy = lib / name
@@ -340,18 +404,23 @@ def stage_runtime(target: Path, numba: bool) -> dict:
             relative = os.path.relpath(lib, elf.parent)
             set_runpath(elf, "$ORIGIN" if relative == "." else f"$ORIGIN/{relative}")
     paths = building_machine_paths()
+    if not python["running"]:   # another interpreter's prefixes, build and install folders (not the system's own)
+        paths |= {p.rstrip("/") for p in python["paths"] if p.startswith("/") and len(p.rstrip("/")) > 5
+                  and not re.match(r"/(usr|lib|lib64|bin|sbin|etc)(/|$)", p)}
     for f in target.rglob("*"):
         if f.is_file():
             scrub_paths(f, paths)
     needs = [version_needs(elf) for elf in elves]
-    return {"python": sys.version.split()[0], "packages": packages, "library": library.name,
+    return {"python": python["version"], "packages": packages, "library": library.name,
             "glibc": newest_version(needs, "GLIBC_"), "glibcxx": newest_version(needs, "GLIBCXX_")}
 
 
-def runtime_key(numba: bool, platform_folder: str) -> str:
-    """Cache key of a runtime: interpreter, package versions, platform folder and this file's layout."""
-    text = json.dumps([LAYOUT, sys.version, sys.base_prefix, bundled_packages(numba), platform_folder,
-                       hashlib.sha256(Path(__file__).read_bytes()).hexdigest()])
+def runtime_key(numba: bool, platform_folder: str, python=None) -> str:
+    """Cache key of a runtime: interpreter (``python``, a path or :func:`interpreter`'s answer; default this
+    one), package versions, platform folder and this file's layout."""
+    python = interpreter(python) if python is None or isinstance(python, (str, os.PathLike)) else python
+    text = json.dumps([LAYOUT, python["sys_version"], python["base_prefix"], bundled_packages(numba, python),
+                       platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()])
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -361,7 +430,7 @@ def runtime_cache_dir() -> Path:
     return Path(base) / "fmu_runtime"
 
 
-def runtime(platform_folder: str, numba: bool = False, cache_dir=None) -> Runtime:
+def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=None) -> Runtime:
     """The runtime for an FMU's ``binaries/<platform>`` folder, staged and zipped once (cached).
 
     Parameters
@@ -372,18 +441,23 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None) -> Runtim
         Also bundle numba and llvmlite (the compiled loops); numpy alone otherwise.
     cache_dir : path, optional
         Default :func:`runtime_cache_dir`.
+    python : path, optional
+        The interpreter whose runtime is carried (it must have numpy, and numba where asked; its
+        libraries beyond glibc beside its libpython): default the running one. An interpreter built
+        on an older system lowers the FMU's glibc floor (``tests/linux_floor/build.sh``).
     """
     if not sys.platform.startswith("linux"):
         raise RuntimeError(f"a standalone FMU is built on Linux only (this is {sys.platform}); see the README's "
                            "'Windows' section for what a Windows build needs")
     cache = Path(cache_dir) if cache_dir else runtime_cache_dir()
-    key = runtime_key(numba, platform_folder)
+    python = interpreter(python)
+    key = runtime_key(numba, platform_folder, python)
     archive, description = cache / f"runtime-{key}.zip", cache / f"runtime-{key}.json"
     if not archive.exists():
         cache.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix="slewing_runtime_", dir=cache) as tmp:
             prefix = Path(tmp) / RUNTIME_FOLDER
-            info = stage_runtime(prefix, numba)
+            info = stage_runtime(prefix, numba, python)
             partial = Path(tmp) / "runtime.zip"
             with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED, compresslevel=6) as z:
                 for f in sorted(prefix.rglob("*")):

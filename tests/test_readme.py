@@ -26,6 +26,8 @@ SKIPPED = (
     (r"make ", "installs the environment / runs the whole suite: what `make test` is"),
     (r"\.venv/bin/python build_fmu\.py", "builds an FMU (half a minute or more); tests/test_fmu*.py build and run it"),
     (r"\.venv/bin/python build_drive_fmu\.py", "builds an FMU; tests/test_drive_fmu.py runs it"),
+    (r"bash tests/linux_floor/", "builds CPython in a Debian 11 chroot (minutes, as root); tests/linux_floor/run_all.sh "
+                                 "runs it, tests/test_linux_floor.py uses what it built"),
     (r"\.venv/bin/python examples/ssp/", "builds and runs the SSP's four FMUs (minutes); tests/test_ssp.py runs it"),
     (r"\.venv/bin/python examples/", "a full example (seconds to a minute); examples/timings.py times each"),
     (r"\.venv/bin/python benchmarks/", "a benchmark (minutes)"),

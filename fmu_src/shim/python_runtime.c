@@ -49,6 +49,7 @@ struct runtime_file {
     char runtime[32];   /* "standalone": the FMU carries its Python (folder); else the host's Python (home...) */
     char folder[PATH_MAX];  /* standalone: the runtime's prefix, relative to the binary's folder */
     char glibc[32];     /* the oldest glibc the FMU's binaries load with (X.Y) */
+    char glibcxx[32];   /* the newest libstdc++ symbol version they need (3.4.N), or "" */
     char packages[256]; /* what the runtime carries, for messages */
     char version[64];   /* X.Y.Z of the building Python */
     char home[PATH_MAX];
@@ -80,6 +81,8 @@ static void read_runtime_file(const char *binary_dir, struct runtime_file *rt)
             snprintf(rt->folder, sizeof rt->folder, "%s", value);
         else if (!strcmp(line, "glibc"))
             snprintf(rt->glibc, sizeof rt->glibc, "%s", value);
+        else if (!strcmp(line, "glibcxx"))
+            snprintf(rt->glibcxx, sizeof rt->glibcxx, "%s", value);
         else if (!strcmp(line, "packages"))
             snprintf(rt->packages, sizeof rt->packages, "%s", value);
         else if (!strcmp(line, "version"))
@@ -181,6 +184,46 @@ static int compare_versions(const char *a, const char *b)
     return 0;
 }
 
+/* Systems that qualify for a glibc floor, for the messages: the oldest release of each family at or above it. */
+static void systems_for(const char *glibc, char *out, size_t size)
+{
+    static const struct { const char *glibc, *family, *name; } systems[] = {
+        {"2.28", "D", "Debian 10"}, {"2.28", "R", "RHEL 8"}, {"2.31", "D", "Debian 11"}, {"2.31", "U", "Ubuntu 20.04"},
+        {"2.34", "R", "RHEL 9"}, {"2.35", "U", "Ubuntu 22.04"}, {"2.36", "D", "Debian 12"}, {"2.39", "U", "Ubuntu 24.04"},
+        {"2.39", "R", "RHEL 10"}, {"2.41", "D", "Debian 13"}};
+    char seen[8] = "";
+    size_t n = 0;
+    out[0] = '\0';
+    for (size_t i = 0; i < sizeof systems / sizeof systems[0]; i++)
+        if (compare_versions(systems[i].glibc, glibc) >= 0 && !strstr(seen, systems[i].family) && n < size) {
+            n += snprintf(out + n, size - n, "%s%s", *seen ? ", " : "", systems[i].name);
+            strcat(seen, systems[i].family);
+        }
+}
+
+/* The GCC whose libstdc++ first has GLIBCXX_<glibcxx> ("3.4.28": 10), for the messages; 0 if unknown. */
+static int gcc_for(const char *glibcxx)
+{
+    int major = 0, minor = 0, patch = 0;
+    if (sscanf(glibcxx, "%d.%d.%d", &major, &minor, &patch) != 3 || major != 3 || minor != 4)
+        return 0;
+    static const int gcc[] = {5, 6, 7, 7, 8, 9, 9, 10};     /* GLIBCXX_3.4.21 .. 3.4.28 */
+    return patch >= 29 ? patch - 18 : patch >= 21 ? gcc[patch - 21] : 0;
+}
+
+/* What the machine needs, for the messages: "Linux x86-64, for example Debian 11, Ubuntu 20.04, RHEL 9 or
+ * newer, with libstdc++ of GCC 10 or newer, as they have". */
+static void requirement(const struct runtime_file *rt, char *out, size_t size)
+{
+    char systems[128];
+    int gcc = gcc_for(rt->glibcxx);
+    systems_for(rt->glibc, systems, sizeof systems);
+    int n = snprintf(out, size, "Linux x86-64%s%s%s", *systems ? ", for example " : "", systems,
+                     *systems ? " or newer" : "");
+    if (gcc && n >= 0 && (size_t)n < size)
+        snprintf(out + n, size - n, ", with libstdc++ of GCC %d or newer%s", gcc, *systems ? ", as they have" : "");
+}
+
 /* The FMU's binaries need glibc rt->glibc or newer: refuse an older system with a message that
  * names the floor, before anything that needs it is loaded (the loader's own message would be a
  * bare "version `GLIBC_2.35' not found" from inside the host). 0, or -1 with a message. */
@@ -189,12 +232,13 @@ static int check_glibc(const struct runtime_file *rt, char *err, size_t errsize)
     const char *have = gnu_get_libc_version();
     if (!*rt->glibc || compare_versions(have, rt->glibc) >= 0)
         return 0;
+    char needs[256];
+    requirement(rt, needs, sizeof needs);
     message(err, errsize,
-            "this FMU needs glibc %s or newer (Linux x86-64, for example Debian 12, Ubuntu 22.04, RHEL 10 or newer, "
-            "with libstdc++ of GCC 12 or newer, as they have); "
+            "this FMU needs glibc %s or newer (%s); "
             "this machine has glibc %s. Run it on a newer system, or ask for an FMU built on a system whose "
             "glibc is at most %s (build_fmu.py states the floor of each FMU it builds).",
-            rt->glibc, have, have);
+            rt->glibc, needs, have, have);
     return -1;
 }
 
@@ -242,6 +286,8 @@ static void preload_libraries(const char *home)
             if (dlopen(name, RTLD_NOW | RTLD_NOLOAD))
                 continue;  /* loaded already: by us, or by the host under that name */
             snprintf(path, sizeof path, "%s/%s", folder, name);
+            if (dlopen(path, RTLD_NOW | RTLD_NOLOAD))
+                continue;  /* loaded by us from this file, whose name is not its soname (libgomp.so.1.0.0) */
             if (dlopen(path, RTLD_NOW | RTLD_GLOBAL))
                 progress = 1;
         }
@@ -272,8 +318,10 @@ static int load_standalone(const char *binary_dir, const struct runtime_file *rt
     preload_libraries(home);
     void *handle = dlopen(library, RTLD_NOW | RTLD_GLOBAL);
     if (!handle) {
-        message(err, errsize, "cannot load the FMU's Python library %s: %s (the FMU needs Linux x86-64 with "
-                "glibc %s or newer and libstdc++ of GCC 12 or newer).", library, dlerror(), rt->glibc);
+        char needs[256];
+        requirement(rt, needs, sizeof needs);
+        message(err, errsize, "cannot load the FMU's Python library %s: %s (the FMU needs glibc %s or newer: %s).",
+                library, dlerror(), rt->glibc, needs);
         return -1;
     }
     void (*set_home)(const wchar_t *) = (void (*)(const wchar_t *))dlsym(handle, "Py_SetPythonHome");
