@@ -80,6 +80,20 @@ def build(variant: dict, output: Path, cold: bool) -> float:
     return time.perf_counter() - start
 
 
+def bench_output(stdout: str) -> tuple[float, np.ndarray, list]:
+    """What the C host's ``bench`` scenario prints: (instantiation s, step times s, final outputs)."""
+    steps, instantiation, final = [], None, None
+    for line in stdout.splitlines():
+        word, *rest = line.split() or [""]
+        if word == "instantiate":
+            instantiation = float(rest[0])
+        elif word == "step":
+            steps.append(float(rest[1]))
+        elif word == "final":
+            final = [float(x) for x in rest[1:]]
+    return instantiation, np.array(steps), final
+
+
 def run(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) -> tuple[float, np.ndarray, list]:
     """One run of the C host: (instantiation s, step times s, final outputs)."""
     integers = sum((["--integer", str(refs[k]), str(v)] for k, v in parameters.items()), [])
@@ -89,16 +103,7 @@ def run(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) ->
                          capture_output=True, text=True, timeout=3600)
     if out.returncode != 0 or "done" not in out.stdout:
         raise RuntimeError(f"the C host failed on {folder}:\n{out.stdout[-3000:]}\n{out.stderr[-3000:]}")
-    steps, instantiation, final = [], None, None
-    for line in out.stdout.splitlines():
-        word, *rest = line.split()
-        if word == "instantiate":
-            instantiation = float(rest[0])
-        elif word == "step":
-            steps.append(float(rest[1]))
-        elif word == "final":
-            final = [float(x) for x in rest[1:]]
-    return instantiation, np.array(steps), final
+    return bench_output(out.stdout)
 
 
 def main() -> None:

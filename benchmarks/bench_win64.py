@@ -29,7 +29,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from bench_fmu_runtime import compile_host  # noqa: E402  (our C host for Linux, as that benchmark builds it)
+from bench_fmu_runtime import bench_output, compile_host  # noqa: E402  (our C host for Linux and its output, as that benchmark has them)
 from cases import CASES  # noqa: E402
 from timing import print_table  # noqa: E402
 
@@ -56,16 +56,7 @@ def run(platform: str, host: Path, folder: Path, refs: dict, inputs: Path, param
         out = w.wine(host, *arguments, timeout=3600)
     if out.returncode != 0 or "done" not in out.stdout:
         raise RuntimeError(f"the {platform} C host failed on {folder}:\n{out.stdout[-3000:]}\n{out.stderr[-3000:]}")
-    steps, instantiation, final = [], None, None
-    for line in out.stdout.splitlines():
-        word, *rest = line.split() or [""]
-        if word == "instantiate":
-            instantiation = float(rest[0])
-        elif word == "step":
-            steps.append(float(rest[1]))
-        elif word == "final":
-            final = [float(x) for x in rest[1:]]
-    return instantiation, np.array(steps), final
+    return bench_output(out.stdout)
 
 
 def sizes(fmu: Path) -> dict:
