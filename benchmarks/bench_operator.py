@@ -14,7 +14,14 @@ products (:func:`slewing_model.rings.reduced_operator.bordered_inverse`), altern
 inversion of the whole: where the kernel hands bordering to numpy
 (:data:`slewing_model.distribution.kernel.BORDER_BLAS_ROWS`) and what a bounded step counts it as.
 
-Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border]
+With ``--stages``: the time of each stage a bounded step counts in floating-point operations
+(:data:`slewing_model.distribution.bime.BOUNDED_WORK`): forming ``W`` from the pitch bearing's
+operators of 160-600 rows (the loads of ``bench_realtime.py``'s reversal scenario) and each stage of its
+inverse (:data:`slewing_model.rings.reduced_operator.STAGES`), against the work counted for it
+(:func:`~slewing_model.distribution.bime.forming_work`,
+:func:`~slewing_model.rings.reduced_operator.stage_work`): what ``BOUNDED_WORK`` is in time here.
+
+Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border | --stages]
 """
 from __future__ import annotations
 
@@ -68,7 +75,7 @@ def formed_operators(case_name: str, steps: int) -> list[np.ndarray]:
 
 def bordering(runs: int, n: int = 368) -> None:
     """Bordering ``r`` rows onto an inverse of ``n`` rows: compiled loop against numpy's products."""
-    from slewing_model.distribution.bime import bordering_work
+    from slewing_model.rings.reduced_operator import bordering_work, inverse_work
     from slewing_model.distribution.kernel import compiled_bordered_inverse
 
     rng = np.random.default_rng(0)
@@ -93,11 +100,63 @@ def bordering(runs: int, n: int = 368) -> None:
             med = {m: float(np.median(t)) * 1e3 for m, t in times.items()}
             rows.append([str(r), f"{med['compiled']:.2f}", f"{med['numpy']:.2f}", f"{med['inversion']:.2f}",
                          f"{med['compiled'] / med['numpy']:.2f}", f"{med['numpy'] / med['inversion']:.2f}",
-                         f"{bordering_work(r, n):.2f}"])
+                         f"{bordering_work(r, n) / inverse_work(n):.2f}"])
     print_table(f"Bordering r rows onto an inverse of {n} rows, one BLAS thread, medians of {runs} runs, "
                 "methods alternating [ms]",
                 ["r", "compiled", "numpy", f"inversion of {n}", "compiled / numpy", "numpy / inversion",
-                 "counted (bordering_work)"], rows)
+                 "counted (work / inversion's)"], rows)
+
+
+def stages(runs: int) -> None:
+    """Forming ``W`` and each stage of its inverse: time against the work a bounded step counts."""
+    from dataclasses import replace
+
+    from slewing_model.distribution import bime
+
+    case = CASES["pitch"](2)
+    bearing = load_bearing(case.bearing)
+    simulator = BearingSimulator(bearing, build_superelement(bearing, mesh="fine", bc="free"),
+                                 SimulatorSettings(load_frame="rotating"))
+    formed = {}                                  # rows -> (point, active) of a W the solver formed
+    original = bime.start_operator
+
+    def keep(point, compliance, stiffness, active, arithmetic=None, until=None):
+        formed.setdefault(2 * int(np.count_nonzero(active)), (point, active))
+        return original(point, compliance, stiffness, active, arithmetic, until)
+
+    bime.start_operator = keep
+    try:
+        loads = case.loads[0]
+        for k in range(60):                      # the moment reversed every 10 steps, scaled up and down
+            factor = (0.6 + 0.1 * (k % 7)) * (-1.0 if (k // 10) % 2 else 1.0)
+            simulator.step(Loads(loads[0], loads[1], loads[2], factor * loads[3], factor * loads[4]), 0.0, 0.0)
+    finally:
+        bime.start_operator = original
+    solver = simulator.solver
+    arithmetic = solver._arithmetic
+    rows = []
+    with blas_threads(1):
+        for n in sorted(formed)[:: max(1, len(formed) // 5)]:
+            point, active = formed[n]
+            times = {k: [] for k in ["form", *range(len(reduced_operator.STAGES))]}
+            for _ in range(runs):
+                start = time.perf_counter()
+                pending = reduced_operator.start_operator(point, solver.compliance, solver.assembly.stiffness, active,
+                                                          arithmetic, until=0)
+                times["form"].append(time.perf_counter() - start)
+                for k in range(len(reduced_operator.STAGES)):
+                    start = time.perf_counter()
+                    pending = reduced_operator.advance_operator(pending, None, None, until=k + 1)
+                    times[k].append(time.perf_counter() - start)
+            counted = [bime.forming_work(n)] + [reduced_operator.stage_work(n, k)
+                                                 for k in range(len(reduced_operator.STAGES))]
+            for (label, t), flops in zip(times.items(), counted):
+                ms = float(np.median(t)) * 1e3
+                rows.append([str(n), "form W" if label == "form" else reduced_operator.STAGES[label].__name__,
+                             f"{ms:.3f}", f"{flops / 1e6:.1f}", f"{flops / 1e6 / ms:.1f}" if ms else "–"])
+    print_table(f"A new operator's work on one BLAS thread, medians of {runs} runs [ms], against the work a bounded "
+                f"step counts (BOUNDED_WORK = {bime.BOUNDED_WORK / 1e6:.0f} M)",
+                ["rows", "stage", "time [ms]", "counted work [M]", "counted per ms [M]"], rows)
 
 
 def main() -> None:
@@ -105,9 +164,12 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=30, help="inversions of each operator by each method")
     parser.add_argument("--steps", type=int, default=200, help="steps of each case that form the operators")
     parser.add_argument("--border", action="store_true", help="time bordering instead (compiled against numpy)")
+    parser.add_argument("--stages", action="store_true", help="time forming W and each stage of its inverse instead")
     args = parser.parse_args()
     if args.border:
         return bordering(args.runs)
+    if args.stages:
+        return stages(args.runs)
     rows = []
     for name in ("pitch", "yaw"):
         operators = formed_operators(name, args.steps)

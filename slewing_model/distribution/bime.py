@@ -64,8 +64,9 @@ from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors be
 from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
-    APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, PendingOperator, ReducedOperator, advance_operator,
-    assemble_operator, complete_operator, start_operator, turned_operator, update_operator,
+    APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, STAGES, PendingOperator, ReducedOperator, advance_operator,
+    assemble_operator, bordering_work, borders, closing_rows, stage_work, start_operator, turned_operator,
+    update_operator,
 )
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
@@ -81,10 +82,16 @@ FINISH_ITERATIONS = 3
 #: with the one it has (:class:`slewing_model.rings.reduced_operator.PendingOperator`); all at once when an
 #: iteration past this many in one solve is still slow (docs/speed.md)
 SPREAD_ITERATIONS = 8
-#: what a bounded warm solve (``step_work="bounded"``) may spend: the ring operator's work, in
-#: inversions of ``W = (A^-1 + M)_aa`` (a stage of a spread inversion is half of one; bordering:
-#: :func:`bordering_work`) ...
-BOUNDED_INVERSIONS = 1.0
+#: what a bounded warm solve (``step_work="bounded"``) may spend of the ring operator's work, and at
+#: least one stage of an inverse on its way: floating-point operations weighted so that they track
+#: time (the stages of a spread inverse of ``W = (A^-1 + M)_aa``:
+#: :func:`~slewing_model.rings.reduced_operator.stage_work`; forming ``W``: :func:`forming_work`;
+#: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
+#: step's answer does not depend on the machine. 1e8, an inverse of about 360 rows (2 ms on one core
+#: here, ``benchmarks/bench_operator.py --stages``), chosen by the pitch bearing's scenarios of
+#: ``benchmarks/bench_realtime.py``: 8e7 and 1.2e8 gave a reversal's slowest step 5.5 and 7.1 ms,
+#: NREL 156 and 24 steps of 6000 flagged (docs/speed.md) ...
+BOUNDED_WORK = 1e8
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Bounded steps")
 BOUNDED_ITERATIONS = 12
@@ -132,7 +139,8 @@ class BimeSolver:
         How much a warm solve may do. "complete": Newton to ``rtol``, however many iterations
         and ring operator inversions that takes (a moment reversed in one step: about 20 and
         4). "bounded" (real time): at most :data:`BOUNDED_ITERATIONS` iterations and
-        :data:`BOUNDED_INVERSIONS` of the operator's work; a solve that would need more returns
+        :data:`BOUNDED_WORK` of the operator's work (a new operator's inverse spread over as
+        many solves as that takes); a solve that would need more returns
         its last iterate with ``converged=False`` and its ``residual``, keeps its operator
         (and one being inverted), and the next warm solve goes on from there. A cold solve
         (no ``initial``) is always complete.
@@ -154,7 +162,7 @@ class BimeSolver:
         self.pressure_limit = pressure_limit
         self.kernel = kernel
         self.step_work = step_work
-        self._work_left = math.inf   # per solve: the ring operator's work still allowed (inversions)
+        self._work_left = math.inf   # per solve: the ring operator's work still allowed (BOUNDED_WORK)
         self._compiled = use_compiled(kernel, "kernel")    # the per-contact work as compiled loops
         self._arithmetic = COMPILED_ARITHMETIC if self._compiled else NUMPY_ARITHMETIC     # the operator's too
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
@@ -169,7 +177,7 @@ class BimeSolver:
         self._loaded_from = 1e-15 * bearing.ball_diameter     # a spring stretched more than this is loaded
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
-        #: a new operator being inverted over two solves (flexible, warm solves), or None: state too
+        #: a new operator being inverted over solves (flexible, warm solves), or None: state too
         self.pending_operator: PendingOperator | None = None
         # a turn of the ring only turns the Jacobian's columns where the moving ring's grooves have no
         # errors; with errors, nearly (reduced_operator.APPROXIMATE_TURN)
@@ -349,7 +357,7 @@ class BimeSolver:
         mu = 1e-12 * self.reference_stiffness
         iterations = 0
         bounded = self.step_work == "bounded" and initial is not None
-        self._work_left = BOUNDED_INVERSIONS if bounded else math.inf
+        self._work_left = BOUNDED_WORK if bounded else math.inf
         limit = min(self.max_iterations, BOUNDED_ITERATIONS) if bounded else self.max_iterations
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
@@ -544,11 +552,12 @@ class BimeSolver:
             op = self._step_operator(p, mu, fresh, iterations)
         except _WorkSpent:
             # a bounded solve ends here; that the next goes further, a new operator at this iterate
-            # has its first stage now, if that is left and none is on its way
-            if self.pending_operator is None and self._work_left >= 1.0 / len(SPREAD_STAGES) - 1e-12:
-                self._work_left -= 1.0 / len(SPREAD_STAGES)
-                self.pending_operator = start_operator(p, self.compliance, self.assembly.stiffness, p.loaded,
-                                                       self._arithmetic)
+            # has the stages now that are left, if none is on its way
+            if self.pending_operator is None:
+                try:
+                    self.pending_operator = self._start_operator(p, mu, SPREAD_STAGES[0], required=False)
+                except _WorkSpent:
+                    pass
                 self._stage_due = False
             raise
         dq, y_new = self._arithmetic.step(op, p, f_scaled)
@@ -557,14 +566,12 @@ class BimeSolver:
     def _step_operator(self, p: "_Point", mu: float, fresh: bool, iterations: int) -> ReducedOperator:
         """The reduced operator of this iteration (:meth:`_flexible_direction`), kept as the solver's."""
         active = p.loaded
-        stiffness, op, pending = self.assembly.stiffness, self._reduced, self.pending_operator
+        op, pending = self._reduced, self.pending_operator
         if pending is not None:
             if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
-                self._spend(_stages_left(pending) / len(SPREAD_STAGES))
-                pending = complete_operator(pending, self.jacobian, mu, self._arithmetic)
-            elif self._stage_due:                                              # one stage a solve
-                self._spend(1.0 / len(SPREAD_STAGES))
-                pending = advance_operator(pending, self.jacobian, mu, self._arithmetic)
+                pending = self._advance(pending, mu, len(STAGES), required=True)
+            elif self._stage_due:                                              # one step's stages a solve
+                pending = self._advance(pending, mu, _step_end(pending), required=False)
             self._stage_due = False
             if isinstance(pending, ReducedOperator):     # inverted: its coupling is that of the Jacobian now
                 op, pending, fresh = pending, None, False
@@ -572,40 +579,68 @@ class BimeSolver:
             else:
                 fresh = False
         elif fresh and op is not None and self._spread and self._stage_due and iterations <= SPREAD_ITERATIONS:
-            self._spend(1.0 / len(SPREAD_STAGES))
-            pending = start_operator(p, self.compliance, stiffness, active, self._arithmetic)
+            pending = self._start_operator(p, mu, SPREAD_STAGES[0], required=False)
             fresh = self._stage_due = False
         self.pending_operator = pending
 
         def bordered(op):                      # contacts closed: bordered in (those that opened stay)
-            closed = active & ~op.active
-            if not np.any(closed):
+            rows = closing_rows(op, active)
+            if rows == 0:
                 return op
-            new_rows = 2 * int(np.count_nonzero(closed))
-            if new_rows <= 0.25 * op.rows.size:                # else update_operator declines: no work
-                self._spend(bordering_work(new_rows, op.rows.size))
-            return update_operator(op, p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
+            if borders(op, rows):              # else update_operator declines: no work
+                self._spend(bordering_work(rows, op.rows.size))
+            return update_operator(op, p, self.compliance, self.assembly.stiffness, self.jacobian, active, mu,
+                                   self._arithmetic)
 
         if not fresh and op is not None:
             op = bordered(self._turned(op, mu))
             if op is None and self.pending_operator is not None:     # too many closed: the pending one, at once
-                self._spend(_stages_left(self.pending_operator) / len(SPREAD_STAGES))
-                op = complete_operator(self.pending_operator, self.jacobian, mu, self._arithmetic)
+                op = self._advance(self.pending_operator, mu, len(STAGES), required=True)
                 self._reduced, self._reduced_jacobian, self.pending_operator = op, self._jacobian_rows, None
                 op = bordered(op)
         if fresh or op is None:
-            self._spend(1.0)
-            op = assemble_operator(p, self.compliance, stiffness, self.jacobian, active, mu, self._arithmetic)
+            if math.isinf(self._work_left):
+                op = assemble_operator(p, self.compliance, self.assembly.stiffness, self.jacobian, active, mu,
+                                       self._arithmetic)
+            else:
+                op = self._start_operator(p, mu, len(STAGES), required=True)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         return op
 
-    def _spend(self, inversions: float) -> None:
-        """Take ``inversions`` of the ring operator's work from what the solve may still do
-        (``step_work``); :class:`_WorkSpent` where it is not left (nothing is done then)."""
-        if inversions > self._work_left + 1e-12:
+    def _start_operator(self, p: "_Point", mu: float, until: int, required: bool):
+        """A new operator formed at ``p`` and its stages up to ``until``, as :meth:`_advance` allows."""
+        self._spend(forming_work(2 * int(np.count_nonzero(p.loaded))))
+        pending = start_operator(p, self.compliance, self.assembly.stiffness, p.loaded, self._arithmetic, until=0)
+        return self._advance(pending, mu, until, required)
+
+    def _advance(self, pending: PendingOperator, mu: float, until: int, required: bool):
+        """The pending operator's stages up to ``until`` (:data:`~slewing_model.rings.reduced_operator.STAGES`),
+        those the solve's work allows (``step_work``: at least one where it spent nothing yet); the
+        operator where they are all done and asked for (``until`` the last), else the pending one,
+        kept as the solver's and :class:`_WorkSpent` raised where ``required``."""
+        n, stage = pending.matrix.shape[0], pending.stage
+        while stage < until:
+            cost = stage_work(n, stage)
+            if cost > self._work_left and self._work_left < BOUNDED_WORK:
+                break
+            self._work_left -= cost
+            stage += 1
+        if stage > pending.stage:
+            pending = advance_operator(pending, None, None, until=stage)
+        if pending.stage >= len(STAGES) and until >= len(STAGES):
+            return advance_operator(pending, self.jacobian, mu, self._arithmetic)
+        if required:
+            self.pending_operator = pending
             raise _WorkSpent
-        self._work_left -= inversions
+        return pending
+
+    def _spend(self, work: float) -> None:
+        """Take ``work`` (:data:`BOUNDED_WORK`) from what the solve may still do (``step_work``);
+        :class:`_WorkSpent` where it is not left (nothing is done then)."""
+        if work > self._work_left:
+            raise _WorkSpent
+        self._work_left -= work
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float,
                 converged: bool = True) -> LoadDistribution:
@@ -658,20 +693,20 @@ class BimeSolver:
         )
 
 
-def bordering_work(new_rows: int, kept_rows: int) -> float:
-    """Bordering ``new_rows`` onto a kept operator of ``kept_rows``, in inversions of the kept one:
-    ``3.5 r / n`` (``4 n^2 r`` flops against about ``n^3``; measured on one BLAS thread, 368 rows: 0.85
-    of an inversion for 92 new rows, 0.34 for 32; ``benchmarks/bench_operator.py --border``)."""
-    return 3.5 * new_rows / kept_rows
+def forming_work(rows: int) -> float:
+    """The work of forming ``W`` on ``rows`` rows (gathering ``M_aa``, adding the springs'
+    compliance) as :data:`BOUNDED_WORK` counts it: ``80 n^2`` (measured against the stages,
+    ``benchmarks/bench_operator.py --stages``)."""
+    return 80.0 * rows * rows
 
 
 class _WorkSpent(Exception):
     """A bounded solve has not the work left for what its next iteration needs (``step_work``)."""
 
 
-def _stages_left(pending: PendingOperator) -> int:
-    """Stages of a pending operator's inverse still to run (:data:`SPREAD_STAGES`)."""
-    return max(len(SPREAD_STAGES) - pending.stage, 0)
+def _step_end(pending: PendingOperator) -> int:
+    """Where the pending operator's next step of stages ends (:data:`SPREAD_STAGES`)."""
+    return next((end for end in SPREAD_STAGES if end > pending.stage), len(STAGES))
 
 
 def _refresh_due(residual: float, last_residual: float | None, rtol: float) -> bool:

@@ -177,35 +177,49 @@ def spd_inverse(w: np.ndarray) -> np.ndarray:
     runs near the machine's peak; ``np.linalg.inv`` (LU, then ``n`` triangular solves) is
     twice as slow on one thread at 380 rows (``docs/speed.md``).
 
-    The top level is three stages (:data:`HALVES`), which :class:`PendingOperator` spreads
-    over two steps."""
+    The top level is six stages (:data:`STAGES`), which :class:`PendingOperator` spreads over
+    steps."""
     if w.shape[0] <= LEAF:
         inverse = np.linalg.inv(w)
         return 0.5 * (inverse + inverse.T)
     parts = ()
-    for stage in HALVES:
+    for stage in STAGES:
         parts = stage(w, *parts)
     return parts[0]
 
 
-def _first_half(w):
-    """``A^-1`` and ``X = A^-1 B`` (5/12 of the flops)."""
+def _a_inverse(w):
+    """``A^-1``."""
     h = w.shape[0] // 2
-    a_inv = spd_inverse(w[:h, :h])
+    return (spd_inverse(w[:h, :h]),)
+
+
+def _x(w, a_inv):
+    """... ``X = A^-1 B``."""
+    h = w.shape[0] // 2
     return a_inv, a_inv @ w[:h, h:]
 
 
-def _second_half(w, a_inv, x):
-    """... and ``S^-1``, ``S = D - B^T X`` (5/12)."""
+def _schur(w, a_inv, x):
+    """... ``S = D - B^T X``, made exactly symmetric."""
     h = w.shape[0] // 2
     schur = w[h:, h:] - w[:h, h:].T @ x
-    return a_inv, x, spd_inverse(0.5 * (schur + schur.T))
+    return a_inv, x, 0.5 * (schur + schur.T)
 
 
-def _joined(w, a_inv, x, s_inv):
-    """... and ``w^-1`` from them (6/12)."""
+def _schur_inverse(w, a_inv, x, schur):
+    """... ``S^-1``."""
+    return a_inv, x, spd_inverse(schur)
+
+
+def _y(w, a_inv, x, s_inv):
+    """... ``Y = X S^-1``."""
+    return a_inv, x, s_inv, x @ s_inv
+
+
+def _joined(w, a_inv, x, s_inv, y):
+    """... and ``w^-1`` from them."""
     h = w.shape[0] // 2
-    y = x @ s_inv
     out = np.empty_like(w)
     corner = a_inv + y @ x.T
     out[:h, :h] = 0.5 * (corner + corner.T)
@@ -216,23 +230,52 @@ def _joined(w, a_inv, x, s_inv):
 
 
 #: the stages of :func:`spd_inverse`'s top level, each taking ``w`` and the last one's results
-HALVES = (_first_half, _second_half, _joined)
-#: the same as the steps of a :class:`PendingOperator`: ``A^-1 B`` on the step that forms ``W``
-#: (with ``W``'s gathering, about half the work), the rest on the next (measured against three
-#: steps and against the split 10/12 | 6/12: docs/speed.md)
-SPREAD_STAGES = ((_first_half,), (_second_half, _joined))
+STAGES = (_a_inverse, _x, _schur, _schur_inverse, _y, _joined)
+#: where the steps of a :class:`PendingOperator` end in a complete solve (one a step): ``A^-1`` and
+#: ``A^-1 B`` on the step that forms ``W`` (with ``W``'s gathering, about half the work), the rest
+#: on the next (measured against three steps and against the split 10/12 | 6/12: docs/speed.md). A
+#: bounded solve runs as many stages as its work allows (:func:`stage_work`).
+SPREAD_STAGES = (2, len(STAGES))
+
+
+#: what a floating-point operation of each stage costs against one of a large product's (one BLAS
+#: thread, measured: ``benchmarks/bench_operator.py --stages``): an inverse of a half recurses down to
+#: LAPACK's leaves and runs at about a third of a product's rate, ``S`` and the join add passes over
+#: the matrix
+STAGE_WEIGHT = (3.0, 1.0, 1.5, 3.0, 1.0, 1.5)
+
+
+def inverse_work(n: int) -> float:
+    """The work of :func:`spd_inverse` of ``n`` rows, its stages' (:func:`stage_work`): about
+    ``2.25 n^3``."""
+    return sum(stage_work(n, k) for k in range(len(STAGES)))
+
+
+def stage_work(n: int, stage: int) -> float:
+    """The work of stage ``stage`` of :data:`STAGES` on ``n`` rows: its floating-point operations
+    (a product of ``(p, q)`` by ``(q, r)`` is ``2 p q r``, an inverse of ``k`` rows ``4 k^3 / 3``, LAPACK's
+    ``2 k^3``; halves of ``h`` and ``m = n - h`` rows) times :data:`STAGE_WEIGHT`, so that work is about
+    time: some 55 million a millisecond on one core here. At :data:`LEAF` rows or fewer the first
+    stage is the whole inverse."""
+    if n <= LEAF:
+        return STAGE_WEIGHT[0] * 2.0 * n ** 3 if stage == 0 else 0.0
+    h = n // 2
+    m = n - h
+    flops = (4.0 / 3.0 * h ** 3, 2.0 * h * h * m, 2.0 * m * m * h, 4.0 / 3.0 * m ** 3, 2.0 * h * m * m,
+             2.0 * h * h * m)[stage]
+    return STAGE_WEIGHT[stage] * flops
 
 
 @dataclass(frozen=True)
 class PendingOperator:
-    """A new reduced operator formed at an iterate and inverted over two steps.
+    """A new reduced operator formed at an iterate and inverted over steps.
 
     Inverting ``W`` is about 2.5 ms on the pitch bearing, more than a whole step: made at
     once, it is what the slowest steps of a co-simulation spend (the 95th and 99th
-    percentiles). :func:`start_operator` forms ``W`` and runs the first of
-    :data:`SPREAD_STAGES`, :func:`advance_operator` the next; meanwhile the solver goes on
-    with the operator it has (a modified Newton step: slower, as exact). ``parts`` are the
-    last stage's results (see :data:`HALVES`)."""
+    percentiles). :func:`start_operator` forms ``W`` and runs the first step's stages
+    (:data:`SPREAD_STAGES`), :func:`advance_operator` the next; meanwhile the solver goes on
+    with the operator it has (a modified Newton step: slower, as exact). ``stage``: the stages
+    of :data:`STAGES` done, ``parts`` the last one's results."""
 
     rows: np.ndarray
     active: np.ndarray
@@ -252,12 +295,12 @@ class PendingOperator:
                    tuple(np.asarray(v) for v in parts))
 
 
-def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None
-                   ) -> PendingOperator:
+def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None,
+                   until: int | None = None) -> PendingOperator:
     """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
-    and run the first stage of its inverse."""
+    and run the stages of its inverse up to ``until`` (default: the first step's, :func:`advance_operator`)."""
     rows, a_inv, w_mat = _arithmetic(arithmetic).form(point, compliance, stiffness, active)
-    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None)
+    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None, until=until)
 
 
 def operator_matrix(point, compliance, stiffness, active):
@@ -271,20 +314,23 @@ def operator_matrix(point, compliance, stiffness, active):
     return rows, a_inv, w_mat
 
 
-def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
-                     ) -> "PendingOperator | ReducedOperator":
-    """The next of :data:`SPREAD_STAGES`; after the last, the operator with its coupling to the
-    Jacobian (4B, 5) of now (``jacobian`` None: the pending operator, inverted). A small ``W``
+def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None,
+                     until: int | None = None) -> "PendingOperator | ReducedOperator":
+    """The stages of :data:`STAGES` up to ``until`` (default: the end of this step's,
+    :data:`SPREAD_STAGES`); after the last, the operator with its coupling to the Jacobian (4B, 5) of
+    now (``jacobian`` None: the pending operator, inverted). A ``W`` of :data:`LEAF` rows or fewer
     is inverted in one stage."""
-    if pending.stage < len(SPREAD_STAGES):
+    if until is None:
+        until = next((end for end in SPREAD_STAGES if end > pending.stage), len(STAGES))
+    if pending.stage < until:
         if pending.matrix.shape[0] <= LEAF:
-            pending = replace(pending, stage=len(SPREAD_STAGES), parts=(spd_inverse(pending.matrix),))
+            pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(pending.matrix),))
         else:
             parts = pending.parts
-            for stage in SPREAD_STAGES[pending.stage]:
+            for stage in STAGES[pending.stage:until]:
                 parts = stage(pending.matrix, *parts)
-            pending = replace(pending, stage=pending.stage + 1, parts=parts)
-    if pending.stage < len(SPREAD_STAGES) or jacobian is None:
+            pending = replace(pending, stage=until, parts=parts)
+    if pending.stage < len(STAGES) or jacobian is None:
         return pending
     return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
                             arithmetic)
@@ -293,9 +339,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
 def complete_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
                       ) -> ReducedOperator:
     """The remaining stages at once."""
-    while isinstance(pending, PendingOperator):
-        pending = advance_operator(pending, jacobian, mu, arithmetic)
-    return pending
+    return advance_operator(pending, jacobian, mu, arithmetic, until=len(STAGES))
 
 
 def assemble_operator(point, compliance, stiffness, jacobian, active, mu,
@@ -329,7 +373,7 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     would be new. The blocks are :func:`bordered_inverse`'s."""
     closed = active & ~op.active
     new_rows = np.flatnonzero(np.repeat(closed, 2))
-    if new_rows.size > 0.25 * op.rows.size:
+    if not borders(op, new_rows.size):
         return None
     rows = np.concatenate([op.rows, new_rows])
     new_a_inv = contact_compliance_blocks(point, stiffness, closed)
@@ -342,6 +386,29 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     # the kept rows keep the Jacobian their coupling is for (a nearly turned one: turned_operator)
     return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
                            np.concatenate([op.jacobian, new_jacobian]), coupling, schur_inverse)
+
+
+#: bordering declines where more than this share of the kept rows would be new (a new operator is due)
+BORDER_SHARE = 0.25
+
+
+def closing_rows(op: ReducedOperator, active: np.ndarray) -> int:
+    """Rows the contacts that closed since ``op`` was formed would add (:func:`update_operator`)."""
+    return 2 * int(np.count_nonzero(active & ~op.active))
+
+
+def borders(op: ReducedOperator, rows: int) -> bool:
+    """Whether :func:`update_operator` borders ``rows`` new rows onto ``op`` (else it declines)."""
+    return rows <= BORDER_SHARE * op.rows.size
+
+
+def bordering_work(rows: int, kept_rows: int) -> float:
+    """The work of bordering ``r = rows`` onto ``n = kept_rows`` (:func:`bordered_inverse`), as
+    :func:`stage_work` counts it: ``X = W^-1 B`` and ``X S X^T``, ``2 n^2 r`` each, ``B^T X`` and ``X S``,
+    ``2 n r^2`` each, ``S``'s inverse by LAPACK, ``6 r^3``, and the new matrix and coupling, ``120 (n + r)^2``
+    (``benchmarks/bench_operator.py --border``)."""
+    n, r = kept_rows, rows
+    return 5.0 * n * n * r + 4.0 * n * r * r + 6.0 * r ** 3 + 120.0 * (n + r) ** 2
 
 
 def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
