@@ -1,7 +1,7 @@
 """The compiled loops ahead of time (build time only; used by ``build_fmu.py --aot``).
 
-The load distribution's and the friction's loops (``slewing_model/distribution/kernel.py``,
-``slewing_model/friction/kernel.py``: every entry of their ``KERNELS``) are compiled once here, by
+The load distribution's, the friction's and the life map's loops (``slewing_model/distribution/kernel.py``,
+``slewing_model/friction/kernel.py``, ``slewing_model/life/kernel.py``: every entry of their ``KERNELS``) are compiled once here, by
 numba's ahead-of-time compiler (``numba.pycc``), into one CPython extension module,
 :data:`slewing_model.numerics.compiled.AOT_MODULE`, for a generic x86-64 CPU. That module needs
 numpy only, not numba or llvmlite (LLVM, 179 of a numba FMU's 270 MB unpacked), and starts
@@ -35,7 +35,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
 #: the modules whose KERNELS are compiled
-KERNEL_MODULES = ("slewing_model.distribution.kernel", "slewing_model.friction.kernel")
+KERNEL_MODULES = ("slewing_model.distribution.kernel", "slewing_model.friction.kernel", "slewing_model.life.kernel")
 
 
 def module_file_name() -> str:

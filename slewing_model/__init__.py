@@ -31,7 +31,8 @@ RUNTIME_MODULES = ("__init__",
                    "numerics/__init__", "numerics/compiled", "numerics/blas",
                    "simulation/__init__", "simulation/simulator",
                    # rainflow is imported only by the life post-processing
-                   "life/__init__", "life/rating", "life/oscillation", "life/raceway_map", "life/wear", "life/dg03",
+                   "life/__init__", "life/rating", "life/oscillation", "life/raceway_map", "life/kernel", "life/wear",
+                   "life/dg03",
                    "life/duty")
 
 __all__ = [

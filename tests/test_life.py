@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import slewing_model.life as life
+from slewing_model.numerics.compiled import AVAILABLE
 from slewing_model import load_bearing
 from slewing_model.life.wear import travel_by_ring_kinematics
 
@@ -144,14 +145,18 @@ def synthetic_step(bearing, psi, pattern, b=1e-3):
                            contact_angle=np.full_like(q, bearing.contact_angle), contact_pressure=q * 1e3)
 
 
-def test_full_rotation_map_gives_the_iso_life():
+KERNELS = ["numpy", pytest.param("compiled", marks=pytest.mark.skipif(not AVAILABLE, reason="numba is not installed"))]
+
+
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_full_rotation_map_gives_the_iso_life(kernel):
     """n revolutions of the inner ring under a load pattern fixed in space, Q(φ) = Q0 (1 + 0.5 cos φ):
     the map's track damage is n / (Qc/Qe)^3 / 10^6 with ISO/TS 16281's rotating Qe = (ΣQ³/Z)^(1/3)
     on the inner ring (contact 3) and standing Qe = (ΣQ^(10/3)/Z)^(3/10) on the outer ring (contact 1);
     the tracks combine as ISO's L10r. Tolerance 3e-3: a slice is passed an integer number of
-    times (±1 in about 75 n)."""
+    times (±1 in about 75 n). Both ways of adding a step's passes (numpy, one compiled loop)."""
     model = life.LifeModel(BEARING, "inner", "fixed")
-    acc = life.LifeAccumulator(model)
+    acc = life.LifeAccumulator(model, kernel=kernel)
     pattern = lambda phi: 2.0e5 * (1 + 0.5 * np.cos(phi))      # noqa: E731
     n, steps = 8, 8 * 720
     for psi in np.linspace(0.0, 2 * np.pi * n, steps + 1):
@@ -168,12 +173,13 @@ def test_full_rotation_map_gives_the_iso_life():
     assert 1.0 / life.rating.combined_damage(d) == pytest.approx(iso * 1e6 / n, rel=3e-3)
 
 
-def test_small_oscillation_damages_only_the_slices_balls_cross():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_small_oscillation_damages_only_the_slices_balls_cross(kernel):
     """A swing Δψ below the critical angle: on the outer (standing) ring each ball covers the arc
     (1 - γ)/2 Δψ, so the damaged share of the track is Z (1 - γ)/2 Δψ / 2π (±1 slice per ball);
     the rest has no rolling damage."""
     model = life.LifeModel(BEARING, "inner", "fixed", life.LifeSettings(slices=7200))
-    acc = life.LifeAccumulator(model)
+    acc = life.LifeAccumulator(model, kernel=kernel)
     swing = 0.5 * model.critical[0]
     for psi in np.concatenate([np.linspace(0, swing, 50), np.linspace(swing, 0, 50)] * 3):
         acc.step(0.0, psi, synthetic_step(BEARING, psi, lambda phi: np.full_like(phi, 1e5)))
@@ -184,7 +190,8 @@ def test_small_oscillation_damages_only_the_slices_balls_cross():
     assert share < 0.6
 
 
-def test_track_damage_kept_step_by_step_equals_the_whole_map_and_states_stay_as_taken():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_track_damage_kept_step_by_step_equals_the_whole_map_and_states_stay_as_taken(kernel):
     """The map changes only where balls crossed, and each track's sum of d_j^(10/9) follows it
     (issue 31): after a swinging and turning run it equals the sum over the whole map to
     round-off; a state taken mid-run (the simulator takes one before every step) is not changed
@@ -192,7 +199,7 @@ def test_track_damage_kept_step_by_step_equals_the_whole_map_and_states_stay_as_
     from slewing_model.life.raceway_map import track_damage
 
     model = life.LifeModel(BEARING, "inner", "fixed")
-    acc = life.LifeAccumulator(model)
+    acc = life.LifeAccumulator(model, kernel=kernel)
     pattern = lambda phi: 2.0e5 * (1 + 0.5 * np.cos(phi))      # noqa: E731
     psis = np.concatenate([np.linspace(0.0, 0.3, 200), 0.3 + 0.02 * np.sin(np.linspace(0, 40, 400)),
                            np.linspace(0.3, 7.0, 300)])
@@ -207,6 +214,26 @@ def test_track_damage_kept_step_by_step_equals_the_whole_map_and_states_stay_as_
     np.testing.assert_array_equal(state["map"]["map"], kept_map)        # untouched by the later steps
     acc.set_state(state)
     np.testing.assert_array_equal(acc.track_damage, kept_damage)
+
+
+@pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
+@pytest.mark.parametrize("moving_ring", ["inner", "outer"])
+def test_compiled_map_step_equals_numpy_s(moving_ring):
+    """The compiled loop adds each pass on its own where numpy sums a slice's passes first: the maps
+    and the kept sums agree to round-off over a run that swings, turns both ways and jumps."""
+    model = life.LifeModel(BEARING, moving_ring, "fixed")
+    maps = {k: life.LifeAccumulator(model, kernel=k) for k in ("numpy", "compiled")}
+    rng = np.random.default_rng(3)
+    psis = np.concatenate([np.cumsum(rng.normal(0.0, 0.01, 400)), np.linspace(0.0, -9.0, 300), [2.0, -1.0]])
+    for psi in psis:
+        pattern = lambda phi: 1.5e5 * (1 + 0.5 * np.cos(phi + psi)) * rng.uniform(0.8, 1.2)  # noqa: E731
+        step = synthetic_step(BEARING, psi, pattern)
+        for acc in maps.values():
+            acc.step(0.0, psi, step)
+    numpy_map, compiled_map = maps["numpy"].map, maps["compiled"].map
+    assert np.count_nonzero(numpy_map.damage_map) > 1000
+    np.testing.assert_allclose(compiled_map.damage_map, numpy_map.damage_map, rtol=1e-12, atol=0.0)
+    np.testing.assert_allclose(compiled_map.track_damage(), numpy_map.track_damage(), rtol=1e-12, atol=0.0)
 
 
 def test_half_cycle_travel_ratio():

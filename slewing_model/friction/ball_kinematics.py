@@ -690,8 +690,9 @@ def warm_friction_step(bearing: Bearing, distribution, mu: float, speed: float, 
     """A warm-started friction torque's loops in one compiled call
     (:func:`slewing_model.friction.kernel.compiled_friction_step`): the same loops, with the same
     arguments, as the steps of :func:`slewing_model.friction.friction_torque` (the same numbers
-    bit for bit). ``warm``: the last state (B, 4). None where the general path must run (a
-    distribution to refuse, no loaded contact, a ball without a warm start); else the
+    bit for bit where every ball has a warm start; a ball without one is started as
+    :func:`cold_start` starts it, the same to round-off). ``warm``: the last state (B, 4). None where
+    the general path must run (a distribution to refuse, no loaded contact); else the
     iterations, largest residual, whether converged, the contacts' powers and torques (C,) and
     :func:`ball_results`'s arrays."""
     arrays = distribution_arrays(bearing, distribution, writable=True)

@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from ..distribution.kernel import KERNELS as CONTACT_KERNELS
+from ..life.kernel import KERNELS as LIFE_KERNELS
 from ..numerics.compiled import AVAILABLE, KERNEL_CHOICES, compile_loop, loop_factory, use_compiled  # noqa: F401
 
 
@@ -346,6 +347,50 @@ def _rule_weight(folded_weight, mu_load):
     return weight
 
 
+def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale, pitch_radius,
+                g10, g12, h1, s0, s1, hs, weight, t2, eps2):
+    """The start of each ``cold`` row of ``u`` (active balls, scaled unknowns), in place:
+    :func:`slewing_model.friction.ball_kinematics.cold_start`, ball by ball, with its candidates
+    (``ContactSet.initial_guesses``: rolling about the normal of the heavier diagonal, and for a ball
+    loaded on both about the axial direction), the one of least power, one Newton step from it and
+    the length of least power among 0, 1/4 and 1/2 of it (``_COLD_STEPS``). The other arguments are
+    :func:`_minimise_balls`'s (the rule the balls are solved on)."""
+    w_o, w_i = (0.0, speed) if inner_moves else (speed, 0.0)
+    big_r, ls = pitch_radius, length_scale
+    g, h, e = np.empty(3), np.empty((3, 3)), np.empty((3, 3))
+    best, other, du, minus_g, trial = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    for row in range(active.size):
+        if not cold[row]:
+            continue
+        ball, c0, c1 = active[row], first[row], first[row + 1]
+        rb = ball_radius[ball]
+        q1, q2 = load[ball, 0], load[ball, 1]
+        outer, sign = (0, 1.0) if q1 >= q2 else (3, -1.0)       # the heavier diagonal: 1 (contacts 1, 3), 2 (4, 2)
+        n_r, n_z = math.cos(angle[ball, outer]), sign * math.sin(angle[ball, outer])
+        w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
+        w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
+        best[0], best[1], best[2] = -w_g * n_z * ls, w_g * n_r * ls, w_c * big_r
+        if q1 > 0.0 and q2 > 0.0:                               # four contacts: the axial rolling too
+            r_o = rb * 0.5 * (math.cos(angle[ball, 0]) + math.cos(angle[ball, 3]))
+            r_i = -rb * 0.5 * (math.cos(angle[ball, 1]) + math.cos(angle[ball, 2]))
+            w_z = (w_i * (big_r + r_i) - w_o * (big_r + r_o)) / (r_i - r_o)
+            w_c = (w_o * (big_r + r_o) - r_o * w_z) / big_r
+            other[0], other[1], other[2] = 0.0, w_z * ls, w_c * big_r
+            if _ball_evaluate(other, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e) < \
+                    _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e):
+                best[:] = other
+        f = _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, False, g, h, e)
+        minus_g[:] = -g
+        _solve3(h, minus_g, du)
+        length, lowest = 0.0, f
+        for t in (0.25, 0.5):                                   # _COLD_STEPS
+            trial[:] = best + t * du
+            power = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e)
+            if power < lowest:
+                length, lowest = t, power
+        u[row] = best + length * du
+
+
 def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
                    sliding_regularisation, length_scale, pitch_radius, fine_nodes, fine_t2, fine_weight,
                    solve_nodes, solve_t2, solve_weight, same_rule, warm, tol, max_iterations, theta_down, theta_up,
@@ -358,9 +403,12 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     by one, with the same arguments, so the same numbers bit for bit.
 
     Returns a status (0; :data:`GENERAL_PATH` where the general path must run: a refused
-    distribution, whose refusal it words, no loaded contact, or a ball without a warm start),
+    distribution, whose refusal it words, or no loaded contact),
     the iterations (as ``minimise_power`` counts them), the largest force residual, whether every
-    ball converged, the contacts' powers and torques (C,), and :func:`_ball_results`'s."""
+    ball converged, the contacts' powers and torques (C,), and :func:`_ball_results`'s.
+
+    A ball without a warm start (newly loaded, or at rest) starts as ``friction_torque``'s general
+    path starts it (:func:`_cold_start`), so that a step whose contacts changed stays one call."""
     n_balls = load.shape[0]
     (status, _, ball_index, contact_index, owner, active, inactive, rows, moving_c, force_scale) = _contact_set(
         load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
@@ -374,15 +422,15 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
         return refused
     scale = (length_scale, length_scale, pitch_radius)
     u = np.empty((active.size, 3))
-    for row in range(active.size):                  # the warm start (friction_torque's), or the general path
+    cold = np.zeros(active.size, np.bool_)
+    for row in range(active.size):                  # the warm start (friction_torque's), or a cold one
         finite, moves = True, False
         for k, column in enumerate((0, 2, 3)):      # SOLVED
             value = warm[active[row], column] * speed * scale[k]
             u[row, k] = value
             finite = finite and math.isfinite(value)
             moves = moves or value != 0.0
-        if not (finite and moves):
-            return refused
+        cold[row] = not (finite and moves)
     a, b, rb, rd, n_r, n_z, ring_speed = rows[4], rows[5], rows[0], rows[1], rows[2], rows[3], rows[6]
     mu_load, eps2 = rows[7], rows[8]
     g10, g12, h1, s0, s1, hs, arm1, arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
@@ -393,15 +441,23 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
         first[owner[j] + 1] = j + 1
     for row in range(active.size):
         first[row + 1] = max(first[row + 1], first[row])
+    inner_moves = moving[1]                         # contact 2 is on the inner ring
     if same_rule:
+        if cold.any():
+            _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale,
+                        pitch_radius, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2)
         u, iterations, residual, converged = _minimise_balls(
             u, first, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, force_scale, tol, -1.0, max_iterations,
             theta_down, theta_up, theta_min_up)
     else:
         c10, c12, c1, c0, c1s, chs, _, _ = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
                                                                solve_nodes, length_scale, pitch_radius)
+        solve_weight_c = _rule_weight(solve_weight, mu_load)
+        if cold.any():
+            _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale,
+                        pitch_radius, c10, c12, c1, c0, c1s, chs, solve_weight_c, solve_t2, eps2)
         u, iterations, residual, converged = _minimise_balls(
-            u, first, c10, c12, c1, c0, c1s, chs, _rule_weight(solve_weight, mu_load), solve_t2, eps2, force_scale,
+            u, first, c10, c12, c1, c0, c1s, chs, solve_weight_c, solve_t2, eps2, force_scale,
             tol, -1.0, max_iterations, theta_down, theta_up, theta_min_up)
     power_c, torque_c = _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, arm1, arm2)
     all_converged = True
@@ -419,7 +475,8 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
 
 #: the helpers the friction's loops call
 _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
-            "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results")
+            "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results",
+            "_cold_start")
 
 
 #: numba's error model of these loops (Python's: a division by zero raises)
@@ -618,8 +675,9 @@ compiled_friction_step = loop_factory(KERNELS, _compile, _friction_step, _FRICTI
 
 def all_kernels(friction: bool = True, contact: bool = True) -> tuple:
     """The compiled loops of a step, the friction's and the load distribution's
-    (:mod:`slewing_model.distribution.kernel`): (factory, Python function) pairs."""
-    return tuple(KERNELS if friction else ()) + tuple(CONTACT_KERNELS if contact else ())
+    (:mod:`slewing_model.distribution.kernel`) with the life map's (:mod:`slewing_model.life.kernel`):
+    (factory, Python function) pairs."""
+    return tuple(KERNELS if friction else ()) + tuple(CONTACT_KERNELS + LIFE_KERNELS if contact else ())
 
 
 def compile_all(friction: bool = True, contact: bool = True) -> None:

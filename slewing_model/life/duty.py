@@ -163,6 +163,8 @@ class LifeAccumulator:
     model : LifeModel
     record : bool
         Keep the per-step numbers :func:`analyse_run` needs (:data:`RECORD_FIELDS`).
+    kernel : {"numpy", "auto", "compiled"}
+        How the raceway map adds a step's passes (``kernel`` of :class:`RacewayMap`).
 
     Examples
     --------
@@ -171,9 +173,9 @@ class LifeAccumulator:
     >>> acc.worst_damage, acc.last_ratio                                # doctest: +SKIP
     """
 
-    def __init__(self, model: LifeModel, record: bool = False):
+    def __init__(self, model: LifeModel, record: bool = False, kernel: str = "numpy"):
         self.model = model
-        self.map = RacewayMap(model.capacity, model.passes, model.moving_ring, model.slices)
+        self.map = RacewayMap(model.capacity, model.passes, model.moving_ring, model.slices, kernel=kernel)
         self.half = HalfCycles()
         self.record = record
         self.rows: list = []

@@ -33,7 +33,8 @@ Derivation (the weakest-link combination used)
     ball moves from its old to its new place on each ring (fixed ring: the ball angle ``φ_b``;
     moving ring: ``φ_b - ψ``), and the pass carries the mean of ``Q^3`` of the two steps.
 
-Run-time module: numpy only (a step costs a few array operations over the balls).
+Run-time module: numpy only (a step costs a few array operations over the balls), or its one
+compiled loop (:mod:`slewing_model.life.kernel`).
 """
 from __future__ import annotations
 
@@ -41,7 +42,9 @@ import math
 
 import numpy as np
 
+from .kernel import compiled_map_update
 from .rating import TRACK_RINGS, WEIBULL_SLOPE, LifeInputError, gamma
+from ..numerics.compiled import use_compiled
 
 #: fewest slices of a track around its circumference by default (0.25 deg each); the default is the
 #: first count from here with no common divisor with the ball count (:func:`default_slices`)
@@ -100,9 +103,13 @@ class RacewayMap:
         ``m`` of the tracks (:func:`passes_per_revolution`).
     moving_ring : {"inner", "outer"}
     slices : int
+    kernel : {"numpy", "auto", "compiled"}
+        How a step's passes are added: numpy array operations, or one compiled loop
+        (:mod:`slewing_model.life.kernel`, needs numba; "auto" where it is installed). The same
+        map to round-off.
     """
 
-    def __init__(self, capacities, passes, moving_ring: str, slices: int = DEFAULT_SLICES):
+    def __init__(self, capacities, passes, moving_ring: str, slices: int = DEFAULT_SLICES, kernel: str = "numpy"):
         if isinstance(slices, bool) or not isinstance(slices, (int, np.integer)) or slices < 4:
             raise LifeInputError(f"slices = {slices!r}: must be a whole number >= 4")
         if moving_ring not in ("inner", "outer"):
@@ -110,6 +117,7 @@ class RacewayMap:
         self.scale = 1.0 / (np.asarray(capacities, float) ** 3 * np.asarray(passes, float) * 1e6)
         self.slices = int(slices)
         self.moving = np.array([r == moving_ring for r in TRACK_RINGS])
+        self._compiled = use_compiled(kernel, "kernel")
         #: the tracks of the fixed ring and of the moving ring
         self._tracks = {ring_moving: np.flatnonzero(self.moving == ring_moving) for ring_moving in (False, True)}
         self.reset()
@@ -126,7 +134,14 @@ class RacewayMap:
         """Add the passes from the last step to this one (the first call only records). Only the
         slices a ball crossed change, and each track's ``Σ d_j^(10/9)`` follows them."""
         q3 = np.maximum(contact_load, 0.0) ** 3
-        if self._angle is not None:
+        if self._angle is not None and self._compiled:
+            if self._shared:                            # a state holds the map: it stays as it was
+                self.damage_map = self.damage_map.copy()
+                self._shared = False
+            compiled_map_update()(self.damage_map, self._power, self.scale, self.moving, self._angle,
+                                  np.ascontiguousarray(ball_angle, dtype=float), self._psi, float(psi), self._q3,
+                                  np.ascontiguousarray(q3), WEIBULL_SLOPE)
+        elif self._angle is not None:
             mean = 0.5 * (q3 + self._q3) * self.scale
             for ring_moving, tracks in self._tracks.items():
                 shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)

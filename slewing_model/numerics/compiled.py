@@ -22,7 +22,8 @@ from pathlib import Path
 #: the extension module of the loops compiled ahead of time (build_aot.py)
 AOT_MODULE = "slewing_kernels"
 #: the sources the loops are compiled from: the kernels, what they take from other modules, this registry
-KERNEL_SOURCES = ("distribution/kernel.py", "friction/kernel.py", "bearing/contact.py", "numerics/compiled.py")
+KERNEL_SOURCES = ("distribution/kernel.py", "friction/kernel.py", "life/kernel.py", "bearing/contact.py",
+                  "numerics/compiled.py")
 
 
 def kernel_source_hash() -> int:

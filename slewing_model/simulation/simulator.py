@@ -24,6 +24,10 @@ from ..bearing.geometry import Bearing
 from ..rings.reduced_operator import PendingOperator, ReducedOperator
 
 RING_MODELS = ("rigid", "flexible")
+#: the ball equilibrium's iterations behind the friction torque of a step whose load distribution is
+#: an iterate on its way (``step_work="bounded"``): its torque is one too, and the next step goes on
+#: from it (after a moment reversal a complete one takes 13-14, about 2 ms on the pitch bearing)
+BOUNDED_FRICTION_ITERATIONS = 4
 LOAD_FRAMES = ("fixed", "rotating")
 
 
@@ -76,15 +80,18 @@ class SimulatorSettings:
         where numba is installed, numpy otherwise; the results are the same to round-off.
     contact_kernel : {"auto", "numpy", "compiled"}
         The same for the load distribution's loops (its per-contact work and the reduced ring
-        operator's: ``kernel`` of :class:`slewing_model.distribution.bime.BimeSolver`).
+        operator's: ``kernel`` of :class:`slewing_model.distribution.bime.BimeSolver`) and the
+        life map's (``kernel`` of :class:`slewing_model.life.RacewayMap`).
     step_work : {"complete", "bounded"}
         How much a step may do (``step_work`` of :class:`slewing_model.distribution.bime.BimeSolver`):
         "complete" solves every step to ``tolerance``, however long a sudden change of the loads
         makes it (a moment reversed in one step: tens of ms); "bounded" (real time) caps a step's
-        work at a few Newton iterations and one inversion of the ring operator, and a step that
+        work at a few Newton iterations and about 2 ms of ring operator work (``BOUNDED_WORK``;
+        a new operator's inverse spread over steps), and a step that
         would need more answers with its last iterate, ``distribution.converged`` False and its
-        ``distribution.residual``, and carries the rest over to the next steps. The first step
-        is complete.
+        ``distribution.residual``, and carries the rest over to the next steps; the friction
+        torque of such a step is an iterate too (:data:`BOUNDED_FRICTION_ITERATIONS`). The first
+        step is complete.
     life : bool
         Accumulate the raceway life and wear step by step (:class:`slewing_model.life.LifeAccumulator`
         as ``BearingSimulator.life``, default :class:`slewing_model.life.LifeSettings`): the
@@ -199,7 +206,7 @@ class BearingSimulator:
         if s.life:
             from ..life import LifeAccumulator, LifeModel
 
-            self.life = LifeAccumulator(LifeModel(bearing, s.moving_ring, s.load_frame))
+            self.life = LifeAccumulator(LifeModel(bearing, s.moving_ring, s.load_frame), kernel=s.contact_kernel)
 
     def tune(self, **changes) -> None:
         """Change the tunable settings (``friction_coefficient``, ``seal_torque``,
@@ -244,7 +251,9 @@ class BearingSimulator:
                 friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
                                            omega=1.0, seal_torque=self.settings.seal_torque,
                                            initial=self._friction_warm, tol=self.settings.friction_tolerance,
-                                           kernel=self.settings.friction_kernel)
+                                           kernel=self.settings.friction_kernel,
+                                           **({} if distribution.converged else
+                                              {"max_iterations": BOUNDED_FRICTION_ITERATIONS}))
                 magnitude = friction.magnitude
                 self._friction_warm = friction.state
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)

@@ -1,0 +1,58 @@
+"""The raceway damage map's step as one compiled loop (numba, where it is installed).
+
+:meth:`slewing_model.life.raceway_map.RacewayMap.update` adds the passes of the balls between two
+steps to the slices they crossed: with numpy some thirty array operations a step (the crossed
+slices of each ring, ``np.unique``, a ``bincount`` per track), each a few microseconds of call
+overhead for a few dozen passes. :func:`_map_update` is the same sum as one loop over tracks,
+balls and the slices each ball crossed, in place. It adds the passes one by one where numpy sums a
+slice's passes first: the map and its sums agree to round-off (``tests/test_life_map.py``).
+"""
+from __future__ import annotations
+
+import math
+
+from ..numerics.compiled import compile_loop, loop_factory
+
+_MAP_UPDATE_SIGNATURE = "void(f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:], f8, f8, f8[:, :], f8[:, :], f8)"
+
+
+def _map_update(damage_map, power, scale, moving, angle_old, angle_new, psi_old, psi_new, q3_old, q3_new, slope):
+    """Add the passes from the last step to this one to ``damage_map`` (4, N) and to each track's
+    ``power`` (4,) ``Σ_j d_j^slope``, in place: ball ``b`` passes the slices whose centres lie between
+    its old and new place on the track's ring (``angle - psi`` on the moving ring, ``moving`` (4,)),
+    half-open, each pass carrying ``scale[k] (q3_old[b, k] + q3_new[b, k]) / 2``
+    (:func:`slewing_model.life.raceway_map.crossed_slices`, ``RacewayMap._add``)."""
+    slices = damage_map.shape[1]
+    per_radian = slices / (2.0 * math.pi)
+    for k in range(damage_map.shape[0]):
+        shift_old = psi_old if moving[k] else 0.0
+        shift_new = psi_new if moving[k] else 0.0
+        for b in range(angle_old.size):
+            u0 = (angle_old[b] - shift_old) * per_radian - 0.5
+            u1 = (angle_new[b] - shift_new) * per_radian - 0.5
+            first = math.floor(min(u0, u1))
+            count = int(math.floor(max(u0, u1)) - first)
+            if count == 0:
+                continue
+            mean = 0.5 * (q3_new[b, k] + q3_old[b, k]) * scale[k]
+            for j in range(count):
+                s = int((first + 1 + j) % slices)
+                old = damage_map[k, s]
+                new = old + mean
+                power[k] += new ** slope - old ** slope
+                damage_map[k, s] = new
+
+
+#: the helpers the loops call
+_HELPERS: tuple = ()
+#: numba's error model of these loops (Python's: a division by zero raises)
+ERROR_MODEL = "python"
+
+
+def _compile(function, signature):
+    return compile_loop(function, signature, _HELPERS, error_model=ERROR_MODEL)
+
+
+#: (factory, Python function) of each compiled loop of the life model
+KERNELS: list = []
+compiled_map_update = loop_factory(KERNELS, _compile, _map_update, _MAP_UPDATE_SIGNATURE)
