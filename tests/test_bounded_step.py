@@ -170,3 +170,34 @@ def test_bordered_inverse_is_the_inverse_of_the_bordered_matrix(new_rows):
         bordered, coupling, _ = bordering(*args)
         assert np.allclose(bordered, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
         assert np.allclose(coupling, expected @ np.vstack([jacobian, new_jacobian]), atol=1e-12)
+
+
+def test_a_flagged_step_caps_its_friction_and_the_steps_after_arrive_at_the_complete_torque(table1, rings,
+                                                                                             monkeypatch):
+    """The friction torque of an iterate on its way is an iterate too: at most
+    BOUNDED_FRICTION_ITERATIONS of the ball equilibrium (a complete one after the reversal takes
+    more), and once the distribution has arrived the torque is the complete solve's within the
+    friction tolerance."""
+    from slewing_model.simulation import simulator
+
+    solved = []
+    original = simulator.friction_torque
+
+    def recorded(*args, **kwargs):
+        solved.append((kwargs.get("max_iterations"), original(*args, **kwargs)))
+        return solved[-1][1]
+    monkeypatch.setattr(simulator, "friction_torque", recorded)
+    steps = {}
+    for work in ("complete", "bounded"):
+        sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, step_work=work))
+        sim.step(FORWARD, 0.0, 0.1)
+        solved.clear()
+        steps[work] = [(sim.step(REVERSED, 0.0, 0.1), solved[-1]) for _ in range(30)]
+    complete_first = steps["complete"][0][1][1]
+    assert complete_first.iterations > simulator.BOUNDED_FRICTION_ITERATIONS      # the case discriminates
+    flagged = [(cap, torque) for result, (cap, torque) in steps["bounded"] if not result.distribution.converged]
+    assert flagged and all(cap == simulator.BOUNDED_FRICTION_ITERATIONS for cap, _ in flagged)
+    assert all(t.iterations <= simulator.BOUNDED_FRICTION_ITERATIONS for _, t in flagged)
+    arrived, complete = steps["bounded"][-1][0], steps["complete"][-1][0]
+    assert arrived.distribution.converged
+    assert arrived.friction_torque_magnitude == pytest.approx(complete.friction_torque_magnitude, rel=1e-5)
