@@ -21,7 +21,9 @@ alternate in blocks, so all see the same machine load. A step is ``setReal`` of 
 instantiation (the FMU solved its start values, zero loads, when leaving initialization).
 
 Goals of issue 31, printed beside the figures: median at most 0.45 of the baseline's, the slowest
-step at most 4 times the NREL median, the first step at most 10 times the median.
+step at most 4 times the NREL median (and how many steps, after the first, were slower than that: one
+step held up by the machine shows in the slowest, not in that count), the first step at most 10 times
+the median.
 
 Run: .venv/bin/python benchmarks/bench_realtime.py [--baseline REV|none] [--blocks 4]
      [--scenarios nrel reversal ...]
@@ -111,7 +113,7 @@ def main() -> None:
         integers = {"bounded": {"step_work": 2}}
         if args.baseline != "none":
             fmus["baseline"] = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",))["pitch_bearing"]
-        rows, medians = [], {}
+        rows, medians, all_times = [], {}, {}
         for name in args.scenarios:
             case = scenario(name)
             path = save(case, tmp / f"{name}.npz")
@@ -135,6 +137,7 @@ def main() -> None:
                 w.close()
                 t = np.array(times[v]) * 1e3
                 medians[name, v] = float(np.median(t))
+                all_times[name, v] = t
                 rows.append([name, v, f"{first[v] * 1e3:.1f}", f"{np.median(t):.2f}", f"{np.percentile(t, 99):.2f}",
                              f"{t.max():.1f}", f"{first[v] * 1e3 / np.median(t):.0f}",
                              "–" if v == "baseline" else str(flagged[v])])
@@ -142,13 +145,15 @@ def main() -> None:
         for row in rows:
             name, v = row[0], row[1]
             ratio = medians[name, v] / medians[name, "baseline"] if "baseline" in fmus else math.nan
-            slowest = float(row[5]) / medians.get(("nrel", "complete"), math.nan)
-            row += [f"{ratio:.2f}", f"{slowest:.1f}"]
+            nrel_median = medians.get(("nrel", "complete"), math.nan)
+            over = int(np.count_nonzero(all_times[name, v] > 4.0 * nrel_median))
+            row += [f"{ratio:.2f}", f"{float(row[5]) / nrel_median:.1f}", str(over)]
         print_table("Pitch bearing FMU through fmpy (flexible rings, friction and life on), one step = setReal + "
                     f"doStep ({DT * 1e3:.0f} ms) + getReal; {args.blocks} alternating blocks per scenario; "
                     f"baseline {args.baseline}",
                     ["scenario", "version", "first step [ms]", "median [ms]", "p99 [ms]", "slowest [ms]",
-                     "first / median", "flagged steps", "median / baseline's", "slowest / NREL median"], rows)
+                     "first / median", "flagged steps", "median / baseline's", "slowest / NREL median",
+                     "steps over 4 NREL medians"], rows)
 
 
 if __name__ == "__main__":

@@ -93,7 +93,7 @@ SPREAD_ITERATIONS = 8
 #: NREL 156 and 24 steps of 6000 flagged (docs/speed.md) ...
 BOUNDED_WORK = 1e8
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
-#: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Bounded steps")
+#: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
 BOUNDED_ITERATIONS = 12
 STEP_WORK = ("complete", "bounded")
 #: the ring of contacts 1..4
