@@ -78,7 +78,8 @@ REFRESH = 0.4
 #: more iterations, which cost less than a new operator (pitch bearing: 3 of 0.1 ms against
 #: one operator of 2.5 ms, 4 ms when this was measured; docs/speed.md)
 FINISH_ITERATIONS = 3
-#: in a warm solve a new operator is inverted over this solve and the next, while the solver goes on
+#: in a warm solve a new operator is inverted over this solve and the next (a bounded one: as its work
+#: allows, BOUNDED_WORK), while the solver goes on
 #: with the one it has (:class:`slewing_model.rings.reduced_operator.PendingOperator`); all at once when an
 #: iteration past this many in one solve is still slow (docs/speed.md)
 SPREAD_ITERATIONS = 8
@@ -541,9 +542,11 @@ class BimeSolver:
         matrix-vector products only.
 
         In a warm solve a fresh operator is formed at once but inverted over this solve and
-        the next (:class:`PendingOperator`), while the kept one goes on: at most one stage a
-        solve, and all at once when an iteration past :data:`SPREAD_ITERATIONS` of one solve
-        is still slow or the kept operator cannot follow the contacts that closed.
+        the next (:class:`PendingOperator`), while the kept one goes on: at most one step's stages
+        (:data:`~slewing_model.rings.reduced_operator.SPREAD_STAGES`) a solve, and all at once when an
+        iteration past :data:`SPREAD_ITERATIONS` of one solve is still slow or the kept operator
+        cannot follow the contacts that closed. A bounded solve (``step_work``) runs of these the
+        stages its work allows (:meth:`_advance`) and goes on in the next solves.
         """
         if not p.any_loaded:
             self._reduced = self.pending_operator = None
