@@ -201,3 +201,15 @@ def test_a_flagged_step_caps_its_friction_and_the_steps_after_arrive_at_the_comp
     arrived, complete = steps["bounded"][-1][0], steps["complete"][-1][0]
     assert arrived.distribution.converged
     assert arrived.friction_torque_magnitude == pytest.approx(complete.friction_torque_magnitude, rel=1e-5)
+
+
+def test_a_bounded_solve_of_small_operators_arrives_as_well(table1, rings, monkeypatch):
+    """Operators of LEAF rows or fewer are inverted by LAPACK in their first stage (here every one:
+    LEAF raised above the case's rows): a bounded run still arrives at the cold solution."""
+    from slewing_model.rings import reduced_operator
+
+    monkeypatch.setattr(reduced_operator, "LEAF", 10_000)
+    results, _ = reversal(table1, rings, "bounded")
+    assert results[-1].converged
+    reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
+    assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
