@@ -222,9 +222,7 @@ def build_simulator(slave, error) -> bool:
         if settings.ring_model == "flexible":
             superelement = Superelement.load(slave.superelement_path, slave.bearing)
         slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
-        from slewing_model.numerics.compiled import use_compiled
-
-        from slewing_model.numerics.compiled import aot_kernels
+        from slewing_model.numerics.compiled import aot_kernels, use_compiled
 
         compiled = ("compiled ahead of time (generic x86-64)" if aot_kernels() is not None
                     else f"compiled by numba for {numba_target()}")

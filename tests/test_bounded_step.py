@@ -14,7 +14,7 @@ from slewing_model.distribution.bime import BOUNDED_ITERATIONS, BOUNDED_WORK
 from slewing_model.distribution.kernel import BORDER_BLAS_ROWS, bordered_inverse as compiled_bordered_inverse
 from slewing_model.numerics.compiled import AVAILABLE
 from slewing_model.rings.reduced_operator import (
-    LEAF, STAGES, bordered_inverse, bordering_work, inverse_work, stage_work,
+    LEAF, STAGES, bordered_inverse, bordering_work, stage_work,
 )
 from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 from statics import load_on_moving_ring
@@ -66,10 +66,6 @@ class OperatorWork:
         def advanced(result, pending, *rest):
             stages(pending.matrix.shape[0], pending.stage, done(result))
 
-        def assembled(result, point, compliance, stiffness, jacobian, active, *rest):
-            n = 2 * int(np.count_nonzero(active))
-            self.work += bime.forming_work(n) + inverse_work(n)
-
         def bordered(result, op, point, compliance, stiffness, jacobian, active, *rest):
             new_rows = 2 * int(np.count_nonzero(active & ~op.active))
             if result is not None and new_rows:
@@ -77,7 +73,6 @@ class OperatorWork:
 
         counted("start_operator", started)
         counted("advance_operator", advanced)
-        counted("assemble_operator", assembled)
         counted("update_operator", bordered)
 
     def take(self) -> tuple[float, float]:

@@ -65,8 +65,7 @@ from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
     APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, STAGES, PendingOperator, ReducedOperator, advance_operator,
-    assemble_operator, bordering_work, borders, closing_rows, stage_work, start_operator, turned_operator,
-    update_operator,
+    bordering_work, borders, closing_rows, stage_work, start_operator, step_end, turned_operator, update_operator,
 )
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
@@ -574,7 +573,7 @@ class BimeSolver:
             if op is None or (fresh and iterations > SPREAD_ITERATIONS):     # the kept one no longer serves
                 pending = self._advance(pending, mu, len(STAGES), required=True)
             elif self._stage_due:                                              # one step's stages a solve
-                pending = self._advance(pending, mu, _step_end(pending), required=False)
+                pending = self._advance(pending, mu, step_end(pending), required=False)
             self._stage_due = False
             if isinstance(pending, ReducedOperator):     # inverted: its coupling is that of the Jacobian now
                 op, pending, fresh = pending, None, False
@@ -601,12 +600,8 @@ class BimeSolver:
                 op = self._advance(self.pending_operator, mu, len(STAGES), required=True)
                 self._reduced, self._reduced_jacobian, self.pending_operator = op, self._jacobian_rows, None
                 op = bordered(op)
-        if fresh or op is None:
-            if math.isinf(self._work_left):
-                op = assemble_operator(p, self.compliance, self.assembly.stiffness, self.jacobian, active, mu,
-                                       self._arithmetic)
-            else:
-                op = self._start_operator(p, mu, len(STAGES), required=True)
+        if fresh or op is None:                # formed and inverted now (a bounded solve: as its work allows)
+            op = self._start_operator(p, mu, len(STAGES), required=True)
             self.pending_operator = None
         self._reduced, self._reduced_jacobian = op, self._jacobian_rows
         return op
@@ -705,11 +700,6 @@ def forming_work(rows: int) -> float:
 
 class _WorkSpent(Exception):
     """A bounded solve has not the work left for what its next iteration needs (``step_work``)."""
-
-
-def _step_end(pending: PendingOperator) -> int:
-    """Where the pending operator's next step of stages ends (:data:`SPREAD_STAGES`)."""
-    return next((end for end in SPREAD_STAGES if end > pending.stage), len(STAGES))
 
 
 def _refresh_due(residual: float, last_residual: float | None, rtol: float) -> bool:

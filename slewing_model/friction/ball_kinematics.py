@@ -27,7 +27,7 @@ from ..distribution.assembly import ball_diameters
 from .contact import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .kernel import (
-    GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
+    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
     compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
 )
 from ..bearing.geometry import RING_CONTACTS, Bearing
@@ -42,8 +42,6 @@ _IS_MOVING = {ring: np.isin(np.arange(4), [c - 1 for c in RING_CONTACTS[ring]]) 
 SOLVED = [0, 2, 3]
 #: damping schedule of the Newton / Weiszfeld blend (see minimise_power)
 _THETA_DOWN, _THETA_UP, _THETA_MIN_UP = 0.2, 10.0, 0.1
-#: step lengths along the first Newton direction of a cold start (see cold_start)
-_COLD_STEPS = (0.25, 0.5)
 #: iterations after which at most a quarter of the balls left unconverged go on alone (see minimise_power).
 #: With the compiled loop an evaluation costs in proportion to its balls, so going alone early pays:
 #: measured on the pitch bearing's steps, after 1 iteration 1.24 ms, after 3 (numpy's best) 1.54 ms,
@@ -508,7 +506,7 @@ def cold_start(geometry: ContactSet, contacts: ContactPoints, u: np.ndarray, col
 
     Per ball the candidate of least power (:meth:`ContactSet.initial_guesses`),
     then one Newton step from it, line-searched on the power over the lengths
-    ``0, 1/4, 1/2`` (:data:`_COLD_STEPS`): from a rolling motion the Newton
+    ``0, 1/4, 1/2`` (:data:`~slewing_model.friction.kernel.COLD_STEPS`): from a rolling motion the Newton
     direction points at the minimum (measured on table3's two-contact balls:
     cosine 1.00 with the direction to it) but the full step overshoots it
     about three times, because the power curves less there than at the
@@ -521,8 +519,8 @@ def cold_start(geometry: ContactSet, contacts: ContactPoints, u: np.ndarray, col
     start = np.where(cold[:, None], best, u)
     f, g, h, _ = contacts.evaluate(start, eps2)
     du = np.where(cold[:, None], solve_per_ball(h, -g), 0.0)
-    lengths = np.array((0.0,) + _COLD_STEPS)
-    power = np.stack([f] + [contacts.evaluate(start + t * du, eps2, derivatives=False)[0] for t in _COLD_STEPS])
+    lengths = np.array((0.0,) + COLD_STEPS)
+    power = np.stack([f] + [contacts.evaluate(start + t * du, eps2, derivatives=False)[0] for t in COLD_STEPS])
     return start + lengths[np.argmin(power, axis=0)][:, None] * du
 
 

@@ -347,13 +347,17 @@ def _rule_weight(folded_weight, mu_load):
     return weight
 
 
+#: step lengths along the first Newton direction of a cold start (``ball_kinematics.cold_start``)
+COLD_STEPS = (0.25, 0.5)
+
+
 def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale, pitch_radius,
                 g10, g12, h1, s0, s1, hs, weight, t2, eps2):
     """The start of each ``cold`` row of ``u`` (active balls, scaled unknowns), in place:
     :func:`slewing_model.friction.ball_kinematics.cold_start`, ball by ball, with its candidates
     (``ContactSet.initial_guesses``: rolling about the normal of the heavier diagonal, and for a ball
     loaded on both about the axial direction), the one of least power, one Newton step from it and
-    the length of least power among 0, 1/4 and 1/2 of it (``_COLD_STEPS``). The other arguments are
+    the length of least power among 0 and :data:`COLD_STEPS` of it. The other arguments are
     :func:`_minimise_balls`'s (the rule the balls are solved on)."""
     w_o, w_i = (0.0, speed) if inner_moves else (speed, 0.0)
     big_r, ls = pitch_radius, length_scale
@@ -383,7 +387,7 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
         minus_g[:] = -g
         _solve3(h, minus_g, du)
         length, lowest = 0.0, f
-        for t in (0.25, 0.5):                                   # _COLD_STEPS
+        for t in COLD_STEPS:
             trial[:] = best + t * du
             power = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e)
             if power < lowest:
@@ -441,24 +445,18 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
         first[owner[j] + 1] = j + 1
     for row in range(active.size):
         first[row + 1] = max(first[row + 1], first[row])
-    inner_moves = moving[1]                         # contact 2 is on the inner ring
-    if same_rule:
-        if cold.any():
-            _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale,
-                        pitch_radius, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2)
-        u, iterations, residual, converged = _minimise_balls(
-            u, first, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, force_scale, tol, -1.0, max_iterations,
-            theta_down, theta_up, theta_min_up)
+    if same_rule:                                   # the rule the balls are solved on: the torque's, or its own
+        c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2 = g10, g12, h1, s0, s1, hs, weight, fine_t2
     else:
         c10, c12, c1, c0, c1s, chs, _, _ = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
                                                                solve_nodes, length_scale, pitch_radius)
-        solve_weight_c = _rule_weight(solve_weight, mu_load)
-        if cold.any():
-            _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale,
-                        pitch_radius, c10, c12, c1, c0, c1s, chs, solve_weight_c, solve_t2, eps2)
-        u, iterations, residual, converged = _minimise_balls(
-            u, first, c10, c12, c1, c0, c1s, chs, solve_weight_c, solve_t2, eps2, force_scale,
-            tol, -1.0, max_iterations, theta_down, theta_up, theta_min_up)
+        rule_weight, rule_t2 = _rule_weight(solve_weight, mu_load), solve_t2
+    if cold.any():
+        _cold_start(u, cold, active, first, load, angle, ball_radius, moving[1], speed, length_scale,   # moving[1]:
+                    pitch_radius, c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2, eps2)  # contact 2's, inner ring
+    u, iterations, residual, converged = _minimise_balls(
+        u, first, c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2, eps2, force_scale, tol, -1.0, max_iterations,
+        theta_down, theta_up, theta_min_up)
     power_c, torque_c = _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, arm1, arm2)
     all_converged = True
     most, largest = 0, 0.0

@@ -5,7 +5,7 @@ steps to the slices they crossed: with numpy some thirty array operations a step
 slices of each ring, ``np.unique``, a ``bincount`` per track), each a few microseconds of call
 overhead for a few dozen passes. :func:`_map_update` is the same sum as one loop over tracks,
 balls and the slices each ball crossed, in place. It adds the passes one by one where numpy sums a
-slice's passes first: the map and its sums agree to round-off (``tests/test_life_map.py``).
+slice's passes first: the map and its sums agree to round-off (``tests/test_life.py``).
 """
 from __future__ import annotations
 

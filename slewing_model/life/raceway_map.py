@@ -135,9 +135,7 @@ class RacewayMap:
         slices a ball crossed change, and each track's ``Σ d_j^(10/9)`` follows them."""
         q3 = np.maximum(contact_load, 0.0) ** 3
         if self._angle is not None and self._compiled:
-            if self._shared:                            # a state holds the map: it stays as it was
-                self.damage_map = self.damage_map.copy()
-                self._shared = False
+            self._own_map()
             compiled_map_update()(self.damage_map, self._power, self.scale, self.moving, self._angle,
                                   np.ascontiguousarray(ball_angle, dtype=float), self._psi, float(psi), self._q3,
                                   np.ascontiguousarray(q3), WEIBULL_SLOPE)
@@ -154,15 +152,19 @@ class RacewayMap:
 
     def _add(self, tracks, ball, where, mean) -> None:
         """Add ``mean[ball, k]`` to slice ``where`` of each track ``k`` of ``tracks``."""
-        if self._shared:                                # a state holds the map: it stays as it was
-            self.damage_map = self.damage_map.copy()
-            self._shared = False
+        self._own_map()
         crossed, inverse = np.unique(where, return_inverse=True)
         for k in tracks:
             old = self.damage_map[k, crossed]
             new = old + np.bincount(inverse, mean[ball, k], minlength=crossed.size)
             self._power[k] += float(np.sum(new ** WEIBULL_SLOPE - old ** WEIBULL_SLOPE))
             self.damage_map[k, crossed] = new
+
+    def _own_map(self) -> None:
+        """Before a change: a map a state holds (:meth:`get_state`) stays as it was, this one is a copy."""
+        if self._shared:
+            self.damage_map = self.damage_map.copy()
+            self._shared = False
 
     def track_damage(self) -> np.ndarray:
         """``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)`` of contacts 1..4, (4,), from the sums kept step by

@@ -321,7 +321,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     now (``jacobian`` None: the pending operator, inverted). A ``W`` of :data:`LEAF` rows or fewer
     is inverted in one stage."""
     if until is None:
-        until = next((end for end in SPREAD_STAGES if end > pending.stage), len(STAGES))
+        until = step_end(pending)
     if pending.stage < until:
         if pending.matrix.shape[0] <= LEAF:
             pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(pending.matrix),))
@@ -334,6 +334,11 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
         return pending
     return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
                             arithmetic)
+
+
+def step_end(pending: PendingOperator) -> int:
+    """Where the pending operator's next step of stages ends (:data:`SPREAD_STAGES`)."""
+    return next((end for end in SPREAD_STAGES if end > pending.stage), len(STAGES))
 
 
 def complete_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None
@@ -406,7 +411,8 @@ def bordering_work(rows: int, kept_rows: int) -> float:
     """The work of bordering ``r = rows`` onto ``n = kept_rows`` (:func:`bordered_inverse`), as
     :func:`stage_work` counts it: ``X = W^-1 B`` and ``X S X^T``, ``2 n^2 r`` each, ``B^T X`` and ``X S``,
     ``2 n r^2`` each, ``S``'s inverse by LAPACK, ``6 r^3``, and the new matrix and coupling, ``120 (n + r)^2``
-    (``benchmarks/bench_operator.py --border``)."""
+    (``benchmarks/bench_operator.py --border``); the ``n^2 r`` products weighted 1.25 (``5 n^2 r``) for the
+    passes of ``X S X^T``."""
     n, r = kept_rows, rows
     return 5.0 * n * n * r + 4.0 * n * r * r + 6.0 * r ** 3 + 120.0 * (n + r) ** 2
 

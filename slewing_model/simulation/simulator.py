@@ -24,11 +24,11 @@ from ..bearing.geometry import Bearing
 from ..rings.reduced_operator import PendingOperator, ReducedOperator
 
 RING_MODELS = ("rigid", "flexible")
+LOAD_FRAMES = ("fixed", "rotating")
 #: the ball equilibrium's iterations behind the friction torque of a step whose load distribution is
 #: an iterate on its way (``step_work="bounded"``): its torque is one too, and the next step goes on
 #: from it (after a moment reversal a complete one takes 13-14, about 2 ms on the pitch bearing)
 BOUNDED_FRICTION_ITERATIONS = 4
-LOAD_FRAMES = ("fixed", "rotating")
 
 
 @dataclass(frozen=True)
