@@ -65,10 +65,12 @@ def rss_mb() -> float:
 
 
 def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = None, outputs=OUTPUTS,
-           trace: str | None = None) -> None:
+           trace: str | None = None, start_inputs: bool = False) -> None:
     """Instantiate the FMU (the case's integer parameters, then ``integers``), then answer lines
     ``first count`` on stdin with the step times and the last ``outputs`` (JSON); with ``trace``, the
-    value of that output after every step too."""
+    value of that output after every step too. ``start_inputs``: the case's first inputs are set in
+    initialization mode, as fmpy's ``simulate_fmu`` sets a master's inputs at the start time (the FMU
+    then solves them when it leaves initialization); else the FMU starts from its start values."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
@@ -83,10 +85,12 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
     fmu.setupExperiment(startTime=0.0)
     for name, value in {**case.parameters, **(integers or {})}.items():
         fmu.setInteger([refs[name]], [value])
+    inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in outputs]
     fmu.enterInitializationMode()
+    if start_inputs:
+        fmu.setReal(inputs, [*map(float, case.loads[0]), float(case.psi[0]), float(case.omega[0])])
     fmu.exitInitializationMode()
     instantiate = time.perf_counter() - start
-    inputs, outputs = [refs[n] for n in INPUTS], [refs[n] for n in outputs]
     compiled = "numba" in sys.modules
     print(json.dumps({"instantiate": instantiate, "compiled": compiled}), flush=True)
     traced = refs[trace] if trace else None
@@ -112,10 +116,10 @@ class Worker:
     """The parent's handle on a worker process."""
 
     def __init__(self, fmu_path: Path, case_name: str, steps: int, without_numba: bool = False,
-                 integers: dict | None = None, outputs=OUTPUTS, trace: str | None = None):
+                 integers: dict | None = None, outputs=OUTPUTS, trace: str | None = None, start_inputs: bool = False):
         command = [sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps),
                    "--worker-options", json.dumps({"integers": integers or {}, "outputs": list(outputs),
-                                                   "trace": trace})]
+                                                   "trace": trace, "start_inputs": start_inputs})]
         if without_numba:
             command.append("--without-numba")
         self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
