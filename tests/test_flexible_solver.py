@@ -163,6 +163,31 @@ def test_block_circulant_product_by_harmonics_equals_the_dense_product(balls):
     assert np.array_equal(matrix[np.ix_([0, 5], [3, 7])], dense[np.ix_([0, 5], [3, 7])])
 
 
+def test_the_contacts_compliance_is_its_blocks_entry_for_entry():
+    """The compiled operator gathers ``M_aa`` from the blocks of the contacts' compliance, bordering
+    gathers ``M`` (kept rows, new rows) from them (``BlockCirculant.blocks``, ``entries``): the rings'
+    compliances are block-circulant exactly (each built from its first block row), so are the
+    contacts' (a selection of both, the same per ball, and their sum), and the blocks give the dense
+    matrix's numbers bit for bit; on a random block-circulant matrix and the pitch bearing's."""
+    from slewing_model import load_bearing
+    from slewing_model.rings.compliance import BlockCirculant, contact_compliance, ring_compliances
+    from slewing_model.rings.superelement import build_superelement
+
+    from conftest import BEARINGS
+
+    rings = ring_compliances(build_superelement(load_bearing(BEARINGS / "pitch_bearing.toml"), mesh="coarse",
+                                                bc="free"))
+    rng = np.random.default_rng(3)
+    for matrix in (BlockCirculant(symmetric_block_circulant(67, seed=5), 4), *rings.values(),
+                   contact_compliance(rings)):
+        n, m = matrix.shape[0], matrix.block
+        index = np.arange(n)
+        shift = (index[None, :] // m - index[:, None] // m) % matrix.balls
+        assert np.array_equal(matrix.blocks[shift, (index % m)[:, None], (index % m)[None, :]], matrix.dense)
+        rows, columns = rng.choice(n, 40, replace=False), rng.choice(n, 9, replace=False)
+        assert np.array_equal(matrix.entries(rows, columns), matrix.dense[np.ix_(rows, columns)])
+
+
 def test_inverse_by_halves_is_as_exact_as_lapack():
     """The reduced operator's inverse by Schur complements (matrix products) against LAPACK's, on
     a matrix like the operator's: the pitch bearing's ring compliance (600 rows, singular: the

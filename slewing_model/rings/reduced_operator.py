@@ -382,8 +382,8 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
         return None
     rows = np.concatenate([op.rows, new_rows])
     new_a_inv = contact_compliance_blocks(point, stiffness, closed)
-    b_mat = np.asarray(compliance).take(new_rows, axis=1).take(op.rows, axis=0)
-    c_mat = np.asarray(compliance).take(new_rows, axis=0).take(new_rows, axis=1)
+    b_mat = compliance.entries(op.rows, new_rows)            # M (kept rows, new rows), M (new, new):
+    c_mat = compliance.entries(new_rows, new_rows)           # BlockCirculant.entries
     _add_blocks(c_mat, new_a_inv)
     new_jacobian = jacobian.reshape(-1, 5)[new_rows]
     inverse, coupling, schur_inverse = _arithmetic(arithmetic).border(
