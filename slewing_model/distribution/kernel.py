@@ -351,7 +351,7 @@ def _operator_matrix(blocks, rows, normal, delta, length, load, stiffness):
     ``delta``, ``length``, ``load``, ``stiffness`` (2B,) of every diagonal), gathering ``M_aa``
     row by row from the block-circulant ``M``'s blocks (``blocks`` (B, m, m),
     :attr:`slewing_model.rings.compliance.BlockCirculant.blocks`: the same entries as the dense
-    matrix's, read from 30 kB instead of 2.9 MB, which a step's other work has pushed out of the
+    matrix's, read from 19 kB instead of 2.9 MB, which a step's other work has pushed out of the
     cache: a new operator's ``W`` was formed in 0.3-1.8 ms inside a step against 0.2 ms isolated)."""
     n = rows.size
     k = n // 2
