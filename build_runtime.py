@@ -452,22 +452,31 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=No
     cache = Path(cache_dir) if cache_dir else runtime_cache_dir()
     python = interpreter(python)
     key = runtime_key(numba, platform_folder, python)
-    archive, description = cache / f"runtime-{key}.zip", cache / f"runtime-{key}.json"
+    archive = cache / f"runtime-{key}.zip"
+    info = zipped_once(archive, lambda prefix: stage_runtime(prefix, numba, python), platform_folder)
+    return Runtime(archive=archive, **info)
+
+
+def zipped_once(archive: Path, stage, platform_folder: str) -> dict:
+    """A runtime staged by ``stage(prefix)`` (which returns its description, JSON data) and zipped with
+    its entries under ``<platform_folder>/python/`` into ``archive``, its description beside it
+    (``.json``), once: later calls read them (the Linux runtime's and, ``build_win64.runtime``, the
+    win64 one's cache). The description is written first, the archive last, each whole
+    (``os.replace``): a concurrent build that finds the archive finds its description complete.
+    Returns the description."""
+    description = archive.with_suffix(".json")
     if not archive.exists():
-        cache.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(prefix="slewing_runtime_", dir=cache) as tmp:
+        archive.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(prefix="slewing_runtime_", dir=archive.parent) as tmp:
             prefix = Path(tmp) / RUNTIME_FOLDER
-            info = stage_runtime(prefix, numba, python)
+            info = stage(prefix)
             partial = Path(tmp) / "runtime.zip"
             with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED, compresslevel=6) as z:
                 for f in sorted(prefix.rglob("*")):
                     if f.is_file():
-                        z.write(f, f"{platform_folder}/{RUNTIME_FOLDER}/{f.relative_to(prefix)}")
-            # the description first, the archive last, each whole (os.replace): a concurrent build that
-            # finds the archive finds its description complete
+                        z.write(f, f"{platform_folder}/{RUNTIME_FOLDER}/{f.relative_to(prefix).as_posix()}")
             partial_description = Path(tmp) / "runtime.json"
             partial_description.write_text(json.dumps(info))
             os.replace(partial_description, description)
             os.replace(partial, archive)
-    info = json.loads(description.read_text())
-    return Runtime(archive=archive, **info)
+    return json.loads(description.read_text())

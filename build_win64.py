@@ -56,7 +56,6 @@ PYTHON_VERSION = "3.11.9"
 PYTHON_LIBRARY = "python311.dll"
 #: the Windows binary folder per FMI version
 WINDOWS_BINARIES = {2: "binaries/win64", 3: "binaries/x86_64-windows"}
-RUNTIME_FOLDER = "python"
 INNER_BINARY = "pythonfmu-export.dll"
 MINGW = "x86_64-w64-mingw32-gcc"
 LAYOUT = 1
@@ -167,24 +166,11 @@ def runtime_key(platform_folder: str) -> str:
 def runtime(platform_folder: str, cache_dir=None) -> tuple[Path, dict]:
     """The win64 runtime for ``platform_folder`` (``binaries/win64`` or ``binaries/x86_64-windows``),
     staged and zipped once (cached): (archive with entries under ``<platform_folder>/python/``, description)."""
+    from build_runtime import zipped_once
+
     cache = Path(cache_dir) if cache_dir else _cache_base() / "fmu_runtime"
-    key = runtime_key(platform_folder)
-    archive, description = cache / f"win64-{key}.zip", cache / f"win64-{key}.json"
-    if not archive.exists():
-        cache.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(prefix="slewing_win64_runtime_", dir=cache) as tmp:
-            prefix = Path(tmp) / RUNTIME_FOLDER
-            info = stage_runtime(prefix)
-            partial = Path(tmp) / "runtime.zip"
-            with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED, compresslevel=6) as z:
-                for f in sorted(prefix.rglob("*")):
-                    if f.is_file():
-                        z.write(f, f"{platform_folder}/{RUNTIME_FOLDER}/{f.relative_to(prefix).as_posix()}")
-            partial_description = Path(tmp) / "runtime.json"
-            partial_description.write_text(json.dumps(info))
-            os.replace(partial_description, description)
-            os.replace(partial, archive)
-    return archive, json.loads(description.read_text())
+    archive = cache / f"win64-{runtime_key(platform_folder)}.zip"
+    return archive, zipped_once(archive, stage_runtime, platform_folder)
 
 
 def merged_archive(linux_archive: Path, fmi_version: int, cache_dir=None) -> tuple[Path, dict]:
