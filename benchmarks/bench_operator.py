@@ -18,7 +18,7 @@ With ``--stages``: the time of each stage a bounded step counts in floating-poin
 (:data:`slewing_model.distribution.bime.BOUNDED_WORK`): forming ``W`` from the pitch bearing's
 operators of 160-600 rows (the loads of ``bench_realtime.py``'s reversal scenario) and each stage of its
 inverse (:data:`slewing_model.rings.reduced_operator.STAGES`), against the work counted for it
-(:func:`~slewing_model.distribution.bime.forming_work`,
+(:func:`~slewing_model.rings.reduced_operator.forming_work`,
 :func:`~slewing_model.rings.reduced_operator.stage_work`): what ``BOUNDED_WORK`` is in time here.
 
 Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border | --stages]
@@ -148,7 +148,7 @@ def stages(runs: int) -> None:
                     start = time.perf_counter()
                     pending = reduced_operator.advance_operator(pending, None, None, until=k + 1)
                     times[k].append(time.perf_counter() - start)
-            counted = [bime.forming_work(n)] + [reduced_operator.stage_work(n, k)
+            counted = [reduced_operator.forming_work(n)] + [reduced_operator.stage_work(n, k)
                                                  for k in range(len(reduced_operator.STAGES))]
             for (label, t), flops in zip(times.items(), counted):
                 ms = float(np.median(t)) * 1e3

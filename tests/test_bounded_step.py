@@ -33,7 +33,7 @@ def rings(table1):
 class OperatorWork:
     """What each solve asked of the ring operator, counted at the calls the solver makes, as
     :data:`~slewing_model.distribution.bime.BOUNDED_WORK` counts work: forming ``W``
-    (:func:`~slewing_model.distribution.bime.forming_work`), the stages of its inverse each call ran
+    (:func:`~slewing_model.rings.reduced_operator.forming_work`), the stages of its inverse each call ran
     (:func:`~slewing_model.rings.reduced_operator.stage_work`, from the stage before and after the
     call), bordering (:func:`~slewing_model.rings.reduced_operator.bordering_work`). ``largest``: the
     largest stage run since the last :meth:`take`."""

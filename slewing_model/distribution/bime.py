@@ -65,7 +65,8 @@ from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
     APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, STAGES, PendingOperator, ReducedOperator, advance_operator,
-    bordering_work, borders, closing_rows, stage_work, start_operator, step_end, turned_operator, update_operator,
+    bordering_work, borders, closing_rows, forming_work, stage_work, start_operator, step_end, turned_operator,
+    update_operator,
 )
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
@@ -85,7 +86,8 @@ SPREAD_ITERATIONS = 8
 #: what a bounded warm solve (``step_work="bounded"``) may spend of the ring operator's work, and at
 #: least one stage of an inverse on its way: floating-point operations weighted so that they track
 #: time (the stages of a spread inverse of ``W = (A^-1 + M)_aa``:
-#: :func:`~slewing_model.rings.reduced_operator.stage_work`; forming ``W``: :func:`forming_work`;
+#: :func:`~slewing_model.rings.reduced_operator.stage_work`; forming ``W``:
+#: :func:`~slewing_model.rings.reduced_operator.forming_work`;
 #: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
 #: step's answer does not depend on the machine. 1e8, an inverse of about 360 rows (2 ms on one core
 #: here, ``benchmarks/bench_operator.py --stages``), chosen by the pitch bearing's scenarios of
@@ -689,13 +691,6 @@ class BimeSolver:
             contact_pressure=pressure, truncated=truncated, energy=p.total, iterations=iterations, residual=residual,
             state=np.concatenate([qs, y]), rings=self.ring_compliance, converged=converged,
         )
-
-
-def forming_work(rows: int) -> float:
-    """The work of forming ``W`` on ``rows`` rows (gathering ``M_aa``, adding the springs'
-    compliance) as :data:`BOUNDED_WORK` counts it: ``80 n^2`` (measured against the stages,
-    ``benchmarks/bench_operator.py --stages``)."""
-    return 80.0 * rows * rows
 
 
 class _WorkSpent(Exception):

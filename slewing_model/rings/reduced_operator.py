@@ -266,6 +266,13 @@ def stage_work(n: int, stage: int) -> float:
     return STAGE_WEIGHT[stage] * flops
 
 
+def forming_work(rows: int) -> float:
+    """The work of forming ``W`` on ``rows`` rows (gathering ``M_aa``, adding the springs'
+    compliance), as :func:`stage_work` counts it: ``80 n^2`` (measured against the stages,
+    ``benchmarks/bench_operator.py --stages``)."""
+    return 80.0 * rows * rows
+
+
 @dataclass(frozen=True)
 class PendingOperator:
     """A new reduced operator formed at an iterate and inverted over steps.
