@@ -62,7 +62,7 @@ def test_compiled_trial_points_equal_the_numpy_ones(pitch, table3, which):
     assert np.abs(solvers["compiled"].jacobian - jacobian).max() <= 1e-15 * np.abs(jacobian).max()
     state = solvers["numpy"].solve(loads).state
     rng = np.random.default_rng(5)
-    f_scaled = solvers["numpy"]._scaled_load(loads)
+    f_scaled = solvers["numpy"].scaled_load(loads)
     compliance = solvers["numpy"].compliance
     for scale in (0.0, 1e-3, 2e-2):                      # the equilibrium, and points off it
         x = state * (1.0 + scale * rng.standard_normal(state.size))
@@ -99,7 +99,7 @@ def test_compiled_contact_results_equal_the_numpy_ones(pitch, table3, which):
     bearing, superelement, loads = _case(which, pitch, table3)
     solvers = {k: BimeSolver(bearing, superelement, psi=0.3, kernel=k) for k in ("numpy", "compiled")}
     state = solvers["numpy"].solve(loads).state
-    f_scaled = solvers["numpy"]._scaled_load(loads)
+    f_scaled = solvers["numpy"].scaled_load(loads)
     point = solvers["numpy"]._evaluate(state[:5], state[5:], f_scaled)
     results = {k: s._result(loads, point, 3, 1e-9) for k, s in solvers.items()}
     for name in ("contact_load", "contact_angle", "contact_deflection", "semi_axis_a", "semi_axis_b",
@@ -143,7 +143,7 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
     loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
     solver = BimeSolver(bearing, superelement)
     state = solver.solve(loads).state
-    f_scaled = solver._scaled_load(loads)
+    f_scaled = solver.scaled_load(loads)
     point = solver._evaluate(state[:5], state[5:], f_scaled)
     loaded = np.flatnonzero(point.delta.ravel() > 0.0)
     mu = 1e-12 * solver.reference_stiffness

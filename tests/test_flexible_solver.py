@@ -124,6 +124,44 @@ def test_simulator_extrapolated_start_reaches_the_cold_solution(bearing):
         assert np.allclose(r.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
 
 
+def test_extrapolated_start_goes_as_far_as_the_loads_go_on():
+    # the start is the last state carried on along its last change by the share of their last
+    # change that the loads repeat: the whole of it where they go on, none where they hold or go back
+    from slewing_model.simulation.simulator import extrapolated_start
+
+    rng = np.random.default_rng(7)
+    warm, previous = rng.normal(size=9), rng.normal(size=9)
+    f0, f1 = rng.normal(size=5), rng.normal(size=5)
+    change = f1 - f0
+    cases = {"go on": (f1 + change, 1.0), "hold": (f1, 0.0), "go back": (f0, 0.0), "half": (f1 + 0.5 * change, 0.5),
+             "twice as fast": (f1 + 2.0 * change, 1.0)}
+    for name, (f, share) in cases.items():
+        assert np.allclose(extrapolated_start(warm, previous, f, f1, f0), warm + share * (warm - previous),
+                           rtol=1e-12, atol=1e-12), name
+    side = np.array([-change[1], change[0], 0.0, 0.0, 0.0])          # a change across the last: none of it
+    assert np.array_equal(extrapolated_start(warm, previous, f1 + side - side @ change / (change @ change) * change,
+                                             f1, f0), warm)
+    # loads that held: the state moved with psi alone, carried on whole; no previous state: the last
+    assert np.allclose(extrapolated_start(warm, previous, f1 + change, f1, f1.copy()), 2.0 * warm - previous)
+    assert extrapolated_start(warm, None, f1, f1, f0) is warm
+
+
+def test_a_step_that_holds_the_loads_after_a_jump_starts_at_its_equilibrium(bearing):
+    # after a moment reversed in one step, the next step with the same inputs starts from the
+    # reversed equilibrium itself (the extrapolation would repeat the reversal): no iteration,
+    # the same state bit for bit
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    sim = BearingSimulator(bearing, synthetic_superelement(bearing.ball_count),
+                           SimulatorSettings(ring_model="flexible", friction_coefficient=0.0))
+    for k in range(3):
+        sim.step(Loads(Fz=5e4, Mx=2e3 + 1e2 * k), psi=0.01 * k, omega=0.1)
+    reversed_ = sim.step(Loads(Fz=5e4, Mx=-2.2e3), psi=0.02, omega=0.1).distribution
+    held = sim.step(Loads(Fz=5e4, Mx=-2.2e3), psi=0.02, omega=0.1).distribution
+    assert reversed_.iterations > 0 and held.iterations == 0
+    assert np.array_equal(held.state, reversed_.state)
+
+
 def test_refused_step_leaves_the_simulator_as_it_was(bearing):
     # an overload refused inside the solver (it had turned the rings and updated its kept
     # operator by then) must not change what the following steps answer: bit for bit the
@@ -280,7 +318,7 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
     loads = LOADS[1]
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
     result = solver.solve(loads)
-    point = solver._evaluate(result.state[:5], result.state[5:], solver._scaled_load(loads))
+    point = solver._evaluate(result.state[:5], result.state[5:], solver.scaled_load(loads))
     loaded = np.flatnonzero((point.delta > 0.0).ravel())
     assert loaded.size > 12
     mu = 1e-12 * solver.reference_stiffness
@@ -309,8 +347,8 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
         assert np.allclose(updated.schur_inverse, fresh.schur_inverse, rtol=1e-8)
         assert np.array_equal(updated.contact_compliance[order[::2] // 2], fresh.contact_compliance)
         # and the step it gives, away from the equilibrium (the forces picked in the operator's order)
-        off = solver._evaluate(1.01 * result.state[:5], 0.98 * result.state[5:], solver._scaled_load(loads))
-        (dq_u, y_u), (dq_f, y_f) = (newton_step(op, off, solver._scaled_load(loads)) for op in (updated, fresh))
+        off = solver._evaluate(1.01 * result.state[:5], 0.98 * result.state[5:], solver.scaled_load(loads))
+        (dq_u, y_u), (dq_f, y_f) = (newton_step(op, off, solver.scaled_load(loads)) for op in (updated, fresh))
         assert np.abs(dq_u - dq_f).max() <= 1e-9 * np.abs(dq_f).max()
         assert np.abs(y_u - y_f).max() <= 1e-9 * np.abs(y_f).max()
 
@@ -395,7 +433,7 @@ def test_nearly_turned_operator_bordered_stays_one_operator(bearing):
     bearing = bearing.with_errors(synthetic_errors(bearing.ball_count, seed=2))
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
     result = solver.solve(LOADS[1])
-    f_scaled = solver._scaled_load(LOADS[1])
+    f_scaled = solver.scaled_load(LOADS[1])
     point = solver._evaluate(result.state[:5], result.state[5:], f_scaled)
     mu, stiffness = 1e-12 * solver.reference_stiffness, solver.assembly.stiffness
     fewer = point.loaded.copy()
@@ -419,7 +457,7 @@ def test_operator_on_few_contacts_after_a_turn_equals_one_formed_anew(bearing):
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
     loads = LOADS[1]
     result = solver.solve(loads)
-    point = solver._evaluate(result.state[:5], result.state[5:], solver._scaled_load(loads))
+    point = solver._evaluate(result.state[:5], result.state[5:], solver.scaled_load(loads))
     loaded = np.flatnonzero((point.delta > 0.0).ravel())
     mu = 1e-12 * solver.reference_stiffness
     for count in (1, 2, 3):

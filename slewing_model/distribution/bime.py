@@ -227,7 +227,9 @@ class BimeSolver:
             self.jacobian = a.moving_sign * jac
         self._jacobian_rows = self.jacobian.reshape(-1, 5)     # (4B, 5): one matrix-vector product
 
-    def _scaled_load(self, loads: Loads) -> np.ndarray:
+    def scaled_load(self, loads: Loads) -> np.ndarray:
+        """The loads as the solver's unknowns take them: ``(Fx, Fy, Fz, Mx / L, My / L)``, N (``L`` its
+        length scale, :attr:`length`), a new array."""
         f = loads.as_array()
         f[3:] /= self.length
         return f
@@ -333,7 +335,7 @@ class BimeSolver:
             groove edge): the load is beyond what the bearing can carry.
         """
         loads = Loads() if loads is None else loads
-        f_scaled = self._scaled_load(loads)
+        f_scaled = self.scaled_load(loads)
         flexible = self.compliance is not None
         n_balls = self.bearing.ball_count
         dw = self.bearing.ball_diameter
