@@ -313,7 +313,8 @@ def extrapolated_start(warm, previous, load, last_load, load_before):
     ``f0`` of ``previous``): ``warm + s (warm - previous)``, the least-squares extrapolation of
     the inputs carried to the state. Loads that held in the last step (their change below
     :data:`HELD_LOADS` of their size) take the whole last change: the state then follows ``psi``.
-    Without ``previous`` (or a load of it), ``warm``."""
+    Without ``previous``: ``warm``; without the loads of both states (a state kept before they
+    were): the whole change, as before."""
     if previous is None or warm is None or previous.shape != warm.shape:
         return warm
     share = 1.0
