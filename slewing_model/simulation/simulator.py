@@ -29,6 +29,8 @@ LOAD_FRAMES = ("fixed", "rotating")
 #: an iterate on its way (``step_work="bounded"``): its torque is one too, and the next step goes on
 #: from it (after a moment reversal a complete one takes 13-14, about 2 ms on the pitch bearing)
 BOUNDED_FRICTION_ITERATIONS = 4
+#: loads whose change in a step is below this share of their size held in it (:func:`extrapolated_start`)
+HELD_LOADS = 1e-9
 
 
 @dataclass(frozen=True)
@@ -324,10 +326,6 @@ def extrapolated_start(warm, previous, load, last_load, load_before):
         if size > (HELD_LOADS * float(np.max(np.abs(last_load)))) ** 2:
             share = min(max(float((load - last_load) @ change) / size, 0.0), 1.0)
     return warm + share * (warm - previous)
-
-
-#: loads whose change in a step is below this share of their size held in it (:func:`extrapolated_start`)
-HELD_LOADS = 1e-9
 
 
 def encode_state(value):
