@@ -353,6 +353,61 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
         assert np.abs(y_u - y_f).max() <= 1e-9 * np.abs(y_f).max()
 
 
+@pytest.mark.parametrize("kernel", ["numpy", "compiled"])
+def test_newton_step_in_increments_solves_the_reduced_system(bearing, kernel):
+    """The modified Newton step, computed in increments (``reduced_operator.newton_step``), is the
+    solution of the reduced system as the module states it, solved here densely from ``M``'s
+    entries: ``[[W, -J_a], [J_a^T, mu I]] [y_a; dq] = [A^-1 f_a + (M y)_a; F]``, ``W = (A^-1 + M)_aa``;
+    also at an iterate whose forces are not all on the operator's rows (a fresh operator on fewer
+    contacts: the rings' motion under those forces enters as ``off_motion``), where leaving it out
+    gives another step."""
+    from slewing_model.rings.reduced_operator import assemble_operator, newton_step, off_rows
+
+    step = newton_step
+    if kernel == "compiled":
+        from slewing_model.friction.kernel import AVAILABLE
+
+        if not AVAILABLE:
+            pytest.skip("numba is not installed: only the numpy path exists here")
+        from slewing_model.distribution.kernel import newton_step as step
+    loads = LOADS[1]
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    result = solver.solve(loads)
+    f_scaled = solver.scaled_load(loads)
+    converged = solver._evaluate(result.state[:5], result.state[5:], f_scaled)
+    # forces 2 % below the equilibrium's, on its loaded diagonals only (which stay loaded: the rings give way less)
+    y = np.where(np.repeat(converged.loaded, 2), 0.98 * converged.y, 0.0)
+    point = solver._evaluate(result.state[:5], y, f_scaled)
+    loaded = np.flatnonzero(point.loaded)
+    assert not np.delete(point.y.reshape(-1, 2), loaded, axis=0).any()
+    mu = 1e-12 * solver.reference_stiffness
+    dense_m = np.column_stack([solver.compliance @ column for column in np.eye(point.y.size)])
+    for diagonals in (loaded, np.delete(loaded, np.s_[::5])):
+        active = np.isin(np.arange(point.loaded.size), diagonals)
+        op = assemble_operator(point, solver.compliance, solver.assembly.stiffness, solver.jacobian, active, mu)
+        rows = op.rows
+        a_inv = np.zeros((rows.size, rows.size))
+        for k in range(rows.size // 2):
+            a_inv[2 * k:2 * k + 2, 2 * k:2 * k + 2] = op.contact_compliance[k]
+        w = a_inv + dense_m[np.ix_(rows, rows)]
+        ja = solver.jacobian.reshape(-1, 5)[rows]
+        system = np.block([[w, -ja], [ja.T, mu * np.eye(5)]])
+        rhs = np.concatenate([a_inv @ point.force.ravel()[rows] + (dense_m @ point.y)[rows], f_scaled])
+        expected = np.linalg.solve(system, rhs)
+        y_off = off_rows(op, point.y)
+        assert (y_off is None) == (diagonals.size == loaded.size)
+        off_motion = None if y_off is None else solver.compliance @ y_off
+        dq, y_new = step(op, point, f_scaled, off_motion)
+        x = np.concatenate([y_new[rows], dq])
+        # the system's residual against its terms' size (backward error), and the forces against the dense solve's
+        assert np.abs(system @ x - rhs).max() <= 1e-14 * (np.abs(system) @ np.abs(x) + np.abs(rhs)).max()
+        assert np.abs(y_new[rows] - expected[:-5]).max() <= 1e-9 * np.abs(expected[:-5]).max()
+        assert not np.delete(y_new, rows).any()                         # zero off the operator's rows
+        if y_off is not None:                                           # the off-row forces' motion counts
+            dq_without, _ = step(op, point, f_scaled)
+            assert np.abs(dq_without - dq).max() > 1e-4 * np.abs(dq).max()
+
+
 def test_operator_turned_then_bordered_follows_the_new_jacobian(bearing):
     """A warm solve after the ring turned, with contacts closing: the kept operator is turned to the
     new Jacobian before it is bordered, so that its coupling is ``W^-1 J`` of the new angle (bordering

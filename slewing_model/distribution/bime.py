@@ -65,8 +65,8 @@ from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
     APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, STAGES, PendingOperator, ReducedOperator, advance_operator,
-    bordering_work, borders, closing_rows, forming_work, stage_work, start_operator, step_end, turned_operator,
-    update_operator,
+    bordering_work, borders, closing_rows, forming_work, off_rows, stage_work, start_operator, step_end,
+    turned_operator, update_operator,
 )
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
@@ -566,7 +566,8 @@ class BimeSolver:
                     pass
                 self._stage_due = False
             raise
-        dq, y_new = self._arithmetic.step(op, p, f_scaled)
+        y_off = off_rows(op, p.y)             # forces a fresh operator's rows leave out: their ring motion
+        dq, y_new = self._arithmetic.step(op, p, f_scaled, None if y_off is None else self._ring_times(y_off))
         return dq, y_new - p.y
 
     def _step_operator(self, p: "_Point", mu: float, fresh: bool, iterations: int) -> ReducedOperator:

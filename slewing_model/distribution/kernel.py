@@ -135,25 +135,29 @@ def _symmetric_times(matrix, vectors):
 
 
 _NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:], "
-                     "f8[:], f8[:], i8)")
+                     "f8[:], f8[:], f8[:])")
 
 
-def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_inverse, force, ring_motion,
-                 f_scaled, n_rows):
-    """The modified Newton step with a kept reduced operator: ``dq`` (5,) and the contact forces
-    after the step (``n_rows``,), zero off the operator's ``rows``: the formulas of
-    :func:`slewing_model.rings.reduced_operator.newton_step` (``force`` and ``ring_motion`` flat, (4B,)).
+def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_inverse, force, y, off_motion,
+                 f_scaled):
+    """The modified Newton step with a kept reduced operator, in increments: ``dq`` (5,) and the
+    contact forces after the step (``y.size``,), zero off the operator's ``rows``: the formulas of
+    :func:`slewing_model.rings.reduced_operator.newton_step` (``force``, ``y`` and ``off_motion``, the
+    ring motion of ``y`` off the rows or zeros, flat, (4B,)).
 
     ``W^-1 rhs`` is summed column by column (:func:`_symmetric_times`)."""
     n = rows.size
     rhs = np.empty(n)
-    for k in range(n // 2):                 # A^-1 f of each diagonal, + (M y) on its rows
-        diagonal = rows[2 * k] // 2
-        f0, f1 = force[2 * diagonal], force[2 * diagonal + 1]
+    for k in range(n // 2):                 # A^-1 (f - y) of each diagonal, + (M y_off) on its rows
+        r0, r1 = rows[2 * k], rows[2 * k + 1]
+        diagonal = r0 // 2
+        m0, m1 = force[2 * diagonal] - y[r0], force[2 * diagonal + 1] - y[r1]
         for c in range(2):
-            rhs[2 * k + c] = (contact_compliance[k, c, 0] * f0 + contact_compliance[k, c, 1] * f1
-                              + ring_motion[rows[2 * k + c]])
+            rhs[2 * k + c] = (contact_compliance[k, c, 0] * m0 + contact_compliance[k, c, 1] * m1
+                              + off_motion[rows[2 * k + c]])
     w = _symmetric_times(inverse, rhs.reshape(1, n))[0]
+    for i in range(n):
+        w[i] += y[rows[i]]
     t = f_scaled.copy()                     # F - J_a^T w
     for i in range(n):
         for c in range(5):
@@ -162,13 +166,27 @@ def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_in
     for r in range(5):
         for c in range(5):
             dq[r] += schur_inverse[r, c] * t[c]
-    y_new = np.zeros(n_rows)
+    y_new = np.zeros(y.size)
     for i in range(n):
         value = w[i]
         for c in range(5):
             value += coupling[i, c] * dq[c]
         y_new[rows[i]] = value
     return dq, y_new
+
+
+def _off_motion(rows, op_active, y, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag):
+    """The rings' motion ``M y_off`` (``y.size``,) under the forces ``y`` has off the operator's diagonals
+    ``op_active`` (zeros where it has none): :func:`_newton_step`'s ``off_motion``."""
+    y_off = np.zeros(y.size)
+    found = False
+    for i in range(y.size):
+        if not op_active[i // 2] and y[i] != 0.0:
+            y_off[i] = y[i]
+            found = True
+    if not found:
+        return y_off
+    return _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, y_off)
 
 
 _TURN_SIGNATURE = "Tuple((b1, f8[:, :], f8[:, :], f8[:, :]))(f8[:, :], f8[:, :], f8[:, :], f8, f8)"
@@ -660,8 +678,10 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
                 break
         if closed:
             break
+        off_motion = _off_motion(rows, op_active, y, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real,
+                                 harmonic_imag)
         dq, y_new = _newton_step(inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse,
-                                 force.reshape(-1), ring_motion, f_scaled, y.size)
+                                 force.reshape(-1), y, off_motion, f_scaled)
         dy = y_new - y
         m_dy = _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, dy)
         slope_q = slope_y = 0.0                    # g . dq - (f - y) . M dy, as two dot products
@@ -701,7 +721,7 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
 
 #: the helpers the load distribution's loops call
 _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_periodic_interp",
-            "_trial_point", "_newton_step", "_ring_times", "_schur_inverse")
+            "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse")
 
 
 #: numpy's floating-point semantics: a division by zero gives inf or NaN as the numpy code does,
@@ -730,11 +750,12 @@ compiled_kept_iterations = loop_factory(KERNELS, _compile, _kept_iterations, _KE
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------
 
-def newton_step(op, point, f_scaled):
+def newton_step(op, point, f_scaled, off_motion=None):
     """:func:`slewing_model.rings.reduced_operator.newton_step` by the compiled loop."""
+    y = point.y
     return compiled_newton_step()(np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian,
-                                  op.coupling, op.schur_inverse, point.force.reshape(-1), point.ring_motion, f_scaled,
-                                  point.y.size)
+                                  op.coupling, op.schur_inverse, point.force.reshape(-1), y,
+                                  np.zeros(y.size) if off_motion is None else off_motion, f_scaled)
 
 
 def column_turn(old, new, coupling, mu, tolerance=0.0):

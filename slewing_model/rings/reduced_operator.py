@@ -446,19 +446,39 @@ def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu
     return bordered, new_coupling, np.linalg.inv(ja.T @ new_coupling + mu * np.eye(5))
 
 
-def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray):
+def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray, off_motion: np.ndarray | None = None):
     """The (modified) Newton step with the kept operator: ``dq`` (5,) and the contact forces
     after the step ``y`` (4B,), zero on the open contacts.
 
-    ``point`` has the spring forces ``force`` (B, 2, 2), the forces felt by the rings ``y``
-    and their motion ``ring_motion = M y``."""
-    rhs = (op.contact_compliance @ point.force.reshape(-1, 2)[op.rows[::2] // 2][..., None]).ravel() \
-        + point.ring_motion[op.rows]
-    w_vec = op.inverse @ rhs
+    ``point`` has the spring forces ``force`` (B, 2, 2) and the forces felt by the rings ``y``
+    (4B,); ``off_motion`` is ``M y_off`` (4B,), the rings' motion under the forces ``y`` has off the
+    operator's rows, where there are any (``None``: ``y`` is zero there).
+
+    The step is solved in increments: with ``W = (A^-1 + M)_aa``, the system's first row
+    ``W y_new = A^-1 f_a + (M y)_a`` is ``W (y_new - y)_a = A^-1 (f - y)_a + (M y_off)_a``, so
+    ``y_new = y_a + W^-1 (A^-1 (f - y)_a + (M y_off)_a) + W^-1 J_a dq``. Equal in exact arithmetic,
+    but the steps' fixed point, ``f = y`` on the operator's rows, no longer depends on ``W^-1``
+    being ``W``'s inverse to round-off: an approximate one (single precision,
+    :data:`OPERATOR_PRECISION`) costs a few iterations' contraction, not the answer's accuracy."""
+    diagonals = op.rows[::2] // 2
+    mismatch = point.force.reshape(-1, 2)[diagonals] - point.y.reshape(-1, 2)[diagonals]
+    rhs = (op.contact_compliance @ mismatch[..., None]).ravel()
+    if off_motion is not None:
+        rhs = rhs + off_motion[op.rows]
+    w_vec = point.y[op.rows] + op.inverse @ rhs
     dq = op.schur_inverse @ (f_scaled - op.jacobian.T @ w_vec)
     y_new = np.zeros_like(point.y)
     y_new[op.rows] = w_vec + op.coupling @ dq
     return dq, y_new
+
+
+def off_rows(op: ReducedOperator, y: np.ndarray) -> np.ndarray | None:
+    """``y`` (4B,) with the operator's rows zeroed, ``None`` where nothing is left (the forces a
+    fresh operator's rows leave out: :func:`newton_step`'s ``off_motion`` is their ring motion)."""
+    if not y.any():
+        return None
+    y_off = np.where(np.repeat(op.active, 2), 0.0, y)
+    return y_off if y_off.any() else None
 
 
 @dataclass(frozen=True)
