@@ -22,6 +22,18 @@ def table3():
     return load_bearing(BEARINGS / "table3.toml")
 
 
+@pytest.fixture
+def double_operator(monkeypatch):
+    """New reduced operators inverted in double precision (``reduced_operator.OPERATOR_PRECISION``), for
+    tests of the operator's algebra (bordering, turning, the step) to round-off; single precision's
+    own accuracy is tested by itself (test_flexible_solver.py)."""
+    import numpy as np
+
+    from slewing_model.rings import reduced_operator
+
+    monkeypatch.setattr(reduced_operator, "OPERATOR_PRECISION", np.float64)
+
+
 @pytest.fixture(autouse=True, scope="session")
 def _cache_dir(tmp_path_factory):
     # superelements built by the tests go to a private cache, not the user's

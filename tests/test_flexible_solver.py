@@ -250,6 +250,48 @@ def test_inverse_by_halves_is_as_exact_as_lapack():
         assert np.abs(halves - lapack).max() <= 1e-8 * np.abs(lapack).max()
 
 
+def test_operator_in_single_precision_reaches_the_double_precision_equilibrium(monkeypatch):
+    """``W``'s inverse computed in single precision (``reduced_operator.OPERATOR_PRECISION``) is within
+    a few ``eps cond(W)`` of the exact inverse, and the solver, whose step is in increments, reaches the
+    equilibrium an operator in double precision gives, to its tolerance: the inverse's error slows its
+    contraction, it does not stay in the answer (with the step computing the forces themselves, as it
+    did, the solves stalled at 1.5-3.7e-7: docs/speed.md)."""
+    from slewing_model import load_bearing
+    from slewing_model.rings import reduced_operator
+    from slewing_model.rings.superelement import build_superelement
+
+    from conftest import BEARINGS
+
+    assert reduced_operator.OPERATOR_PRECISION == np.float32
+    bearing = load_bearing(BEARINGS / "pitch_bearing.toml")
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    loads = Loads(Fx=3e5, Fz=-4e5, Mx=2.5e6, My=-1.5e6)
+    forms = []
+    original = reduced_operator.start_operator
+
+    def kept(point, compliance, stiffness, active, arithmetic=None, until=None):
+        pending = original(point, compliance, stiffness, active, arithmetic, until)
+        forms.append((point, compliance, stiffness, active, pending.matrix.dtype))
+        return pending
+
+    monkeypatch.setattr("slewing_model.distribution.bime.start_operator", kept)
+    single = BimeSolver(bearing, superelement).solve(loads)
+    point, compliance, stiffness, active, dtype = forms[-1]
+    assert dtype == np.float32
+    _, _, w = reduced_operator.operator_matrix(point, compliance, stiffness, active)
+    exact = np.linalg.inv(w)
+    approximate = reduced_operator.spd_inverse(w.astype(np.float32)).astype(float)
+    bound = 10.0 * np.finfo(np.float32).eps * np.linalg.cond(w)
+    assert np.abs(approximate - exact).max() <= bound * np.abs(exact).max()
+    assert np.abs(approximate - exact).max() >= 1e-9 * np.abs(exact).max()        # single precision indeed
+    monkeypatch.setattr(reduced_operator, "OPERATOR_PRECISION", np.float64)
+    double = BimeSolver(bearing, superelement).solve(loads)
+    assert single.converged and double.converged and single.residual <= 1e-10
+    assert np.abs(single.displacement - double.displacement).max() <= 1e-9 * np.abs(double.displacement).max()
+    assert np.abs(single.contact_load - double.contact_load).max() <= 1e-9 * double.max_ball_load
+    assert single.iterations <= double.iterations + 3
+
+
 def test_inverse_spread_over_two_steps_equals_the_inverse_at_once():
     """The new operator's inverse in the stages of two steps (a complete solve's) or one stage at a
     time (a bounded solve's), its state serialised between them (a co-simulation's rollback), is
@@ -301,7 +343,7 @@ def test_cold_solve_does_not_depend_on_the_solves_before(bearing):
 
 
 @pytest.mark.parametrize("kernel", ["numpy", "compiled"])
-def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel):
+def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel, double_operator):
     """Contacts closing (the kept inverse bordered by their rows; those that opened keep theirs)
     give the inverse, coupling and Schur complement that forming and inverting the operator on
     the same contacts gives, at the same iterate, with the rows in another order; the bordering's
@@ -354,7 +396,7 @@ def test_operator_bordered_by_closed_contacts_equals_a_fresh_one(bearing, kernel
 
 
 @pytest.mark.parametrize("kernel", ["numpy", "compiled"])
-def test_newton_step_in_increments_solves_the_reduced_system(bearing, kernel):
+def test_newton_step_in_increments_solves_the_reduced_system(bearing, kernel, double_operator):
     """The modified Newton step, computed in increments (``reduced_operator.newton_step``), is the
     solution of the reduced system as the module states it, solved here densely from ``M``'s
     entries: ``[[W, -J_a], [J_a^T, mu I]] [y_a; dq] = [A^-1 f_a + (M y)_a; F]``, ``W = (A^-1 + M)_aa``;

@@ -24,9 +24,14 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from cases import CASES  # noqa: E402
 
 #: relative accuracy asked of every output at every step, and the absolute floor of each output
-#: where it passes through zero (the tilts change sign; the torque is 0 while a yaw drive rests)
+#: where it passes through zero (the tilts change sign; the torque is 0 while a yaw drive rests).
+#: The tilts' floor, 1e-7 rad, asks a tilt near zero to 1e-11 rad, 1e-7 of the cases' tilts (1e-4 to
+#: 1e-3 rad), which is what the stop rule (residuals 1e-7 of the load) bounds; 1e-9 rad asked
+#: 1e-13 rad, met only while the last Newton step with an inverse exact to round-off went far past the
+#: tolerance (a single-precision inverse, reduced_operator.OPERATOR_PRECISION: 1.3e-12 rad on the
+#: pitch case's first step, where its tilt rx is 2e-16 rad)
 RTOL = 1e-4
-FLOOR = {"z": 1e-9, "rx": 1e-9, "ry": 1e-9, "max_ball_load": 1e-3, "friction_torque": 1e-3}  # m, rad, N, N m
+FLOOR = {"z": 1e-9, "rx": 1e-7, "ry": 1e-7, "max_ball_load": 1e-3, "friction_torque": 1e-3}  # m, rad, N, N m
 STEPS = 60
 #: the reference: residuals near the round-off floor (~1e-12 of the load scale), ball equilibrium to 1e-9
 TIGHT, TIGHT_FRICTION = 1e-11, 1e-9

@@ -159,6 +159,14 @@ def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
             matrix[first + r, first + c] += blocks[:, r, c]
 
 
+#: the precision ``W``'s inverse is computed in (its stages, :data:`STAGES`; the inverse is then kept
+#: in double precision). Single: 0.6 of double's time (one thread, the stages of 430 rows 3.5 -> 2.2
+#: ms) and an inverse within about ``1e-7 cond(W)`` of ``W``'s (the pitch bearing's ``W``, condition
+#: 5.7e3: 4e-5), which the step in increments (:func:`newton_step`) takes as one more approximation
+#: of its modified Newton operator: the equilibrium it converges to is the same (docs/speed.md,
+#: "Issue 31, sixth turn")
+OPERATOR_PRECISION = np.float32
+
 #: below this size :func:`spd_inverse` calls LAPACK's inverse
 LEAF = 64
 
@@ -238,11 +246,13 @@ STAGES = (_a_inverse, _x, _schur, _schur_inverse, _y, _joined)
 SPREAD_STAGES = (2, len(STAGES))
 
 
-#: what a floating-point operation of each stage costs against one of a large product's (one BLAS
-#: thread, measured: ``benchmarks/bench_operator.py --stages``): an inverse of a half recurses down to
-#: LAPACK's leaves and runs at about a third of a product's rate, ``S`` and the join add passes over
-#: the matrix
-STAGE_WEIGHT = (3.0, 1.0, 1.5, 3.0, 1.0, 1.5)
+#: what a floating-point operation of each stage costs against one of a large product's in double
+#: precision (one BLAS thread, measured: ``benchmarks/bench_operator.py --stages``), in
+#: :data:`OPERATOR_PRECISION`: an inverse of a half recurses down to LAPACK's leaves and runs at
+#: about a third of a double product's rate (single: 1.3 times faster), ``S`` and the join add passes
+#: over the matrix; single precision runs the products 2.2 times, the join 2 times faster than double
+#: (which had 3, 1, 1.5, 3, 1, 1.5)
+STAGE_WEIGHT = (2.3, 0.45, 0.7, 2.3, 0.45, 0.75)
 
 
 def inverse_work(n: int) -> float:
@@ -304,10 +314,12 @@ class PendingOperator:
 
 def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None,
                    until: int | None = None) -> PendingOperator:
-    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
-    and run the stages of its inverse up to ``until`` (default: the first step's, :func:`advance_operator`)."""
+    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`),
+    kept in :data:`OPERATOR_PRECISION`, and run the stages of its inverse up to ``until`` (default:
+    the first step's, :func:`advance_operator`)."""
     rows, a_inv, w_mat = _arithmetic(arithmetic).form(point, compliance, stiffness, active)
-    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None, until=until)
+    pending = PendingOperator(rows, active, a_inv, w_mat.astype(OPERATOR_PRECISION), 0, ())
+    return advance_operator(pending, None, None, until=until)
 
 
 def operator_matrix(point, compliance, stiffness, active):
@@ -339,8 +351,8 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             pending = replace(pending, stage=until, parts=parts)
     if pending.stage < len(STAGES) or jacobian is None:
         return pending
-    return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
-                            arithmetic)
+    return reduced_operator(pending.rows, pending.active, pending.contact_compliance,
+                            pending.parts[0].astype(float), jacobian, mu, arithmetic)
 
 
 def step_end(pending: PendingOperator) -> int:
