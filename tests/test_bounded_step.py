@@ -128,6 +128,17 @@ def test_a_bounded_step_flags_what_it_carries_over_and_arrives_at_the_complete_a
     assert np.allclose(balance, REVERSED.as_array(), atol=1e-4 * 4e5)
 
 
+def test_the_step_after_a_bounded_solve_arrives_starts_at_its_equilibrium(table1, rings):
+    """A flagged step's iterate is no point of the trajectory: the step after the first converged one,
+    the loads held, starts at that equilibrium (0 iterations, the same state), not extrapolated along
+    iterate -> equilibrium (which took it off again)."""
+    results, _ = reversal(table1, rings, "bounded", steps=20)
+    first = next(k for k, r in enumerate(results) if r.converged)
+    assert first >= 1 and not results[first - 1].converged
+    following = results[first + 1]
+    assert following.iterations == 0 and np.array_equal(following.state, results[first].state)
+
+
 def test_an_iterate_on_its_way_is_not_refused_for_capacity(table1, rings):
     """Its contact angles are those of an iterate: the capacity check waits for the equilibrium."""
     results, _ = reversal(table1, rings, "bounded", steps=1)

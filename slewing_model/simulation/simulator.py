@@ -202,6 +202,7 @@ class BearingSimulator:
         self._warm: np.ndarray | None = None
         self._previous: np.ndarray | None = None      # the state one step before _warm
         self._loads: tuple = (None, None)              # the scaled loads of _warm and of _previous
+        self._warm_converged = True                    # _warm an equilibrium (not a bounded step's iterate)
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
         self._psi = 0.0
         self.last: StepResult | None = None
@@ -264,10 +265,12 @@ class BearingSimulator:
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         if self.life is not None:
             self.life.step(None, psi, distribution)
-        # an iterate on its way (a bounded step) is no point of the trajectory to extrapolate from
-        self._previous = self._warm if distribution.converged else None
+        # an iterate on its way (a bounded step) is no point of the trajectory to extrapolate from or to
+        keep = distribution.converged and self._warm_converged
+        self._previous = self._warm if keep else None
         self._warm = distribution.state
-        self._loads = (load, self._loads[0] if distribution.converged else None)
+        self._loads = (load, self._loads[0] if keep else None)
+        self._warm_converged = distribution.converged
         self._psi = psi
         self.last = StepResult(distribution, signed, magnitude)
         return self.last
@@ -278,7 +281,8 @@ class BearingSimulator:
         the solver's reused Newton operator (numpy arrays, not copied: they are
         never changed in place). :func:`encode_state` makes it JSON data."""
         operator, pending = self.solver.operator, self.solver.pending_operator
-        return {"warm": self._warm, "previous": self._previous, "loads": list(self._loads), "psi": self._psi,
+        return {"warm": self._warm, "previous": self._previous, "loads": list(self._loads),
+                "warm_converged": self._warm_converged, "psi": self._psi,
                 "operator": None if operator is None else operator.as_tuple(),
                 "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm,
                 "life": None if self.life is None else self.life.get_state()}
@@ -289,6 +293,7 @@ class BearingSimulator:
         self._previous = None if state.get("previous") is None else np.asarray(state["previous"], dtype=float)
         self._loads = tuple(None if f is None else np.asarray(f, dtype=float)
                             for f in state.get("loads") or (None, None))
+        self._warm_converged = bool(state.get("warm_converged", True))
         self._psi = float(state["psi"])
         self.solver.set_rotation(self._psi)
         self.solver.operator = None if state["operator"] is None else ReducedOperator.from_tuple(state["operator"])
