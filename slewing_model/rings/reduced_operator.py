@@ -15,7 +15,9 @@ and ``y`` the contact forces after the step. :class:`ReducedOperator` keeps
 complement). It is reused between iterations and between warm-started steps (a modified
 Newton step, still a descent direction), bordered by the contacts that close
 (:func:`update_operator`; contacts that open keep their rows until a fresh operator), and
-rebuilt when convergence slows (:func:`assemble_operator`).
+rebuilt when convergence slows (:func:`assemble_operator`). A new one is inverted in single
+precision (:data:`OPERATOR_PRECISION`): the step is solved in increments of ``y``
+(:func:`newton_step`), so an approximate ``W^-1`` slows the iteration without moving its answer.
 
 Run-time module: numpy.
 """
@@ -159,12 +161,13 @@ def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
             matrix[first + r, first + c] += blocks[:, r, c]
 
 
-#: the precision ``W``'s inverse is computed in (its stages, :data:`STAGES`; the inverse is then kept
-#: in double precision). Single: 0.6 of double's time (one thread, the stages of 430 rows 3.5 -> 2.2
-#: ms) and an inverse within about ``1e-7 cond(W)`` of ``W``'s (the pitch bearing's ``W``, condition
-#: 5.7e3: 4e-5), which the step in increments (:func:`newton_step`) takes as one more approximation
-#: of its modified Newton operator: the equilibrium it converges to is the same (docs/speed.md,
-#: "Issue 31, sixth turn")
+#: the precision ``W``'s inverse is computed in (its stages, :data:`STAGES`; ``W`` is kept in double,
+#: and so is the inverse once done). Single: 0.6 of double's time (one thread, the stages of 430 rows
+#: 3.5 -> 2.2 ms) and an inverse within about ``1e-7 cond(W)`` of ``W``'s (the pitch bearing's ``W``,
+#: condition 5.7e3: 4e-5), which the step in increments (:func:`newton_step`) takes as one more
+#: approximation of its modified Newton operator: the equilibrium it converges to is the same. An
+#: inverse too far off (:func:`checked_inverse`), or a ``W`` singular in single precision, is inverted
+#: again in double (docs/speed.md, "Issue 31, sixth turn")
 OPERATOR_PRECISION = np.float32
 
 #: below this size :func:`spd_inverse` calls LAPACK's inverse
@@ -188,8 +191,7 @@ def spd_inverse(w: np.ndarray) -> np.ndarray:
     The top level is six stages (:data:`STAGES`), which :class:`PendingOperator` spreads over
     steps."""
     if w.shape[0] <= LEAF:
-        inverse = np.linalg.inv(w)
-        return 0.5 * (inverse + inverse.T)
+        return _lapack_inverse(w)
     parts = ()
     for stage in STAGES:
         parts = stage(w, *parts)
@@ -314,12 +316,10 @@ class PendingOperator:
 
 def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None,
                    until: int | None = None) -> PendingOperator:
-    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`),
-    kept in :data:`OPERATOR_PRECISION`, and run the stages of its inverse up to ``until`` (default:
-    the first step's, :func:`advance_operator`)."""
+    """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
+    and run the stages of its inverse up to ``until`` (default: the first step's, :func:`advance_operator`)."""
     rows, a_inv, w_mat = _arithmetic(arithmetic).form(point, compliance, stiffness, active)
-    pending = PendingOperator(rows, active, a_inv, w_mat.astype(OPERATOR_PRECISION), 0, ())
-    return advance_operator(pending, None, None, until=until)
+    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None, until=until)
 
 
 def operator_matrix(point, compliance, stiffness, active):
@@ -338,21 +338,60 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     """The stages of :data:`STAGES` up to ``until`` (default: the end of this step's,
     :data:`SPREAD_STAGES`); after the last, the operator with its coupling to the Jacobian (4B, 5) of
     now (``jacobian`` None: the pending operator, inverted). A ``W`` of :data:`LEAF` rows or fewer
-    is inverted in one stage."""
+    is inverted in one stage. The stages run in :data:`OPERATOR_PRECISION`; the inverse, once done,
+    is checked (:func:`checked_inverse`) and kept in double; a ``W`` singular in that precision is
+    inverted in double at once."""
     if until is None:
         until = step_end(pending)
     if pending.stage < until:
-        if pending.matrix.shape[0] <= LEAF:
-            pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(pending.matrix),))
-        else:
-            parts = pending.parts
-            for stage in STAGES[pending.stage:until]:
-                parts = stage(pending.matrix, *parts)
-            pending = replace(pending, stage=until, parts=parts)
+        w_mat = pending.matrix.astype(OPERATOR_PRECISION, copy=False)
+        try:
+            if pending.matrix.shape[0] <= LEAF:
+                pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(w_mat),))
+            else:
+                parts = pending.parts
+                for stage in STAGES[pending.stage:until]:
+                    parts = stage(w_mat, *parts)
+                pending = replace(pending, stage=until, parts=parts)
+        except np.linalg.LinAlgError:        # singular in single precision: in double, at once
+            pending = replace(pending, stage=len(STAGES), parts=(_lapack_inverse(pending.matrix),))
+        if pending.stage == len(STAGES) and pending.parts[0].dtype != pending.matrix.dtype:
+            pending = replace(pending, parts=(checked_inverse(pending.matrix, pending.parts[0]),))
     if pending.stage < len(STAGES) or jacobian is None:
         return pending
-    return reduced_operator(pending.rows, pending.active, pending.contact_compliance,
-                            pending.parts[0].astype(float), jacobian, mu, arithmetic)
+    return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
+                            arithmetic)
+
+
+#: how far ``W X v`` may be from ``v`` for a probe vector ``v`` (relative, largest entry) before an
+#: inverse ``X`` computed in :data:`OPERATOR_PRECISION` is computed again in double precision
+#: (:func:`checked_inverse`): about the contraction an iteration of the step in increments keeps on
+#: account of the inverse. Measured in single precision: a median of 2e-3 (pitch and yaw bearings
+#: under load) up to 0.036 (pitch), with the same Newton iterations a step as in double (NREL 4.69
+#: against 4.68); the yaw bearing's first operator after a start at zero loads 0.48
+INVERSE_CHECK = 0.1
+
+
+def checked_inverse(w_mat: np.ndarray, inverse: np.ndarray) -> np.ndarray:
+    """The inverse of ``W`` (``w_mat``, double) in double precision: ``inverse`` where ``W inverse v``
+    is within :data:`INVERSE_CHECK` of ``v`` for the probe ``v = (1, 1.125, ..., 1.75, 1, ...)``, else
+    computed again by LAPACK in double. In single precision an inverse is within about
+    ``1e-7 cond(W)`` of ``W``'s: the operators under load are conditioned 5e3-4e5 here, but ``W`` of
+    the preload alone (the yaw bearing at zero loads: 4e13) is singular in single precision. LAPACK,
+    not :func:`spd_inverse`: by halves, ill-conditioned matrices lose more (condition 1e9: ``|X W - I|``
+    2e-5 against LAPACK's 7e-8; 1e13: 11 against 1e-3)."""
+    inverse = inverse.astype(w_mat.dtype)
+    probe = 1.0 + 0.125 * (np.arange(w_mat.shape[0]) % 7)
+    error = np.abs(w_mat @ (inverse @ probe) - probe).max()
+    if error <= INVERSE_CHECK * probe.max():
+        return inverse
+    return _lapack_inverse(w_mat)
+
+
+def _lapack_inverse(w_mat: np.ndarray) -> np.ndarray:
+    """LAPACK's inverse, made exactly symmetric."""
+    inverse = np.linalg.inv(w_mat)
+    return 0.5 * (inverse + inverse.T)
 
 
 def step_end(pending: PendingOperator) -> int:
