@@ -355,7 +355,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
                 pending = replace(pending, stage=until, parts=parts)
         except np.linalg.LinAlgError:        # singular in single precision: in double, at once
             pending = replace(pending, stage=len(STAGES), parts=(_lapack_inverse(pending.matrix),))
-        if pending.stage == len(STAGES) and pending.parts[0].dtype != pending.matrix.dtype:
+        if pending.stage == len(STAGES):
             pending = replace(pending, parts=(checked_inverse(pending.matrix, pending.parts[0]),))
     if pending.stage < len(STAGES) or jacobian is None:
         return pending
@@ -379,8 +379,9 @@ def checked_inverse(w_mat: np.ndarray, inverse: np.ndarray) -> np.ndarray:
     ``1e-7 cond(W)`` of ``W``'s: the operators under load are conditioned 5e3-4e5 here, but ``W`` of
     the preload alone (the yaw bearing at zero loads: 4e13) is singular in single precision. LAPACK,
     not :func:`spd_inverse`: by halves, ill-conditioned matrices lose more (condition 1e9: ``|X W - I|``
-    2e-5 against LAPACK's 7e-8; 1e13: 11 against 1e-3)."""
-    inverse = inverse.astype(w_mat.dtype)
+    2e-5 against LAPACK's 7e-8; 1e13: 11 against 1e-3), so an inverse by halves in double is checked
+    too."""
+    inverse = inverse.astype(w_mat.dtype, copy=False)
     probe = 1.0 + 0.125 * (np.arange(w_mat.shape[0]) % 7)
     error = np.abs(w_mat @ (inverse @ probe) - probe).max()
     if error <= INVERSE_CHECK * probe.max():
