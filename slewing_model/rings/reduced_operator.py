@@ -43,7 +43,8 @@ class ReducedOperator:
     contact_compliance : ndarray (n/2, 2, 2)
         ``A^-1`` of the operator's diagonals, in its order, when each entered.
     inverse : ndarray (n, n)
-        ``W^-1 = (A^-1 + M)_aa^-1``.
+        ``W^-1 = (A^-1 + M)_aa^-1``, double; computed in :data:`OPERATOR_PRECISION` (checked,
+        :func:`checked_inverse`), so within about ``1e-7 cond(W)`` of the exact inverse.
     jacobian : ndarray (n, 5)
         ``J_a`` (scaled rotations) when the coupling was formed.
     coupling : ndarray (n, 5)
@@ -289,7 +290,8 @@ def forming_work(rows: int) -> float:
 class PendingOperator:
     """A new reduced operator formed at an iterate and inverted over steps.
 
-    Inverting ``W`` is about 2.5 ms on the pitch bearing, more than a whole step: made at
+    Inverting ``W`` is about 1.5-2.5 ms on the pitch bearing (single or double precision,
+    :data:`OPERATOR_PRECISION`), more than a whole step: made at
     once, it is what the slowest steps of a co-simulation spend (the 95th and 99th
     percentiles). :func:`start_operator` forms ``W`` and runs the first step's stages
     (:data:`SPREAD_STAGES`), :func:`advance_operator` the next; meanwhile the solver goes on
