@@ -229,17 +229,23 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     g_t, h_t, e_t = np.empty(3), np.empty((3, 3)), np.empty((3, 3))    # at the trial point
     newton, du, trial, minus_g = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     damped = np.empty((3, 3))
+    # every ball's power, gradient and Hessian at its start: they give the floor (the mean power) and
+    # start each ball's loop, one evaluation a ball (the power is summed as without derivatives)
+    start_f = np.empty(n_balls)
+    start_g, start_h = np.empty((n_balls, 3)), np.empty((n_balls, 3, 3))
+    total = 0.0
+    for b in range(n_balls):
+        start_f[b] = _ball_evaluate(out[b], first[b], first[b + 1], g10, g12, h1, s0, s1, hs, weight, t2, eps2,
+                                    True, False, start_g[b], start_h[b], e)
+        total += start_f[b]
     if floor < 0.0:
-        total = 0.0
-        for b in range(n_balls):
-            total += _ball_evaluate(out[b], first[b], first[b + 1], g10, g12, h1, s0, s1, hs, weight, t2, eps2,
-                                    False, False, g, h, e)
         floor = total / max(n_balls, 1)
     for b in range(n_balls):
         c0, c1 = first[b], first[b + 1]
         x[:] = out[b]
         theta = 0.0
-        f = _ball_evaluate(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, False, g, h, e)
+        f = start_f[b]
+        g[:], h[:, :] = start_g[b], start_h[b]
         has_extra = False
         count = 0
         while True:
