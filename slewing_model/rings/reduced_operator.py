@@ -167,8 +167,9 @@ def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
 #: 3.5 -> 2.2 ms) and an inverse within about ``1e-7 cond(W)`` of ``W``'s (the pitch bearing's ``W``,
 #: condition 5.7e3: 4e-5), which the step in increments (:func:`newton_step`) takes as one more
 #: approximation of its modified Newton operator: the equilibrium it converges to is the same. An
-#: inverse too far off (:func:`checked_inverse`), or a ``W`` singular in single precision, is inverted
-#: again in double (docs/speed.md, "Issue 31, sixth turn")
+#: inverse too far off, or a ``W`` singular in single precision, is inverted again through its
+#: Cholesky factor, in single precision and if need be in double (:func:`checked_inverse`;
+#: docs/speed.md, "Issue 31, sixth and seventh turns")
 OPERATOR_PRECISION = np.float32
 
 #: below this size :func:`spd_inverse` calls LAPACK's inverse
@@ -342,7 +343,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     now (``jacobian`` None: the pending operator, inverted). A ``W`` of :data:`LEAF` rows or fewer
     is inverted in one stage. The stages run in :data:`OPERATOR_PRECISION`; the inverse, once done,
     is checked (:func:`checked_inverse`) and kept in double; a ``W`` singular in that precision is
-    inverted in double at once."""
+    inverted by the check's other ways at once."""
     if until is None:
         until = step_end(pending)
     if pending.stage < until:
@@ -355,8 +356,8 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
                 for stage in STAGES[pending.stage:until]:
                     parts = stage(w_mat, *parts)
                 pending = replace(pending, stage=until, parts=parts)
-        except np.linalg.LinAlgError:        # singular in single precision: in double, at once
-            pending = replace(pending, stage=len(STAGES), parts=(_lapack_inverse(pending.matrix),))
+        except np.linalg.LinAlgError:        # singular in single precision: inverted again at once
+            pending = replace(pending, stage=len(STAGES), parts=(None,))
         if pending.stage == len(STAGES):
             pending = replace(pending, parts=(checked_inverse(pending.matrix, pending.parts[0]),))
     if pending.stage < len(STAGES) or jacobian is None:
@@ -366,7 +367,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
 
 
 #: how far ``W X v`` may be from ``v`` for a probe vector ``v`` (relative, largest entry) before an
-#: inverse ``X`` computed in :data:`OPERATOR_PRECISION` is computed again in double precision
+#: inverse ``X`` computed in :data:`OPERATOR_PRECISION` is computed again, more exactly
 #: (:func:`checked_inverse`): about the contraction an iteration of the step in increments keeps on
 #: account of the inverse. Measured in single precision: a median of 2e-3 (pitch and yaw bearings
 #: under load) up to 0.036 (pitch), with the same Newton iterations a step as in double (NREL 4.69
@@ -374,27 +375,93 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
 INVERSE_CHECK = 0.1
 
 
-def checked_inverse(w_mat: np.ndarray, inverse: np.ndarray) -> np.ndarray:
-    """The inverse of ``W`` (``w_mat``, double) in double precision: ``inverse`` where ``W inverse v``
-    is within :data:`INVERSE_CHECK` of ``v`` for the probe ``v = (1, 1.125, ..., 1.75, 1, ...)``, else
-    computed again by LAPACK in double. In single precision an inverse is within about
-    ``1e-7 cond(W)`` of ``W``'s: the operators under load are conditioned 5e3-4e5 here, but ``W`` of
-    the preload alone (the yaw bearing at zero loads: 4e13) is singular in single precision. LAPACK,
-    not :func:`spd_inverse`: by halves, ill-conditioned matrices lose more (condition 1e9: ``|X W - I|``
-    2e-5 against LAPACK's 7e-8; 1e13: 11 against 1e-3), so an inverse by halves in double is checked
-    too."""
-    inverse = inverse.astype(w_mat.dtype, copy=False)
-    probe = 1.0 + 0.125 * (np.arange(w_mat.shape[0]) % 7)
-    error = np.abs(w_mat @ (inverse @ probe) - probe).max()
-    if error <= INVERSE_CHECK * probe.max():
-        return inverse
+def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None") -> np.ndarray:
+    """The inverse of ``W`` (``w_mat``, double) in double precision: ``inverse`` (by :func:`spd_inverse`, in
+    :data:`OPERATOR_PRECISION`; None where ``W`` was singular there) where ``W inverse v`` is within
+    :data:`INVERSE_CHECK` of ``v`` for the probe ``v = (1, 1.125, ..., 1.75, 1, ...)``, else inverted
+    again, each time checked so: through its Cholesky factor (:func:`cholesky_inverse`), first in single
+    precision, then in double, and last by LAPACK's ``inv`` in double.
+
+    In single precision an inverse is within about ``1e-7 cond(W)`` of ``W``'s, and the operators
+    under load are conditioned 4e3-1e8 here. By halves (:func:`spd_inverse`) the errors compound from
+    level to level: after a moment reversal the pitch bearing's operators (condition 5e4-8e4) missed
+    the check by far (probe residuals 0.24-1.5), a few times in a thousand steps, and each was inverted
+    again by LAPACK in double, 4-19 ms, the slowest steps of the bounded scenarios. Through the factor,
+    scaled to a unit diagonal, single precision gives 0.004-0.007 for them (one of condition 1e8:
+    0.05) in about twice the time of an inverse by halves, a third to a half of LAPACK's in double;
+    what it misses, double precision gives to about ``1e-16 cond(W)`` (docs/speed.md, "Issue 31,
+    seventh turn"). ``W`` of the preload alone (the yaw bearing at zero loads: condition 4e13) is
+    singular in single precision; LAPACK's ``inv`` is the last resort for a ``W`` the Cholesky factor
+    refuses in double too."""
+    if inverse is not None:
+        inverse = inverse.astype(w_mat.dtype, copy=False)
+        if _probe_residual(w_mat, inverse) <= INVERSE_CHECK:
+            return inverse
+    for precision in dict.fromkeys((OPERATOR_PRECISION, np.float64)):
+        try:
+            inverse = cholesky_inverse(w_mat, precision)
+        except np.linalg.LinAlgError:       # not positive definite in this precision
+            continue
+        if _probe_residual(w_mat, inverse) <= INVERSE_CHECK:
+            return inverse
     return _lapack_inverse(w_mat)
+
+
+def _probe_residual(w_mat: np.ndarray, inverse: np.ndarray) -> float:
+    """``|W X v - v|`` relative to ``v``'s largest entry, for :func:`checked_inverse`'s probe ``v``."""
+    probe = 1.0 + 0.125 * (np.arange(w_mat.shape[0]) % 7)
+    return float(np.abs(w_mat @ (inverse @ probe) - probe).max()) / float(probe.max())
 
 
 def _lapack_inverse(w_mat: np.ndarray) -> np.ndarray:
     """LAPACK's inverse, made exactly symmetric."""
     inverse = np.linalg.inv(w_mat)
     return 0.5 * (inverse + inverse.T)
+
+
+def cholesky_inverse(w_mat: np.ndarray, precision=np.float64) -> np.ndarray:
+    """The inverse (double) of a symmetric positive definite ``W`` (double) through its Cholesky
+    factor, computed in ``precision``: ``W`` scaled to a unit diagonal, ``S W S`` with
+    ``S = diag(W)^-1/2`` (Jacobi's scaling: a contact that just closed is soft, and the diagonal
+    spans up to 1e6), ``X = L^-1`` of its factor ``L`` (:func:`factor_inverse`), and
+    ``W^-1 = S X^T X S``. As accurate as LAPACK's Cholesky inverse (``potri``): about
+    ``1e-7 cond(W)`` in single precision, where the inverse by halves (:func:`spd_inverse`, faster:
+    ``4/3 n^3`` flops against about ``2 n^3`` here) can be 100 times farther off.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        ``W`` is not positive definite in ``precision``."""
+    diagonal = np.diagonal(w_mat)
+    if not np.all(diagonal > 0.0):
+        raise np.linalg.LinAlgError("W's diagonal is not positive")
+    scale = 1.0 / np.sqrt(diagonal)
+    scale = np.outer(scale, scale)                   # S_ii S_jj, exactly symmetric
+    factor = factor_inverse((w_mat * scale).astype(precision, copy=False))
+    inverse = (factor.T @ factor).astype(np.float64, copy=False)  # X^T X: BLAS's symmetric product, exactly so
+    inverse *= scale
+    return inverse
+
+
+def factor_inverse(w: np.ndarray) -> np.ndarray:
+    """``X = L^-1`` (lower triangular) of the Cholesky factor ``L`` of ``w`` (symmetric positive
+    definite), by halves: with ``w = [[A, B^T], [B, D]]``, ``X11`` that of ``A``, ``L21 = B X11^T``,
+    ``X22`` that of the Schur complement ``S = D - L21 L21^T`` and ``X21 = -X22 L21 X11``; LAPACK's
+    factor and inverse at :data:`LEAF` rows or fewer. ``S`` is formed from ``L21``, whose error grows
+    with the square root of ``A``'s condition (not from ``A^-1``, as :func:`spd_inverse` does)."""
+    n = w.shape[0]
+    if n <= LEAF:
+        return np.tril(np.linalg.inv(np.linalg.cholesky(w)))
+    h = n // 2
+    x11 = factor_inverse(w[:h, :h])
+    l21 = w[h:, :h] @ x11.T
+    schur = w[h:, h:] - l21 @ l21.T
+    x22 = factor_inverse(0.5 * (schur + schur.T))
+    out = np.zeros_like(w)
+    out[:h, :h] = x11
+    out[h:, h:] = x22
+    out[h:, :h] = -(x22 @ (l21 @ x11))
+    return out
 
 
 def step_end(pending: PendingOperator) -> int:
