@@ -21,7 +21,7 @@ inverse (:data:`slewing_model.rings.reduced_operator.STAGES`), against the work 
 (:func:`~slewing_model.rings.reduced_operator.forming_work`,
 :func:`~slewing_model.rings.reduced_operator.stage_work`): what ``BOUNDED_WORK`` is in time here.
 
-Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border | --stages]
+Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border | --stages [--method 0|1|2]]
 """
 from __future__ import annotations
 
@@ -107,8 +107,9 @@ def bordering(runs: int, n: int = 368) -> None:
                  "counted (work / inversion's)"], rows)
 
 
-def stages(runs: int) -> None:
-    """Forming ``W`` and each stage of its inverse: time against the work a bounded step counts."""
+def stages(runs: int, method: int = 0) -> None:
+    """Forming ``W`` and each stage of its inverse (``method`` 1 and 2: through the Cholesky factor,
+    ``FACTOR_STAGES``, in single and in double precision): time against the work a bounded step counts."""
     from dataclasses import replace
 
     from slewing_model.distribution import bime
@@ -138,21 +139,23 @@ def stages(runs: int) -> None:
     with blas_threads(1):
         for n in sorted(formed)[:: max(1, len(formed) // 5)]:
             point, active = formed[n]
-            times = {k: [] for k in ["form", *range(len(reduced_operator.STAGES))]}
+            stages = reduced_operator.FACTOR_STAGES if method else reduced_operator.STAGES
+            times = {k: [] for k in ["form", *range(len(stages))]}
             for _ in range(runs):
                 start = time.perf_counter()
                 pending = reduced_operator.start_operator(point, solver.compliance, solver.assembly.stiffness, active,
                                                           arithmetic, until=0)
+                pending = replace(pending, method=method)
                 times["form"].append(time.perf_counter() - start)
-                for k in range(len(reduced_operator.STAGES)):
+                for k in range(len(stages)):
                     start = time.perf_counter()
                     pending = reduced_operator.advance_operator(pending, None, None, until=k + 1)
                     times[k].append(time.perf_counter() - start)
-            counted = [reduced_operator.forming_work(n)] + [reduced_operator.stage_work(n, k)
-                                                 for k in range(len(reduced_operator.STAGES))]
+            counted = [reduced_operator.forming_work(n)] + [reduced_operator.stage_work(n, k, method)
+                                                 for k in range(len(stages))]
             for (label, t), flops in zip(times.items(), counted):
                 ms = float(np.median(t)) * 1e3
-                rows.append([str(n), "form W" if label == "form" else reduced_operator.STAGES[label].__name__,
+                rows.append([str(n), "form W" if label == "form" else stages[label].__name__,
                              f"{ms:.3f}", f"{flops / 1e6:.1f}", f"{flops / 1e6 / ms:.1f}" if ms else "–"])
     print_table(f"A new operator's work on one BLAS thread, medians of {runs} runs [ms], against the work a bounded "
                 f"step counts (BOUNDED_WORK = {bime.BOUNDED_WORK / 1e6:.0f} M)",
@@ -165,11 +168,14 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=200, help="steps of each case that form the operators")
     parser.add_argument("--border", action="store_true", help="time bordering instead (compiled against numpy)")
     parser.add_argument("--stages", action="store_true", help="time forming W and each stage of its inverse instead")
+    parser.add_argument("--method", type=int, default=0, choices=(0, 1, 2),
+                        help="with --stages: the stages of a PendingOperator of this method (1 and 2: through the "
+                             "Cholesky factor, FACTOR_STAGES, in single and in double precision)")
     args = parser.parse_args()
     if args.border:
         return bordering(args.runs)
     if args.stages:
-        return stages(args.runs)
+        return stages(args.runs, args.method)
     rows = []
     for name in ("pitch", "yaw"):
         operators = formed_operators(name, args.steps)

@@ -420,12 +420,15 @@ def test_a_start_at_zero_loads_whose_operator_is_singular_in_single_precision(mo
 def test_inverse_spread_over_two_steps_equals_the_inverse_at_once(double_operator):
     """The new operator's inverse in the stages of two steps (a complete solve's) or one stage at a
     time (a bounded solve's), its state serialised between them (a co-simulation's rollback), is
-    :func:`spd_inverse`'s bit for bit."""
+    :func:`spd_inverse`'s bit for bit; through the Cholesky factor (a pending operator of method 1 or
+    2), :func:`cholesky_inverse`'s."""
     import json
 
     from conftest import BEARINGS
     from slewing_model import load_bearing
-    from slewing_model.rings.reduced_operator import STAGES, PendingOperator, advance_operator, spd_inverse
+    from slewing_model.rings.reduced_operator import (
+        STAGES, PendingOperator, advance_operator, cholesky_inverse, method_precision, spd_inverse,
+    )
     from slewing_model.rings.compliance import contact_compliance, ring_compliances
     from slewing_model.simulation.simulator import decode_state, encode_state
     from slewing_model.rings.superelement import build_superelement
@@ -447,6 +450,16 @@ def test_inverse_spread_over_two_steps_equals_the_inverse_at_once(double_operato
             pending = advance_operator(pending, None, None, until=pending.stage + 1)
             pending = PendingOperator.from_tuple(decode_state(json.loads(json.dumps(encode_state(pending.as_tuple())))))
         assert np.array_equal(pending.parts[0], spd_inverse(w))
+        # the inverse through the Cholesky factor (methods 1 and 2: an inverse made again) the same way
+        for method in (1, 2):
+            pending = PendingOperator(np.arange(rows), np.ones(rows // 2, bool), np.zeros((rows // 2, 2, 2)), w, 0, (),
+                                      method)
+            while pending.stage < len(STAGES):
+                pending = advance_operator(pending, None, None, until=pending.stage + 1)
+                pending = PendingOperator.from_tuple(
+                    decode_state(json.loads(json.dumps(encode_state(pending.as_tuple())))))
+            assert pending.method == method
+            assert np.array_equal(pending.parts[0], cholesky_inverse(w, method_precision(method)))
 
 
 def test_cold_solve_does_not_depend_on_the_solves_before(bearing):

@@ -624,13 +624,14 @@ class BimeSolver:
         kept as the solver's and :class:`_WorkSpent` raised where ``required``."""
         n, stage = pending.matrix.shape[0], pending.stage
         while stage < until:
-            cost = stage_work(n, stage)
+            cost = stage_work(n, stage, pending.method)
             if cost > self._work_left and self._work_left < BOUNDED_WORK:
                 break
             self._work_left -= cost
             stage += 1
-        if stage > pending.stage:
-            pending = advance_operator(pending, None, None, until=stage)
+        if stage > pending.stage:    # an inverse that misses the check: made again, spread where the solve can
+            pending = advance_operator(pending, None, None, until=stage,  # wait or its work is bounded
+                                       again=not required or math.isfinite(self._work_left))
         if pending.stage >= len(STAGES) and until >= len(STAGES):
             return advance_operator(pending, self.jacobian, mu, self._arithmetic)
         if required:

@@ -265,19 +265,154 @@ def inverse_work(n: int) -> float:
     return sum(stage_work(n, k) for k in range(len(STAGES)))
 
 
-def stage_work(n: int, stage: int) -> float:
-    """The work of stage ``stage`` of :data:`STAGES` on ``n`` rows: its floating-point operations
-    (a product of ``(p, q)`` by ``(q, r)`` is ``2 p q r``, an inverse of ``k`` rows ``4 k^3 / 3``, LAPACK's
-    ``2 k^3``; halves of ``h`` and ``m = n - h`` rows) times :data:`STAGE_WEIGHT`, so that work is about
-    time: some 55 million a millisecond on one core here. At :data:`LEAF` rows or fewer the first
-    stage is the whole inverse."""
+def stage_work(n: int, stage: int, method: int = 0) -> float:
+    """The work of stage ``stage`` of :data:`STAGES` on ``n`` rows (``method`` 1 and 2:
+    :data:`FACTOR_STAGES`', in :data:`OPERATOR_PRECISION` and in double): its floating-point operations
+    (a product of ``(p, q)`` by ``(q, r)`` is ``2 p q r``, a symmetric one ``p q p``, an inverse of ``k``
+    rows ``4 k^3 / 3``, an inverse Cholesky factor ``k^3``, LAPACK's ``2 k^3``; halves of ``h`` and
+    ``m = n - h`` rows) times :data:`STAGE_WEIGHT` (:data:`FACTOR_WEIGHT`, :data:`FACTOR_WEIGHT_DOUBLE`),
+    so that work is about time: some 55 million a millisecond on one core here. At :data:`LEAF` rows
+    or fewer the first stage is the whole inverse."""
+    weight = (STAGE_WEIGHT, FACTOR_WEIGHT, FACTOR_WEIGHT_DOUBLE)[method]
     if n <= LEAF:
-        return STAGE_WEIGHT[0] * 2.0 * n ** 3 if stage == 0 else 0.0
+        return weight[0] * 2.0 * n ** 3 if stage == 0 else 0.0
     h = n // 2
     m = n - h
-    flops = (4.0 / 3.0 * h ** 3, 2.0 * h * h * m, 2.0 * m * m * h, 4.0 / 3.0 * m ** 3, 2.0 * h * m * m,
-             2.0 * h * h * m)[stage]
-    return STAGE_WEIGHT[stage] * flops
+    if method:
+        flops = (h ** 3, 2.0 * h * h * m, m * m * h, m ** 3, 2.0 * m * h * (h + m),
+                 h * h * (h + m) + m ** 3 + 2.0 * h * m * m)
+    else:
+        flops = (4.0 / 3.0 * h ** 3, 2.0 * h * h * m, 2.0 * m * m * h, 4.0 / 3.0 * m ** 3, 2.0 * h * m * m,
+                 2.0 * h * h * m)
+    return weight[stage] * flops[stage]
+
+
+def cholesky_inverse(w_mat: np.ndarray, precision=np.float64) -> np.ndarray:
+    """The inverse (double) of a symmetric positive definite ``W`` (double) through its Cholesky
+    factor, computed in ``precision``: ``W`` scaled to a unit diagonal (:func:`scaled_matrix`), the
+    inverse of that by :data:`FACTOR_STAGES` and scaled back. As accurate as LAPACK's Cholesky inverse
+    (``potri``): about ``1e-7 cond(W)`` in single precision, where the inverse by halves
+    (:func:`spd_inverse`, about half the time) can be 100 times farther off: the second way of
+    :func:`checked_inverse`.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        ``W`` is not positive definite in ``precision``."""
+    scaled, scale = scaled_matrix(w_mat, precision)
+    if scaled.shape[0] <= LEAF:
+        return _unscaled(_lapack_inverse(scaled), scale)
+    parts = ()
+    for stage in FACTOR_STAGES:
+        parts = stage(scaled, *parts)
+    return _unscaled(parts[0], scale)
+
+
+def scaled_matrix(w_mat: np.ndarray, precision) -> tuple[np.ndarray, np.ndarray]:
+    """``S W S`` in ``precision``, ``S = diag(W)^-1/2`` (a unit diagonal: Jacobi's scaling; a contact
+    that just closed is soft, and the diagonal spans up to 1e6), and ``S_ii S_jj`` (double, exactly
+    symmetric).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        A diagonal entry of ``W`` is not positive: ``W`` is not positive definite."""
+    diagonal = np.diagonal(w_mat)
+    if not np.all(diagonal > 0.0):
+        raise np.linalg.LinAlgError("W's diagonal is not positive")
+    scale = 1.0 / np.sqrt(diagonal)
+    scale = np.outer(scale, scale)
+    return (w_mat * scale).astype(precision, copy=False), scale
+
+
+def _unscaled(inverse: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """``S (S W S)^-1 S`` in double from the inverse of the scaled ``W`` (:func:`scaled_matrix`)."""
+    out = inverse.astype(np.float64)
+    out *= scale
+    return out
+
+
+def factor_inverse(w: np.ndarray) -> np.ndarray:
+    """``X = L^-1`` (lower triangular) of the Cholesky factor ``L`` of ``w`` (symmetric positive
+    definite), by halves as :data:`FACTOR_STAGES` form it: ``[[X11, 0], [-X22 L21 X11, X22]]``;
+    LAPACK's factor and inverse at :data:`LEAF` rows or fewer."""
+    n = w.shape[0]
+    if n <= LEAF:
+        return np.tril(np.linalg.inv(np.linalg.cholesky(w)))
+    x11, l21, schur = _factor_schur(w, *_coupling_factor(w, *_half_factor(w)))
+    columns, x22 = _lower_columns(w, *_schur_factor(w, x11, l21, schur))
+    out = np.zeros_like(w)
+    h = n // 2
+    out[:, :h] = columns
+    out[h:, h:] = x22
+    return out
+
+
+def _half_factor(w):
+    """``X11``, the inverse Cholesky factor of ``A`` (``w = [[A, B^T], [B, D]]``) ..."""
+    h = w.shape[0] // 2
+    return (factor_inverse(w[:h, :h]),)
+
+
+def _coupling_factor(w, x11):
+    """... ``L21 = B X11^T`` ..."""
+    h = w.shape[0] // 2
+    return x11, w[h:, :h] @ x11.T
+
+
+def _factor_schur(w, x11, l21):
+    """... ``S = D - L21 L21^T`` (formed from ``L21``, whose error grows with the square root of
+    ``A``'s condition, where :data:`STAGES` form it from ``A^-1``), exactly symmetric ..."""
+    h = w.shape[0] // 2
+    schur = w[h:, h:] - l21 @ l21.T
+    return x11, l21, 0.5 * (schur + schur.T)
+
+
+def _schur_factor(w, x11, l21, schur):
+    """... ``X22``, the inverse Cholesky factor of ``S`` ..."""
+    return x11, l21, factor_inverse(schur)
+
+
+def _lower_columns(w, x11, l21, x22):
+    """... ``X``'s first ``h`` columns ``[X11; X21]``, ``X21 = -X22 L21 X11`` ..."""
+    h = w.shape[0] // 2
+    columns = np.empty((w.shape[0], h), dtype=w.dtype)
+    columns[:h] = x11
+    columns[h:] = -(x22 @ (l21 @ x11))
+    return columns, x22
+
+
+def _factor_joined(w, columns, x22):
+    """... and ``w^-1 = X^T X`` from them (its corners as symmetric products), exactly symmetric."""
+    h = w.shape[0] // 2
+    out = np.empty_like(w)
+    corner = columns.T @ columns                 # X11^T X11 + X21^T X21
+    out[:h, :h] = 0.5 * (corner + corner.T)
+    out[:h, h:] = columns[h:].T @ x22            # X21^T X22
+    out[h:, :h] = out[:h, h:].T
+    corner = x22.T @ x22
+    out[h:, h:] = 0.5 * (corner + corner.T)
+    return (out,)
+
+
+#: the stages of the inverse through the Cholesky factor (:func:`cholesky_inverse`), as :data:`STAGES`
+#: are :func:`spd_inverse`'s: the way an inverse by halves that misses the check in single precision
+#: is made again, spread over steps where the solve allows (:func:`advance_operator`)
+FACTOR_STAGES = (_half_factor, _coupling_factor, _factor_schur, _schur_factor, _lower_columns, _factor_joined)
+#: :data:`STAGE_WEIGHT` of :data:`FACTOR_STAGES` (in :data:`OPERATOR_PRECISION`; measured so,
+#: ``benchmarks/bench_operator.py --stages --factor``): the inverse factors of the halves recurse down to
+#: LAPACK's leaves (the first stage also scales ``W``), and the symmetric products run at about half a
+#: general product's rate a counted flop
+FACTOR_WEIGHT = (6.8, 0.43, 1.0, 3.6, 0.43, 1.1)
+#: ... and in double precision (a pending operator of method 2)
+FACTOR_WEIGHT_DOUBLE = (8.1, 0.97, 2.0, 5.0, 1.13, 2.2)
+assert len(FACTOR_STAGES) == len(STAGES)                 # a pending operator is done after len(STAGES) of either
+
+
+def method_precision(method: int):
+    """The precision of the stages of a :class:`PendingOperator` of ``method``: :data:`OPERATOR_PRECISION`
+    (0: by halves; 1: through the Cholesky factor), double (2: through the factor)."""
+    return np.float64 if method == 2 else OPERATOR_PRECISION
 
 
 def forming_work(rows: int) -> float:
@@ -297,7 +432,11 @@ class PendingOperator:
     percentiles). :func:`start_operator` forms ``W`` and runs the first step's stages
     (:data:`SPREAD_STAGES`), :func:`advance_operator` the next; meanwhile the solver goes on
     with the operator it has (a modified Newton step: slower, as exact). ``stage``: the stages
-    of :data:`STAGES` done, ``parts`` the last one's results."""
+    done, of :data:`STAGES` (``method`` 0: by halves) or of :data:`FACTOR_STAGES` (``method`` 1:
+    through the Cholesky factor, ``W`` scaled: an inverse by halves that missed the check, made
+    again; ``method`` 2: the same in double, where that missed it too), ``parts`` the last one's
+    results (in :func:`method_precision`); ``scaled``: :func:`scaled_matrix` of ``matrix`` for
+    methods 1 and 2 (not part of the state: it follows from ``matrix``)."""
 
     rows: np.ndarray
     active: np.ndarray
@@ -305,16 +444,18 @@ class PendingOperator:
     matrix: np.ndarray
     stage: int
     parts: tuple
+    method: int = 0
+    scaled: tuple = ()
 
     def as_tuple(self) -> tuple:
-        """The arrays (not copied) and the stage: a solver state to keep or serialise."""
-        return (self.rows, self.active, self.contact_compliance, self.matrix, self.stage, *self.parts)
+        """The arrays (not copied), the stage and the method: a solver state to keep or serialise."""
+        return (self.rows, self.active, self.contact_compliance, self.matrix, self.stage, self.method, *self.parts)
 
     @classmethod
     def from_tuple(cls, values) -> "PendingOperator":
-        rows, active, a_inv, matrix, stage, *parts = values
+        rows, active, a_inv, matrix, stage, method, *parts = values
         return cls(*(np.asarray(v) for v in (rows, active, a_inv, matrix)), int(stage),
-                   tuple(np.asarray(v) for v in parts))
+                   tuple(np.asarray(v) for v in parts), int(method))
 
 
 def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorArithmetic | None" = None,
@@ -337,29 +478,44 @@ def operator_matrix(point, compliance, stiffness, active):
 
 
 def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "OperatorArithmetic | None" = None,
-                     until: int | None = None) -> "PendingOperator | ReducedOperator":
-    """The stages of :data:`STAGES` up to ``until`` (default: the end of this step's,
-    :data:`SPREAD_STAGES`); after the last, the operator with its coupling to the Jacobian (4B, 5) of
-    now (``jacobian`` None: the pending operator, inverted). A ``W`` of :data:`LEAF` rows or fewer
-    is inverted in one stage. The stages run in :data:`OPERATOR_PRECISION`; the inverse, once done,
-    is checked (:func:`checked_inverse`) and kept in double; a ``W`` singular in that precision is
-    inverted by the check's other ways at once."""
+                     until: int | None = None, again: bool = False) -> "PendingOperator | ReducedOperator":
+    """The stages up to ``until`` (default: the end of this step's, :data:`SPREAD_STAGES`), of
+    :data:`STAGES` (of :data:`FACTOR_STAGES` for ``pending.method`` 1 and 2); after the last, the operator
+    with its coupling to the Jacobian (4B, 5) of now (``jacobian`` None: the pending operator,
+    inverted). A ``W`` of :data:`LEAF` rows or fewer is inverted in one stage. The stages run in
+    :func:`method_precision`; the inverse, once done, is checked (:func:`checked_inverse`) and
+    kept in double. An inverse that misses the check is made again through the Cholesky factor:
+    with ``again``, as a pending operator of the next method at stage 0 (by halves: 1, in single
+    precision; 1: 2, in double), whose stages the next calls run (a solve that can go on without it,
+    or a bounded one: spread over steps as any new operator); else at once, as a ``W`` singular in
+    single precision is."""
     if until is None:
         until = step_end(pending)
     if pending.stage < until:
-        w_mat = pending.matrix.astype(OPERATOR_PRECISION, copy=False)
         try:
+            if pending.method:
+                if not pending.scaled:
+                    pending = replace(pending, scaled=scaled_matrix(pending.matrix, method_precision(pending.method)))
+                w_mat = pending.scaled[0]
+            else:
+                w_mat = pending.matrix.astype(OPERATOR_PRECISION, copy=False)
             if pending.matrix.shape[0] <= LEAF:
                 pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(w_mat),))
             else:
                 parts = pending.parts
-                for stage in STAGES[pending.stage:until]:
+                for stage in (FACTOR_STAGES if pending.method else STAGES)[pending.stage:until]:
                     parts = stage(w_mat, *parts)
                 pending = replace(pending, stage=until, parts=parts)
         except np.linalg.LinAlgError:        # singular in single precision: inverted again at once
             pending = replace(pending, stage=len(STAGES), parts=(None,))
         if pending.stage == len(STAGES):
-            pending = replace(pending, parts=(checked_inverse(pending.matrix, pending.parts[0]),))
+            inverse = pending.parts[0]
+            if inverse is not None and pending.method:
+                inverse = _unscaled(inverse, pending.scaled[1])
+            if (again and inverse is not None and method_precision(pending.method) != np.float64
+                    and not passes_check(pending.matrix, inverse)):
+                return replace(pending, stage=0, parts=(), method=pending.method + 1, scaled=())
+            pending = replace(pending, parts=(checked_inverse(pending.matrix, inverse, pending.method),), scaled=())
     if pending.stage < len(STAGES) or jacobian is None:
         return pending
     return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
@@ -375,12 +531,13 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
 INVERSE_CHECK = 0.1
 
 
-def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None") -> np.ndarray:
-    """The inverse of ``W`` (``w_mat``, double) in double precision: ``inverse`` (by :func:`spd_inverse`, in
-    :data:`OPERATOR_PRECISION`; None where ``W`` was singular there) where ``W inverse v`` is within
-    :data:`INVERSE_CHECK` of ``v`` for the probe ``v = (1, 1.125, ..., 1.75, 1, ...)``, else inverted
-    again, each time checked so: through its Cholesky factor (:func:`cholesky_inverse`), first in single
-    precision, then in double, and last by LAPACK's ``inv`` in double.
+def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None", method: int = 0) -> np.ndarray:
+    """The inverse of ``W`` (``w_mat``, double) in double precision: ``inverse`` (computed by
+    ``method``, :class:`PendingOperator`'s: by :func:`spd_inverse` in :data:`OPERATOR_PRECISION`, or
+    through the Cholesky factor; None where ``W`` was singular there) where it passes the check
+    (:func:`passes_check`), else inverted again, each time checked so: through its Cholesky factor
+    (:func:`cholesky_inverse`), in single precision and then in double (the methods after
+    ``method``), and last by LAPACK's ``inv`` in double.
 
     In single precision an inverse is within about ``1e-7 cond(W)`` of ``W``'s, and the operators
     under load are conditioned 4e3-1e8 here. By halves (:func:`spd_inverse`) the errors compound from
@@ -395,16 +552,22 @@ def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None") -> np.ndarr
     refuses in double too."""
     if inverse is not None:
         inverse = inverse.astype(w_mat.dtype, copy=False)
-        if _probe_residual(w_mat, inverse) <= INVERSE_CHECK:
+        if passes_check(w_mat, inverse):
             return inverse
-    for precision in dict.fromkeys((OPERATOR_PRECISION, np.float64)):
+    for precision in dict.fromkeys(method_precision(m) for m in range(method + 1, 3)):
         try:
             inverse = cholesky_inverse(w_mat, precision)
         except np.linalg.LinAlgError:       # not positive definite in this precision
             continue
-        if _probe_residual(w_mat, inverse) <= INVERSE_CHECK:
+        if passes_check(w_mat, inverse):
             return inverse
     return _lapack_inverse(w_mat)
+
+
+def passes_check(w_mat: np.ndarray, inverse: np.ndarray) -> bool:
+    """Whether ``W inverse v`` is within :data:`INVERSE_CHECK` of ``v`` for the probe
+    ``v = (1, 1.125, ..., 1.75, 1, ...)`` (relative to its largest entry)."""
+    return _probe_residual(w_mat, inverse) <= INVERSE_CHECK
 
 
 def _probe_residual(w_mat: np.ndarray, inverse: np.ndarray) -> float:
@@ -417,51 +580,6 @@ def _lapack_inverse(w_mat: np.ndarray) -> np.ndarray:
     """LAPACK's inverse, made exactly symmetric."""
     inverse = np.linalg.inv(w_mat)
     return 0.5 * (inverse + inverse.T)
-
-
-def cholesky_inverse(w_mat: np.ndarray, precision=np.float64) -> np.ndarray:
-    """The inverse (double) of a symmetric positive definite ``W`` (double) through its Cholesky
-    factor, computed in ``precision``: ``W`` scaled to a unit diagonal, ``S W S`` with
-    ``S = diag(W)^-1/2`` (Jacobi's scaling: a contact that just closed is soft, and the diagonal
-    spans up to 1e6), ``X = L^-1`` of its factor ``L`` (:func:`factor_inverse`), and
-    ``W^-1 = S X^T X S``. As accurate as LAPACK's Cholesky inverse (``potri``): about
-    ``1e-7 cond(W)`` in single precision, where the inverse by halves (:func:`spd_inverse`, faster:
-    ``4/3 n^3`` flops against about ``2 n^3`` here) can be 100 times farther off.
-
-    Raises
-    ------
-    numpy.linalg.LinAlgError
-        ``W`` is not positive definite in ``precision``."""
-    diagonal = np.diagonal(w_mat)
-    if not np.all(diagonal > 0.0):
-        raise np.linalg.LinAlgError("W's diagonal is not positive")
-    scale = 1.0 / np.sqrt(diagonal)
-    scale = np.outer(scale, scale)                   # S_ii S_jj, exactly symmetric
-    factor = factor_inverse((w_mat * scale).astype(precision, copy=False))
-    inverse = (factor.T @ factor).astype(np.float64, copy=False)  # X^T X: BLAS's symmetric product, exactly so
-    inverse *= scale
-    return inverse
-
-
-def factor_inverse(w: np.ndarray) -> np.ndarray:
-    """``X = L^-1`` (lower triangular) of the Cholesky factor ``L`` of ``w`` (symmetric positive
-    definite), by halves: with ``w = [[A, B^T], [B, D]]``, ``X11`` that of ``A``, ``L21 = B X11^T``,
-    ``X22`` that of the Schur complement ``S = D - L21 L21^T`` and ``X21 = -X22 L21 X11``; LAPACK's
-    factor and inverse at :data:`LEAF` rows or fewer. ``S`` is formed from ``L21``, whose error grows
-    with the square root of ``A``'s condition (not from ``A^-1``, as :func:`spd_inverse` does)."""
-    n = w.shape[0]
-    if n <= LEAF:
-        return np.tril(np.linalg.inv(np.linalg.cholesky(w)))
-    h = n // 2
-    x11 = factor_inverse(w[:h, :h])
-    l21 = w[h:, :h] @ x11.T
-    schur = w[h:, h:] - l21 @ l21.T
-    x22 = factor_inverse(0.5 * (schur + schur.T))
-    out = np.zeros_like(w)
-    out[:h, :h] = x11
-    out[h:, h:] = x22
-    out[h:, :h] = -(x22 @ (l21 @ x11))
-    return out
 
 
 def step_end(pending: PendingOperator) -> int:
