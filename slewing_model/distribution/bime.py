@@ -90,9 +90,10 @@ SPREAD_ITERATIONS = 8
 #: :func:`~slewing_model.rings.reduced_operator.forming_work`;
 #: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
 #: step's answer does not depend on the machine. 1e8, an inverse of about 360 rows (2 ms on one core
-#: here, ``benchmarks/bench_operator.py --stages``), chosen by the pitch bearing's scenarios of
-#: ``benchmarks/bench_realtime.py``: 8e7 and 1.2e8 gave a reversal's slowest step 5.5 and 7.1 ms,
-#: NREL 156 and 24 steps of 6000 flagged (docs/speed.md) ...
+#: here, ``benchmarks/bench_operator.py --stages``; about 2.4 ms within a step, its matrices out of
+#: cache), chosen by the pitch bearing's scenarios of ``benchmarks/bench_realtime.py``: 6.5e7 and 1e8
+#: gave a reversal's slowest step 5.4 and 6.5 ms in the library, 141 and 83 steps of 2000 flagged,
+#: NREL 174 and 29 of 6000 (docs/speed.md, "Issue 31, seventh turn") ...
 BOUNDED_WORK = 1e8
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
