@@ -400,11 +400,11 @@ def _factor_joined(w, columns, x22):
 #: is made again, spread over steps where the solve allows (:func:`advance_operator`)
 FACTOR_STAGES = (_half_factor, _coupling_factor, _factor_schur, _schur_factor, _lower_columns, _factor_joined)
 #: :data:`STAGE_WEIGHT` of :data:`FACTOR_STAGES` (in :data:`OPERATOR_PRECISION`; measured so,
-#: ``benchmarks/bench_operator.py --stages --factor``): the inverse factors of the halves recurse down to
+#: ``benchmarks/bench_operator.py --stages --method 1``): the inverse factors of the halves recurse down to
 #: LAPACK's leaves (the first stage also scales ``W``), and the symmetric products run at about half a
 #: general product's rate a counted flop
 FACTOR_WEIGHT = (6.8, 0.43, 1.0, 3.6, 0.43, 1.1)
-#: ... and in double precision (a pending operator of method 2)
+#: ... and in double precision (a pending operator of method 2; ``--method 2``)
 FACTOR_WEIGHT_DOUBLE = (8.1, 0.97, 2.0, 5.0, 1.13, 2.2)
 assert len(FACTOR_STAGES) == len(STAGES)                 # a pending operator is done after len(STAGES) of either
 
