@@ -192,10 +192,16 @@ def spd_inverse(w: np.ndarray) -> np.ndarray:
 
     The top level is six stages (:data:`STAGES`), which :class:`PendingOperator` spreads over
     steps."""
+    return _at_once(w, STAGES)
+
+
+def _at_once(w: np.ndarray, stages: tuple) -> np.ndarray:
+    """The inverse of ``w`` by ``stages`` (:data:`STAGES`, :data:`FACTOR_STAGES`) at once; LAPACK's at
+    :data:`LEAF` rows or fewer."""
     if w.shape[0] <= LEAF:
         return _lapack_inverse(w)
     parts = ()
-    for stage in STAGES:
+    for stage in stages:
         parts = stage(w, *parts)
     return parts[0]
 
@@ -300,12 +306,7 @@ def cholesky_inverse(w_mat: np.ndarray, precision=np.float64) -> np.ndarray:
     numpy.linalg.LinAlgError
         ``W`` is not positive definite in ``precision``."""
     scaled, scale = scaled_matrix(w_mat, precision)
-    if scaled.shape[0] <= LEAF:
-        return _unscaled(_lapack_inverse(scaled), scale)
-    parts = ()
-    for stage in FACTOR_STAGES:
-        parts = stage(scaled, *parts)
-    return _unscaled(parts[0], scale)
+    return _unscaled(_at_once(scaled, FACTOR_STAGES), scale)
 
 
 def scaled_matrix(w_mat: np.ndarray, precision) -> tuple[np.ndarray, np.ndarray]:
@@ -510,12 +511,16 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             pending = replace(pending, stage=len(STAGES), parts=(None,))
         if pending.stage == len(STAGES):
             inverse = pending.parts[0]
-            if inverse is not None and pending.method:
-                inverse = _unscaled(inverse, pending.scaled[1])
-            if (again and inverse is not None and method_precision(pending.method) != np.float64
-                    and not passes_check(pending.matrix, inverse)):
-                return replace(pending, stage=0, parts=(), method=pending.method + 1, scaled=())
-            pending = replace(pending, parts=(checked_inverse(pending.matrix, inverse, pending.method),), scaled=())
+            if inverse is not None:          # in double (W^-1 = S (S W S)^-1 S for the factor's), checked
+                inverse = (_unscaled(inverse, pending.scaled[1]) if pending.method
+                           else inverse.astype(np.float64, copy=False))
+                if not passes_check(pending.matrix, inverse):
+                    if again and method_precision(pending.method) != np.float64:
+                        return replace(pending, stage=0, parts=(), method=pending.method + 1, scaled=())
+                    inverse = None
+            if inverse is None:
+                inverse = checked_inverse(pending.matrix, pending.method)
+            pending = replace(pending, parts=(inverse,), scaled=())
     if pending.stage < len(STAGES) or jacobian is None:
         return pending
     return reduced_operator(pending.rows, pending.active, pending.contact_compliance, pending.parts[0], jacobian, mu,
@@ -531,13 +536,12 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
 INVERSE_CHECK = 0.1
 
 
-def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None", method: int = 0) -> np.ndarray:
-    """The inverse of ``W`` (``w_mat``, double) in double precision: ``inverse`` (computed by
-    ``method``, :class:`PendingOperator`'s: by :func:`spd_inverse` in :data:`OPERATOR_PRECISION`, or
-    through the Cholesky factor; None where ``W`` was singular there) where it passes the check
-    (:func:`passes_check`), else inverted again, each time checked so: through its Cholesky factor
-    (:func:`cholesky_inverse`), in single precision and then in double (the methods after
-    ``method``), and last by LAPACK's ``inv`` in double.
+def checked_inverse(w_mat: np.ndarray, method: int = 0) -> np.ndarray:
+    """The inverse of ``W`` (``w_mat``, double) in double precision, made again where the one
+    :class:`PendingOperator`'s ``method`` made (by :func:`spd_inverse` in :data:`OPERATOR_PRECISION`, or
+    through the Cholesky factor) missed the check (:func:`passes_check`) or ``W`` was singular in its
+    precision: through the Cholesky factor (:func:`cholesky_inverse`) in single precision and then in
+    double (the methods after ``method``), each checked, and last by LAPACK's ``inv`` in double.
 
     In single precision an inverse is within about ``1e-7 cond(W)`` of ``W``'s, and the operators
     under load are conditioned 4e3-1e8 here. By halves (:func:`spd_inverse`) the errors compound from
@@ -550,10 +554,6 @@ def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None", method: int
     seventh turn"). ``W`` of the preload alone (the yaw bearing at zero loads: condition 4e13) is
     singular in single precision; LAPACK's ``inv`` is the last resort for a ``W`` the Cholesky factor
     refuses in double too."""
-    if inverse is not None:
-        inverse = inverse.astype(w_mat.dtype, copy=False)
-        if passes_check(w_mat, inverse):
-            return inverse
     for precision in dict.fromkeys(method_precision(m) for m in range(method + 1, 3)):
         try:
             inverse = cholesky_inverse(w_mat, precision)
@@ -567,13 +567,8 @@ def checked_inverse(w_mat: np.ndarray, inverse: "np.ndarray | None", method: int
 def passes_check(w_mat: np.ndarray, inverse: np.ndarray) -> bool:
     """Whether ``W inverse v`` is within :data:`INVERSE_CHECK` of ``v`` for the probe
     ``v = (1, 1.125, ..., 1.75, 1, ...)`` (relative to its largest entry)."""
-    return _probe_residual(w_mat, inverse) <= INVERSE_CHECK
-
-
-def _probe_residual(w_mat: np.ndarray, inverse: np.ndarray) -> float:
-    """``|W X v - v|`` relative to ``v``'s largest entry, for :func:`checked_inverse`'s probe ``v``."""
     probe = 1.0 + 0.125 * (np.arange(w_mat.shape[0]) % 7)
-    return float(np.abs(w_mat @ (inverse @ probe) - probe).max()) / float(probe.max())
+    return float(np.abs(w_mat @ (inverse @ probe) - probe).max()) <= INVERSE_CHECK * float(probe.max())
 
 
 def _lapack_inverse(w_mat: np.ndarray) -> np.ndarray:
