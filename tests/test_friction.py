@@ -18,6 +18,9 @@ from slewing_model.friction import (
     ellipse_quadrature, friction_torque, omega_regularisation_for_step, preload_sweep, regularised_torque,
     stick_slip_torque, torque_ripple,
 )
+from slewing_model.friction import ball_kinematics
+from slewing_model.friction.ball_kinematics import SOLVED, ContactSet
+from slewing_model.numerics.compiled import AVAILABLE
 
 SIGN_R = np.array([1.0, -1.0, -1.0, 1.0])   # contact normals of contacts 1..4 (geometry.Bearing.contact_normals)
 SIGN_Z = np.array([1.0, 1.0, -1.0, -1.0])
@@ -370,6 +373,44 @@ def test_warm_start_gives_the_same_torque_in_fewer_iterations(combined):
     again = friction_torque(bearing, nearby)
     assert warm.magnitude == pytest.approx(again.magnitude, rel=1e-5)
     assert warm.iterations < again.iterations
+
+
+def _stale_balls(bearing, dist, warm):
+    """``ContactSet.stale_warm_start`` of a warm state (B, 4), as ``friction_torque`` asks it."""
+    geometry = ContactSet(bearing, dist, 0.1, 1.0, 1e-3)
+    scale = np.array([geometry.length_scale, geometry.length_scale, geometry.pitch_radius])
+    return geometry.active[geometry.stale_warm_start(warm[geometry.active][:, SOLVED] * scale)]
+
+
+def test_a_warm_start_on_the_other_diagonal_starts_cold(table3, preloaded, monkeypatch):
+    """A tilting moment reversed in one step: a ball's warm motion rolls on the diagonal it left.
+    Such balls (and those that left a preload's four-point contact) start cold, in both kernels
+    alike, and reach the torque of a cold start; a ball at its own equilibrium (a motion tilted as
+    rolling on its heavier diagonal) is never one of them. Kept, the stale motions' power inflates
+    the minimisation's floor (the mean power at the start), which loosens every ball's stop."""
+    before = solve(table3, Loads(Fz=100e3, Mx=150e3))
+    after = solve(table3, Loads(Fz=100e3, Mx=-150e3))
+    q_before, q_after = before.contact_load, after.contact_load
+    one_diagonal = (q_after[:, 0] > 0) != (q_after[:, 1] > 0)
+    flipped = np.flatnonzero(((q_before[:, 0] >= q_before[:, 1]) != (q_after[:, 0] >= q_after[:, 1])) & one_diagonal)
+    assert flipped.size > 10
+    warm = friction_torque(table3, before)
+    for bearing, dist, own in ((table3, before, warm), (table3, after, friction_torque(table3, after)),
+                               (*preloaded, friction_torque(*preloaded))):
+        assert _stale_balls(bearing, dist, own.state).size == 0
+    assert set(flipped) <= set(_stale_balls(table3, after, warm.state))
+    assert set(np.flatnonzero(one_diagonal)) <= set(_stale_balls(table3, after, friction_torque(*preloaded).state))
+    cold = friction_torque(table3, after)
+    restarted = {k: friction_torque(table3, after, initial=warm, kernel=k)
+                 for k in (("numpy", "compiled") if AVAILABLE else ("numpy",))}
+    for result in restarted.values():
+        assert result.magnitude == pytest.approx(cold.magnitude, rel=1e-5)
+        assert result.iterations == restarted["numpy"].iterations
+        assert result.magnitude == pytest.approx(restarted["numpy"].magnitude, rel=1e-10)
+    monkeypatch.setattr(ball_kinematics, "WARM_ROLLING", -np.inf)     # every warm motion kept (numpy path)
+    kept = friction_torque(table3, after, initial=warm, kernel="numpy")
+    assert kept.magnitude == pytest.approx(cold.magnitude, rel=1e-5)
+    assert restarted["numpy"].residual < 0.25 * kept.residual
 
 
 @pytest.mark.parametrize("tol", [1e-3, 1e-4])

@@ -27,8 +27,9 @@ from ..distribution.assembly import ball_diameters
 from .contact import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .kernel import (
-    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, compiled_ball_results, compiled_contact_set, compiled_evaluate_points,
-    compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients, compiled_tractions,
+    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, WARM_ROLLING, compiled_ball_results, compiled_contact_set,
+    compiled_evaluate_points, compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients,
+    compiled_tractions,
 )
 from ..bearing.geometry import RING_CONTACTS, Bearing
 
@@ -208,12 +209,28 @@ class ContactSet:
         out[self.owner, np.arange(self.ball_index.size)] = 1.0
         return out
 
+    def diagonal_rolling(self) -> np.ndarray:
+        """The rolling motions (2, B_active, 3), scaled unknowns, about the axis normal to
+        diagonal 1 (contacts 1, 3) and to diagonal 2 (4, 2), rolling without sliding at the
+        diagonal's two contact centres (the classical two-contact kinematics)."""
+        alpha = self.contact_angle[self.active]
+        rb = self.ball_radius[self.active]
+        big_r, ls = self.pitch_radius, self.length_scale
+        w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
+        diagonals = []
+        for outer, sign in ((0, 1.0), (3, -1.0)):          # diagonal 1 (contacts 1, 3), diagonal 2 (4, 2)
+            n_r, n_z = np.cos(alpha[:, outer]), sign * np.sin(alpha[:, outer])
+            # v . t = 0 at the outer contact (normal n) and at the inner one (-n), w = w_g g, g = (-n_z, 0, n_r)
+            w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
+            w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
+            diagonals.append(np.stack([-w_g * n_z * ls, w_g * n_r * ls, w_c * big_r], axis=-1))
+        return np.stack(diagonals)
+
     def initial_guesses(self) -> np.ndarray:
         """Candidate scaled unknowns (2, B_active, 3) for a cold start, each a
         rolling motion without sliding at contact centres:
 
-        0. about an axis normal to the more loaded diagonal, rolling at its two
-           contact centres (the classical two-contact kinematics);
+        0. about an axis normal to the more loaded diagonal (:meth:`diagonal_rolling`);
         1. about the axial direction (``w_r = 0``), rolling at the centres of
            the outer and of the inner contacts (the motion of a symmetric
            four-contact ball; measured, it stays near the equilibrium until one
@@ -227,13 +244,7 @@ class ContactSet:
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
         w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
-        diagonals = []
-        for outer, sign in ((0, 1.0), (3, -1.0)):          # diagonal 1 (contacts 1, 3), diagonal 2 (4, 2)
-            n_r, n_z = np.cos(alpha[:, outer]), sign * np.sin(alpha[:, outer])
-            # v . t = 0 at the outer contact (normal n) and at the inner one (-n), w = w_g g, g = (-n_z, 0, n_r)
-            w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
-            w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
-            diagonals.append(np.stack([-w_g * n_z * ls, w_g * n_r * ls, w_c * big_r], axis=-1))
+        diagonals = self.diagonal_rolling()
         q1, q2 = q[:, 0], q[:, 1]
         heavier = np.where((q1 >= q2)[:, None], diagonals[0], diagonals[1])
         # v . t = -r_r w_z - R w_c + W (R + r_r) = 0 at the outer (r_r > 0) and inner (r_r < 0) centres
@@ -244,6 +255,22 @@ class ContactSet:
         axial = np.stack([np.zeros_like(w_z), w_z * ls, w_c * big_r], axis=-1)
         four = ((q1 > 0.0) & (q2 > 0.0))[:, None]
         return np.stack([heavier, np.where(four, axial, heavier)])
+
+    def stale_warm_start(self, u: np.ndarray) -> np.ndarray:
+        """The balls (B_active,) whose motion ``u`` (a warm start, scaled unknowns) belongs to
+        another contact set: its spin axis tilts towards the normal of the heavier diagonal less
+        than :data:`~slewing_model.friction.kernel.WARM_ROLLING` of the way rolling on it does
+        (:meth:`diagonal_rolling`'s radial component), for a ball loaded on one diagonal, or away
+        from it by more than that share, for a ball in four-point contact (whose equilibria lie
+        between the axial rolling, 0, and the diagonal's, 1). A ball whose heavier diagonal flipped
+        (a moment reversed) or that left four-point contact (the first load after a preload)
+        then starts cold: after a reversal of the pitch bearing's mean load its minimisation takes
+        6 iterations instead of 9-10."""
+        q = self.contact_load[self.active]
+        diagonals = self.diagonal_rolling()
+        tilt = np.where(q[:, 0] >= q[:, 1], diagonals[0, :, 0], diagonals[1, :, 0])
+        least = np.where((q[:, 0] > 0.0) & (q[:, 1] > 0.0), -WARM_ROLLING, WARM_ROLLING)
+        return ~(u[:, 0] * tilt >= least * tilt * tilt)
 
 
 @dataclass(frozen=True)

@@ -355,6 +355,22 @@ def _rule_weight(folded_weight, mu_load):
 
 #: step lengths along the first Newton direction of a cold start (``ball_kinematics.cold_start``)
 COLD_STEPS = (0.25, 0.5)
+#: a ball's warm start is kept where its spin axis tilts towards the normal of its heavier diagonal
+#: at least this share of the way rolling on that diagonal does, for a ball loaded on one
+#: diagonal, and away from it less than this share for a ball in four-point contact
+#: (``ContactSet.stale_warm_start``). The shares at the equilibria of the pitch bearing's NREL series:
+#: 1.009-1.014 on one diagonal, 0-1.014 in four-point contact; -1 after a moment reversal, 0 (the
+#: axial rolling) after four-point contact
+WARM_ROLLING = 0.5
+
+
+def _diagonal_rolling(rb, alpha, sign, w_o, w_i, big_r, ls, out):
+    """``ContactSet.diagonal_rolling`` of one ball and diagonal (its outer contact's angle
+    ``alpha``, ``sign`` 1 for diagonal 1, -1 for diagonal 2), into ``out`` (3,)."""
+    n_r, n_z = math.cos(alpha), sign * math.sin(alpha)
+    w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
+    w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
+    out[0], out[1], out[2] = -w_g * n_z * ls, w_g * n_r * ls, w_c * big_r
 
 
 def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, speed, length_scale, pitch_radius,
@@ -376,10 +392,7 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
         rb = ball_radius[ball]
         q1, q2 = load[ball, 0], load[ball, 1]
         outer, sign = (0, 1.0) if q1 >= q2 else (3, -1.0)       # the heavier diagonal: 1 (contacts 1, 3), 2 (4, 2)
-        n_r, n_z = math.cos(angle[ball, outer]), sign * math.sin(angle[ball, outer])
-        w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
-        w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
-        best[0], best[1], best[2] = -w_g * n_z * ls, w_g * n_r * ls, w_c * big_r
+        _diagonal_rolling(rb, angle[ball, outer], sign, w_o, w_i, big_r, ls, best)
         if q1 > 0.0 and q2 > 0.0:                               # four contacts: the axial rolling too
             r_o = rb * 0.5 * (math.cos(angle[ball, 0]) + math.cos(angle[ball, 3]))
             r_i = -rb * 0.5 * (math.cos(angle[ball, 1]) + math.cos(angle[ball, 2]))
@@ -417,8 +430,9 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     the iterations (as ``minimise_power`` counts them), the largest force residual, whether every
     ball converged, the contacts' powers and torques (C,), and :func:`_ball_results`'s.
 
-    A ball without a warm start (newly loaded, or at rest) starts as ``friction_torque``'s general
-    path starts it (:func:`_cold_start`), so that a step whose contacts changed stays one call."""
+    A ball without a warm start (newly loaded, or at rest), or with a stale one (its loaded diagonal
+    flipped: ``ContactSet.stale_warm_start``), starts as ``friction_torque``'s general path starts it
+    (:func:`_cold_start`), so that a step whose contacts changed stays one call."""
     n_balls = load.shape[0]
     (status, _, ball_index, contact_index, owner, active, inactive, rows, moving_c, force_scale) = _contact_set(
         load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
@@ -441,6 +455,18 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
             finite = finite and math.isfinite(value)
             moves = moves or value != 0.0
         cold[row] = not (finite and moves)
+    w_o, w_i = (0.0, speed) if moving[1] else (speed, 0.0)         # moving[1]: contact 2's, the inner ring
+    rolling = np.empty(3)
+    for row in range(active.size):                  # a stale warm start (ContactSet.stale_warm_start): cold
+        ball = active[row]
+        q1, q2 = load[ball, 0], load[ball, 1]
+        if cold[row]:
+            continue
+        outer, sign = (0, 1.0) if q1 >= q2 else (3, -1.0)
+        _diagonal_rolling(ball_radius[ball], angle[ball, outer], sign, w_o, w_i, pitch_radius, length_scale,
+                          rolling)
+        least = -WARM_ROLLING if q1 > 0.0 and q2 > 0.0 else WARM_ROLLING
+        cold[row] = not u[row, 0] * rolling[0] >= least * rolling[0] * rolling[0]
     a, b, rb, rd, n_r, n_z, ring_speed = rows[4], rows[5], rows[0], rows[1], rows[2], rows[3], rows[6]
     mu_load, eps2 = rows[7], rows[8]
     g10, g12, h1, s0, s1, hs, arm1, arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
@@ -480,7 +506,7 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
 #: the helpers the friction's loops call
 _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
             "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results",
-            "_cold_start")
+            "_cold_start", "_diagonal_rolling")
 
 
 #: numba's error model of these loops (Python's: a division by zero raises)

@@ -341,6 +341,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
                     raise ValueError(f"initial: state of shape {warm.shape}, expected ({n_balls}, 4) for this bearing")
                 u = warm[active][:, SOLVED] * speed * scale_u
                 cold = ~(np.all(np.isfinite(u), axis=1) & np.any(u != 0.0, axis=1))
+                cold |= geometry.stale_warm_start(u)
             if np.any(cold):
                 u = cold_start(geometry, solver, u, cold)
             u, iterations, residual, converged = minimise_power(solver, u, tol, max_iterations)
