@@ -1,0 +1,83 @@
+"""What a bounded step that was flagged answers, against the complete step at the same time (issue 31).
+
+A bounded step (``step_work`` = "bounded") that cannot reach the equilibrium within its work answers
+with its last iterate, flagged by ``distribution.converged`` False (the FMU: ``equilibrium_residual``
+above ``tolerance``). This runs the pitch bearing's five real-time scenarios (``bench_realtime.py``)
+through the library's simulator twice, bounded and complete, step by step side by side (flexible
+rings, friction and life on), and compares the flagged steps' friction torque and largest ball load
+with the complete steps': as answered (the iterate) and, for comparison, as the last equilibrium of
+the bounded run would give them (held). Accuracy, not time: the figures do not depend on the machine.
+
+Run: .venv/bin/python benchmarks/bench_flagged.py [--scenarios reversal nrel ...]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_realtime import SCENARIOS, scenario  # noqa: E402
+from timing import print_table  # noqa: E402
+
+
+def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
+    """Per flagged step: (residual, friction torque error of the iterate, of the held equilibrium,
+    largest ball load error of the iterate, of the held equilibrium), relative to the complete step;
+    and both runs' life damage at the end."""
+    from slewing_model import Loads, load_bearing
+    from slewing_model.rings.superelement import build_superelement
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    case = scenario(name)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="fine", progress=False)
+    sims = {work: BearingSimulator(bearing, superelement, SimulatorSettings(
+        ring_model="flexible", load_frame="rotating", life=True, step_work=work)) for work in ("complete", "bounded")}
+    held, rows = None, []
+    for k in range(case.steps):
+        out = {work: sim.step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
+               for work, sim in sims.items()}
+        bounded, complete = out["bounded"], out["complete"]
+        if bounded.distribution.converged:
+            held = bounded
+            continue
+        torque = complete.friction_torque_magnitude
+        peak = complete.distribution.contact_load.max()
+        rows.append((bounded.distribution.residual, bounded.friction_torque_magnitude / torque - 1.0,
+                     np.nan if held is None else held.friction_torque_magnitude / torque - 1.0,
+                     bounded.distribution.contact_load.max() / peak - 1.0,
+                     np.nan if held is None else held.distribution.contact_load.max() / peak - 1.0))
+    damage = {work: sim.life.worst_damage for work, sim in sims.items()}
+    return np.array(rows).reshape(-1, 5), damage
+
+
+def _spread(errors: np.ndarray) -> str:
+    errors = np.abs(errors[np.isfinite(errors)])
+    if not errors.size:
+        return "–"
+    return f"{np.median(errors):.3g} / {np.percentile(errors, 90):.3g} / {errors.max():.3g}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
+    args = parser.parse_args()
+    rows = []
+    for name in args.scenarios:
+        errors, damage = flagged_errors(name)
+        residual = f"{np.median(errors[:, 0]):.1e} / {errors[:, 0].max():.1e}" if errors.size else "–"
+        rows.append([name, str(len(errors)), residual, _spread(errors[:, 1]), _spread(errors[:, 2]),
+                     _spread(errors[:, 3]), _spread(errors[:, 4]),
+                     f"{damage['bounded'] / damage['complete']:.4f}" if damage["complete"] > 0 else "–"])
+    print_table("Flagged bounded steps against the complete steps (pitch bearing, library); errors relative, "
+                "median / 90th percentile / largest",
+                ["scenario", "flagged steps", "residual (median / largest)", "friction torque: iterate",
+                 "friction torque: last equilibrium", "largest ball load: iterate", "largest ball load: last equilibrium",
+                 "life damage, bounded / complete"], rows)
+
+
+if __name__ == "__main__":
+    main()
