@@ -48,6 +48,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_friction.py
 	$(PY) benchmarks/bench_fmu.py
 	$(PY) benchmarks/bench_batch.py
+	$(PY) benchmarks/bench_realtime.py
+	$(PY) benchmarks/bench_flagged.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info results
