@@ -209,10 +209,12 @@ class ContactSet:
         out[self.owner, np.arange(self.ball_index.size)] = 1.0
         return out
 
+    @functools.cached_property
     def diagonal_rolling(self) -> np.ndarray:
         """The rolling motions (2, B_active, 3), scaled unknowns, about the axis normal to
         diagonal 1 (contacts 1, 3) and to diagonal 2 (4, 2), rolling without sliding at the
-        diagonal's two contact centres (the classical two-contact kinematics)."""
+        diagonal's two contact centres (the classical two-contact kinematics); made when first
+        asked for (by :meth:`stale_warm_start` and :meth:`initial_guesses` of one step)."""
         alpha = self.contact_angle[self.active]
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
@@ -230,7 +232,7 @@ class ContactSet:
         """Candidate scaled unknowns (2, B_active, 3) for a cold start, each a
         rolling motion without sliding at contact centres:
 
-        0. about an axis normal to the more loaded diagonal (:meth:`diagonal_rolling`);
+        0. about an axis normal to the more loaded diagonal (:attr:`diagonal_rolling`);
         1. about the axial direction (``w_r = 0``), rolling at the centres of
            the outer and of the inner contacts (the motion of a symmetric
            four-contact ball; measured, it stays near the equilibrium until one
@@ -244,7 +246,7 @@ class ContactSet:
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
         w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
-        diagonals = self.diagonal_rolling()
+        diagonals = self.diagonal_rolling
         q1, q2 = q[:, 0], q[:, 1]
         heavier = np.where((q1 >= q2)[:, None], diagonals[0], diagonals[1])
         # v . t = -r_r w_z - R w_c + W (R + r_r) = 0 at the outer (r_r > 0) and inner (r_r < 0) centres
@@ -260,7 +262,7 @@ class ContactSet:
         """The balls (B_active,) whose motion ``u`` (a warm start, scaled unknowns) belongs to
         another contact set: its spin axis tilts towards the normal of the heavier diagonal less
         than :data:`~slewing_model.friction.kernel.WARM_ROLLING` of the way rolling on it does
-        (:meth:`diagonal_rolling`'s radial component), for a ball loaded on one diagonal, or away
+        (:attr:`diagonal_rolling`'s radial component), for a ball loaded on one diagonal, or away
         from it by more than that share, for a ball in four-point contact (whose equilibria lie
         between the axial rolling, 0, and the diagonal's, 1). A ball whose heavier diagonal flipped
         (a moment reversed) or that left four-point contact (the first load after a preload)
@@ -268,7 +270,7 @@ class ContactSet:
         mean load 0.70 ms instead of 1.04; rigid reversals of table1 and table3 0.6 and 0.3 ms
         instead of 0.9 and 0.4)."""
         q = self.contact_load[self.active]
-        diagonals = self.diagonal_rolling()
+        diagonals = self.diagonal_rolling
         tilt = np.where(q[:, 0] >= q[:, 1], diagonals[0, :, 0], diagonals[1, :, 0])
         least = np.where((q[:, 0] > 0.0) & (q[:, 1] > 0.0), -WARM_ROLLING, WARM_ROLLING)
         return ~(u[:, 0] * tilt >= least * tilt * tilt)

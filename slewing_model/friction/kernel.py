@@ -447,6 +447,8 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     scale = (length_scale, length_scale, pitch_radius)
     u = np.empty((active.size, 3))
     cold = np.zeros(active.size, np.bool_)
+    w_o, w_i = (0.0, speed) if moving[1] else (speed, 0.0)         # moving[1]: contact 2's, the inner ring
+    rolling = np.empty(3)
     for row in range(active.size):                  # the warm start (friction_torque's), or a cold one
         finite, moves = True, False
         for k, column in enumerate((0, 2, 3)):      # SOLVED
@@ -455,18 +457,14 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
             finite = finite and math.isfinite(value)
             moves = moves or value != 0.0
         cold[row] = not (finite and moves)
-    w_o, w_i = (0.0, speed) if moving[1] else (speed, 0.0)         # moving[1]: contact 2's, the inner ring
-    rolling = np.empty(3)
-    for row in range(active.size):                  # a stale warm start (ContactSet.stale_warm_start): cold
-        ball = active[row]
-        q1, q2 = load[ball, 0], load[ball, 1]
-        if cold[row]:
-            continue
-        outer, sign = (0, 1.0) if q1 >= q2 else (3, -1.0)
-        _diagonal_rolling(ball_radius[ball], angle[ball, outer], sign, w_o, w_i, pitch_radius, length_scale,
-                          rolling)
-        least = -WARM_ROLLING if q1 > 0.0 and q2 > 0.0 else WARM_ROLLING
-        cold[row] = not u[row, 0] * rolling[0] >= least * rolling[0] * rolling[0]
+        if not cold[row]:                           # a stale warm start (ContactSet.stale_warm_start): cold
+            ball = active[row]
+            q1, q2 = load[ball, 0], load[ball, 1]
+            outer, sign = (0, 1.0) if q1 >= q2 else (3, -1.0)
+            _diagonal_rolling(ball_radius[ball], angle[ball, outer], sign, w_o, w_i, pitch_radius, length_scale,
+                              rolling)
+            least = -WARM_ROLLING if q1 > 0.0 and q2 > 0.0 else WARM_ROLLING
+            cold[row] = not u[row, 0] * rolling[0] >= least * rolling[0] * rolling[0]
     a, b, rb, rd, n_r, n_z, ring_speed = rows[4], rows[5], rows[0], rows[1], rows[2], rows[3], rows[6]
     mu_load, eps2 = rows[7], rows[8]
     g10, g12, h1, s0, s1, hs, arm1, arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,

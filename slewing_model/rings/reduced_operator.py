@@ -200,10 +200,15 @@ def _at_once(w: np.ndarray, stages: tuple) -> np.ndarray:
     :data:`LEAF` rows or fewer."""
     if w.shape[0] <= LEAF:
         return _lapack_inverse(w)
-    parts = ()
+    return _run_stages(w, stages)[0]
+
+
+def _run_stages(w: np.ndarray, stages, parts: tuple = ()) -> tuple:
+    """``stages`` run on ``w`` one after the other from ``parts`` (the results of the stage before
+    the first): the last one's results."""
     for stage in stages:
         parts = stage(w, *parts)
-    return parts[0]
+    return parts
 
 
 def _a_inverse(w):
@@ -340,8 +345,7 @@ def factor_inverse(w: np.ndarray) -> np.ndarray:
     n = w.shape[0]
     if n <= LEAF:
         return np.tril(np.linalg.inv(np.linalg.cholesky(w)))
-    x11, l21, schur = _factor_schur(w, *_coupling_factor(w, *_half_factor(w)))
-    columns, x22 = _lower_columns(w, *_schur_factor(w, x11, l21, schur))
+    columns, x22 = _run_stages(w, FACTOR_STAGES[:-1])     # all but the join: X's blocks
     out = np.zeros_like(w)
     h = n // 2
     out[:, :h] = columns
@@ -503,10 +507,8 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             if pending.matrix.shape[0] <= LEAF:
                 pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(w_mat),))
             else:
-                parts = pending.parts
-                for stage in (FACTOR_STAGES if pending.method else STAGES)[pending.stage:until]:
-                    parts = stage(w_mat, *parts)
-                pending = replace(pending, stage=until, parts=parts)
+                stages = (FACTOR_STAGES if pending.method else STAGES)[pending.stage:until]
+                pending = replace(pending, stage=until, parts=_run_stages(w_mat, stages, pending.parts))
         except np.linalg.LinAlgError:        # singular in single precision: inverted again at once
             pending = replace(pending, stage=len(STAGES), parts=(None,))
         if pending.stage == len(STAGES):
