@@ -6,7 +6,9 @@ above ``tolerance``). This runs the pitch bearing's five real-time scenarios (``
 through the library's simulator twice, bounded and complete, step by step side by side (flexible
 rings, friction and life on), and compares the flagged steps' friction torque and largest ball load
 with the complete steps': as answered (the iterate) and, for comparison, as the last equilibrium of
-the bounded run would give them (held). Accuracy, not time: the figures do not depend on the machine.
+the bounded run would give them (held) and as a rigid-ring simulator stepped alongside gives them (the
+cheap approximate answer such a step could give instead). Accuracy, not time: the figures do not depend
+on the machine.
 
 Run: .venv/bin/python benchmarks/bench_flagged.py [--scenarios reversal nrel ...]
 """
@@ -25,8 +27,9 @@ from timing import print_table  # noqa: E402
 
 def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
     """Per flagged step: (residual, friction torque error of the iterate, of the held equilibrium,
-    largest ball load error of the iterate, of the held equilibrium), relative to the complete step;
-    and both runs' life damage at the end."""
+    largest ball load error of the iterate, of the held equilibrium, friction torque error of the rigid
+    rings, largest ball load error of the rigid rings), relative to the complete step; and the flexible
+    runs' life damage at the end."""
     from slewing_model import Loads, load_bearing
     from slewing_model.rings.superelement import build_superelement
     from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
@@ -36,10 +39,12 @@ def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
     superelement = build_superelement(bearing, mesh="fine", progress=False)
     sims = {work: BearingSimulator(bearing, superelement, SimulatorSettings(
         ring_model="flexible", load_frame="rotating", life=True, step_work=work)) for work in ("complete", "bounded")}
+    rigid = BearingSimulator(bearing, None, SimulatorSettings(ring_model="rigid", load_frame="rotating", life=False))
     held, rows = None, []
     for k in range(case.steps):
         out = {work: sim.step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
                for work, sim in sims.items()}
+        rigid_out = rigid.step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
         bounded, complete = out["bounded"], out["complete"]
         if bounded.distribution.converged:
             held = bounded
@@ -49,9 +54,11 @@ def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
         rows.append((bounded.distribution.residual, bounded.friction_torque_magnitude / torque - 1.0,
                      np.nan if held is None else held.friction_torque_magnitude / torque - 1.0,
                      bounded.distribution.contact_load.max() / peak - 1.0,
-                     np.nan if held is None else held.distribution.contact_load.max() / peak - 1.0))
+                     np.nan if held is None else held.distribution.contact_load.max() / peak - 1.0,
+                     rigid_out.friction_torque_magnitude / torque - 1.0,
+                     rigid_out.distribution.contact_load.max() / peak - 1.0))
     damage = {work: sim.life.worst_damage for work, sim in sims.items()}
-    return np.array(rows).reshape(-1, 5), damage
+    return np.array(rows).reshape(-1, 7), damage
 
 
 def _spread(errors: np.ndarray) -> str:
@@ -70,12 +77,13 @@ def main() -> None:
         errors, damage = flagged_errors(name)
         residual = f"{np.median(errors[:, 0]):.1e} / {errors[:, 0].max():.1e}" if errors.size else "–"
         rows.append([name, str(len(errors)), residual, _spread(errors[:, 1]), _spread(errors[:, 2]),
-                     _spread(errors[:, 3]), _spread(errors[:, 4]),
+                     _spread(errors[:, 3]), _spread(errors[:, 4]), _spread(errors[:, 5]), _spread(errors[:, 6]),
                      f"{damage['bounded'] / damage['complete']:.4f}" if damage["complete"] > 0 else "–"])
     print_table("Flagged bounded steps against the complete steps (pitch bearing, library); errors relative, "
                 "median / 90th percentile / largest",
                 ["scenario", "flagged steps", "residual (median / largest)", "friction torque: iterate",
                  "friction torque: last equilibrium", "largest ball load: iterate", "largest ball load: last equilibrium",
+                 "friction torque: rigid rings", "largest ball load: rigid rings",
                  "life damage, bounded / complete"], rows)
 
 
