@@ -39,25 +39,29 @@ def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
     superelement = build_superelement(bearing, mesh="fine", progress=False)
     sims = {work: BearingSimulator(bearing, superelement, SimulatorSettings(
         ring_model="flexible", load_frame="rotating", life=True, step_work=work)) for work in ("complete", "bounded")}
-    rigid = BearingSimulator(bearing, None, SimulatorSettings(ring_model="rigid", load_frame="rotating", life=False))
+    sims["rigid"] = BearingSimulator(bearing, None, SimulatorSettings(ring_model="rigid", load_frame="rotating",
+                                                                      life=False))
     held, rows = None, []
     for k in range(case.steps):
         out = {work: sim.step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
                for work, sim in sims.items()}
-        rigid_out = rigid.step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
         bounded, complete = out["bounded"], out["complete"]
         if bounded.distribution.converged:
             held = bounded
             continue
         torque = complete.friction_torque_magnitude
         peak = complete.distribution.contact_load.max()
-        rows.append((bounded.distribution.residual, bounded.friction_torque_magnitude / torque - 1.0,
-                     np.nan if held is None else held.friction_torque_magnitude / torque - 1.0,
-                     bounded.distribution.contact_load.max() / peak - 1.0,
-                     np.nan if held is None else held.distribution.contact_load.max() / peak - 1.0,
-                     rigid_out.friction_torque_magnitude / torque - 1.0,
-                     rigid_out.distribution.contact_load.max() / peak - 1.0))
-    damage = {work: sim.life.worst_damage for work, sim in sims.items()}
+
+        def errors(answer):          # of the friction torque and of the largest ball load
+            if answer is None:
+                return np.nan, np.nan
+            return answer.friction_torque_magnitude / torque - 1.0, answer.distribution.contact_load.max() / peak - 1.0
+
+        (torque_iterate, peak_iterate), (torque_held, peak_held), (torque_rigid, peak_rigid) = map(
+            errors, (bounded, held, out["rigid"]))
+        rows.append((bounded.distribution.residual, torque_iterate, torque_held, peak_iterate, peak_held,
+                     torque_rigid, peak_rigid))
+    damage = {work: sims[work].life.worst_damage for work in ("complete", "bounded")}
     return np.array(rows).reshape(-1, 7), damage
 
 
