@@ -1,11 +1,13 @@
 """The structured Flexible-BIME Newton solver (paper eq 20) on a ring model with a known
 stiffness matrix: against the dense Newton on all 5 + 8B unknowns, statics, limits."""
 import dataclasses
+import math
 
 import numpy as np
 import pytest
 
 from slewing_model import BimeSolver, Loads, solve
+import slewing_model.distribution.bime as bime
 from slewing_model.distribution.bime import solve_dense_newton
 from conftest import symmetric_block_circulant
 from synthetic_rings import synthetic_superelement
@@ -160,6 +162,56 @@ def test_a_step_that_holds_the_loads_after_a_jump_starts_at_its_equilibrium(bear
     held = sim.step(Loads(Fz=5e4, Mx=-2.2e3), psi=0.02, omega=0.1).distribution
     assert reversed_.iterations > 0 and held.iterations == 0
     assert np.array_equal(held.state, reversed_.state)
+
+
+REVERSALS = [(Loads(Fz=5e4, Mx=2e4), Loads(Fz=5e4, Mx=-2e4)),
+             (Loads(Fx=2e4, Fz=5e4, My=1e4), Loads(Fx=-2e4, Fz=5e4, My=-1e4))]
+
+
+@pytest.mark.parametrize("before, after", REVERSALS)
+def test_held_rings_start_balances_the_moving_ring_and_lowers_the_energy(bearing, before, after):
+    # a warm start far from its equilibrium (a moment reversed) first moves the moving ring to its
+    # equilibrium under the new loads with the rings held: force balance on (X, Y, Z, rx, ry) there,
+    # and a total energy (eq 20) below the start's; the ring forces are untouched
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    first = solver.solve(before)
+    f_scaled = solver.scaled_load(after)
+    start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
+    assert start.peak_residual > bime.HELD_START * max(np.abs(f_scaled).max(), start.peak_force)
+    held = solver._held_rings_start(start, after, f_scaled)
+    assert held.total < start.total
+    assert np.array_equal(held.y, start.y)
+    # the rigid solve stops at a relative residual of 1e-6 of the loads
+    assert np.abs(held.gradient).max() <= 1e-5 * np.abs(f_scaled).max()
+
+
+def test_held_rings_start_is_not_taken_where_the_loads_grow_in_their_direction(bearing):
+    # three times the load: far from its equilibrium, but the moving ring's equilibrium with the rings
+    # held loads no contact that was open, and the Newton steps from the old equilibrium serve better
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+    before = Loads(Fx=2e4, Fz=5e4, My=1e4)
+    first = solver.solve(before)
+    after = Loads(*(3.0 * before.as_array()))
+    f_scaled = solver.scaled_load(after)
+    start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
+    assert start.peak_residual > bime.HELD_START * max(np.abs(f_scaled).max(), start.peak_force)
+    assert solver._held_rings_start(start, after, f_scaled) is start
+
+
+@pytest.mark.parametrize("before, after", REVERSALS)
+def test_held_rings_start_reaches_the_cold_solution_in_fewer_iterations(bearing, before, after, monkeypatch):
+    # the Newton steps from the old equilibrium overshoot after a reversal; from the held start
+    # they reach the same equilibrium (the cold solve's) in fewer iterations
+    se = synthetic_superelement(bearing.ball_count)
+    cold = BimeSolver(bearing, se).solve(after)
+    iterations = {}
+    for held_start in (math.inf, bime.HELD_START):
+        monkeypatch.setattr(bime, "HELD_START", held_start)
+        solver = BimeSolver(bearing, se)
+        warm = solver.solve(after, initial=solver.solve(before))
+        assert np.allclose(warm.contact_load, cold.contact_load, rtol=1e-8, atol=1e-8 * cold.max_ball_load)
+        iterations[held_start] = warm.iterations
+    assert iterations[bime.HELD_START] < iterations[math.inf]
 
 
 def test_refused_step_leaves_the_simulator_as_it_was(bearing):
