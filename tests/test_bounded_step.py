@@ -116,6 +116,25 @@ def test_a_bounded_step_does_at_most_its_share_of_the_work(table1, rings, monkey
     assert not results[0].converged
 
 
+def test_a_bounded_step_counts_the_held_rings_start_in_its_work(table1, rings, monkeypatch):
+    # the reversal's first bounded step starts from the moving ring's equilibrium with the rings held
+    # (BimeSolver._held_rings_start): its rigid solve takes HELD_WORK of the bound, the operator the rest
+    work = OperatorWork(monkeypatch)
+    held = []
+    original = bime.BimeSolver._held_rings_start
+
+    def spied(self, p, *rest):
+        start = original(self, p, *rest)
+        held.append(start is not p)
+        return start
+
+    monkeypatch.setattr(bime.BimeSolver, "_held_rings_start", spied)
+    _, spent = reversal(table1, rings, "bounded", work, steps=1)
+    assert held == [True]
+    operator_work, largest = spent[0]
+    assert operator_work <= max(BOUNDED_WORK - bime.HELD_WORK, largest) * (1 + 1e-12)
+
+
 def test_a_bounded_step_flags_what_it_carries_over_and_arrives_at_the_complete_answer(table1, rings):
     results, _ = reversal(table1, rings, "bounded")
     for r in results:                       # the flag says what the residual says
