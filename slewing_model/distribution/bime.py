@@ -100,7 +100,8 @@ BOUNDED_WORK = 1e8
 BOUNDED_ITERATIONS = 12
 #: a warm start whose relative residual is above this (the loads jumped) tries the moving ring's
 #: equilibrium with the rings held (BimeSolver._held_rings_start); steps of slowly varying loads
-#: start at 1e-3-1e-2, a reversal at 2, NREL's first step from zero loads at 1, a load 1.5 times the last at 0.33
+#: start at 1e-3-1e-2, a reversal at 2, NREL's first step from zero loads at 1, a load 1.5 times
+#: the last at 0.33
 HELD_START = 0.5
 #: ... and kept where more than this share of the diagonals it loads were open at the start
 HELD_NEW_CONTACTS = 0.25
@@ -150,8 +151,8 @@ class BimeSolver:
     step_work : {"complete", "bounded"}
         How much a warm solve may do. "complete": Newton to ``rtol``, however many iterations
         and ring operator inversions that takes (the pitch bearing's moment reversed in one step:
-        9 and 5, from the held-rings start of :meth:`_held_rings_start`). "bounded" (real time): at most :data:`BOUNDED_ITERATIONS` iterations and
-        :data:`BOUNDED_WORK` of the operator's work (a new operator's inverse spread over as
+        9 and 5, from the held-rings start of :meth:`_held_rings_start`). "bounded" (real time): at
+        most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of the operator's work (a new operator's inverse spread over as
         many solves as that takes); a solve that would need more returns
         its last iterate with ``converged=False`` and its ``residual``, keeps its operator
         (and one being inverted), and the next warm solve goes on from there. A cold solve
@@ -460,9 +461,9 @@ class BimeSolver:
         return rigid
 
     def _held_rings_start(self, p: "_Point", loads: Loads, f_scaled: np.ndarray) -> "_Point":
-        """A warm start ``p`` far from its equilibrium (relative residual above :data:`HELD_START`:
-        the loads jumped), or the moving ring's equilibrium under the new loads with the rings held
-        as they are deformed, where that loads other contacts.
+        """The start of a warm solve: ``p``, or where ``p`` is far from its equilibrium (relative
+        residual above :data:`HELD_START`: the loads jumped) and it loads other contacts, the moving
+        ring's equilibrium under the new loads with the rings held as they are deformed.
 
         After a moment reversal the old equilibrium's operator knows only the contacts that carried
         the old load: its Newton steps overshoot, and finding the new contact set takes many
