@@ -152,9 +152,9 @@ class BimeSolver:
         How much a warm solve may do. "complete": Newton to ``rtol``, however many iterations
         and ring operator inversions that takes (the pitch bearing's moment reversed in one step:
         9 and 5, from the held-rings start of :meth:`_held_rings_start`). "bounded" (real time): at
-        most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of the operator's work (a new operator's inverse spread over as
-        many solves as that takes); a solve that would need more returns
-        its last iterate with ``converged=False`` and its ``residual``, keeps its operator
+        most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of the operator's work
+        (a new operator's inverse spread over as many solves as that takes); a solve that would
+        need more returns its last iterate with ``converged=False`` and its ``residual``, keeps its operator
         (and one being inverted), and the next warm solve goes on from there. A cold solve
         (no ``initial``) is always complete.
     """
