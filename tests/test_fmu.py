@@ -183,15 +183,17 @@ def test_a_static_safety_factor_below_one_is_logged_as_a_warning_when_it_starts(
 
 
 def test_bounded_steps_answer_as_the_library_and_flag_what_they_carry_over(table3_fmu):
-    """step_work = 2 (bounded): a tilting moment reversed in one step is answered over several
-    steps, each flagged by equilibrium_residual above the tolerance until the equilibrium is
-    reached; the values are the library's bounded simulator's (the FMU holds no physics)."""
+    """step_work = 2 (bounded): a tilting moment turned by a quarter turn in one step is answered
+    over several steps, each flagged by equilibrium_residual above the tolerance until the
+    equilibrium is reached; the values are the library's bounded simulator's (the FMU holds no
+    physics). (A moment reversed, as this test had it, is now reached within one step's bound
+    here: the held-rings start, ``BimeSolver._held_rings_start``.)"""
     from slewing_model.rings.superelement import build_superelement
 
     fmu, refs, _, unzipped = _slave(table3_fmu)
     names = ["equilibrium_residual", "z", "rx", "max_ball_load", "friction_torque", "ball[20].Q2"]
     inputs = ["Fz", "Mx", "My", "psi", "omega"]
-    forward, reversed_ = [1e5, 1.5e4, 5e4, 0.4, 0.05], [1e5, -1.5e4, -5e4, 0.4, 0.05]
+    forward, turned = [1e5, 1.5e4, 5e4, 0.4, 0.05], [1e5, -5e4, 1.5e4, 0.4, 0.05]
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.setInteger([refs["step_work"]], [2])
@@ -204,7 +206,7 @@ def test_bounded_steps_answer_as_the_library_and_flag_what_they_carry_over(table
     residuals = []
     try:
         for k in range(10):
-            values = forward if k < 2 else reversed_
+            values = forward if k < 2 else turned
             fmu.setReal([refs[n] for n in inputs], values)
             assert fmu.fmi2DoStep(fmu.component, 0.01 * k, 0.01, 1) == 0
             out = dict(zip(names, fmu.getReal([refs[n] for n in names])))
@@ -221,7 +223,7 @@ def test_bounded_steps_answer_as_the_library_and_flag_what_they_carry_over(table
         fmu.freeInstance()
         shutil.rmtree(unzipped, ignore_errors=True)
     tolerance = 1e-7                                        # the parameter's default
-    assert max(residuals[:2]) <= tolerance < residuals[2]    # the reversal's step is flagged ...
+    assert max(residuals[:2]) <= tolerance < residuals[2]    # the turned moment's step is flagged ...
     assert residuals[-1] <= tolerance                       # ... and the equilibrium reached within 8 steps
 
 
