@@ -210,11 +210,13 @@ class ContactSet:
         return out
 
     @functools.cached_property
-    def diagonal_rolling(self) -> np.ndarray:
-        """The rolling motions (2, B_active, 3), scaled unknowns, about the axis normal to
-        diagonal 1 (contacts 1, 3) and to diagonal 2 (4, 2), rolling without sliding at the
-        diagonal's two contact centres (the classical two-contact kinematics); made when first
-        asked for (by :meth:`stale_warm_start` and :meth:`initial_guesses` of one step)."""
+    def heavier_rolling(self) -> np.ndarray:
+        """The rolling motions (B_active, 3), scaled unknowns, about the axis normal to each ball's
+        more loaded diagonal (1: contacts 1, 3, where it carries at least diagonal 2's load; else
+        2: contacts 4, 2), rolling without sliding at the diagonal's two contact centres (the
+        classical two-contact kinematics); made when first asked for (by :meth:`stale_warm_start`
+        and :meth:`initial_guesses` of one step)."""
+        q = self.contact_load[self.active]
         alpha = self.contact_angle[self.active]
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
@@ -226,13 +228,13 @@ class ContactSet:
             w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
             w_g = ((w_o - w_c) * big_r + w_o * rb * n_r) / rb
             diagonals.append(np.stack([-w_g * n_z * ls, w_g * n_r * ls, w_c * big_r], axis=-1))
-        return np.stack(diagonals)
+        return np.where((q[:, 0] >= q[:, 1])[:, None], diagonals[0], diagonals[1])
 
     def initial_guesses(self) -> np.ndarray:
         """Candidate scaled unknowns (2, B_active, 3) for a cold start, each a
         rolling motion without sliding at contact centres:
 
-        0. about an axis normal to the more loaded diagonal (:attr:`diagonal_rolling`);
+        0. about an axis normal to the more loaded diagonal (:attr:`heavier_rolling`);
         1. about the axial direction (``w_r = 0``), rolling at the centres of
            the outer and of the inner contacts (the motion of a symmetric
            four-contact ball; measured, it stays near the equilibrium until one
@@ -246,9 +248,8 @@ class ContactSet:
         rb = self.ball_radius[self.active]
         big_r, ls = self.pitch_radius, self.length_scale
         w_o, w_i = (0.0, self.speed) if self.moving_ring == "inner" else (self.speed, 0.0)
-        diagonals = self.diagonal_rolling
+        heavier = self.heavier_rolling
         q1, q2 = q[:, 0], q[:, 1]
-        heavier = np.where((q1 >= q2)[:, None], diagonals[0], diagonals[1])
         # v . t = -r_r w_z - R w_c + W (R + r_r) = 0 at the outer (r_r > 0) and inner (r_r < 0) centres
         r_o = rb * 0.5 * (np.cos(alpha[:, 0]) + np.cos(alpha[:, 3]))
         r_i = -rb * 0.5 * (np.cos(alpha[:, 1]) + np.cos(alpha[:, 2]))
@@ -262,7 +263,7 @@ class ContactSet:
         """The balls (B_active,) whose motion ``u`` (a warm start, scaled unknowns) belongs to
         another contact set: its spin axis tilts towards the normal of the heavier diagonal less
         than :data:`~slewing_model.friction.kernel.WARM_ROLLING` of the way rolling on it does
-        (:attr:`diagonal_rolling`'s radial component), for a ball loaded on one diagonal, or away
+        (:attr:`heavier_rolling`'s radial component), for a ball loaded on one diagonal, or away
         from it by more than that share, for a ball in four-point contact (whose equilibria lie
         between the axial rolling, 0, and the diagonal's, 1). A ball whose heavier diagonal flipped
         (a moment reversed) or that left four-point contact (the first load after a preload)
@@ -270,8 +271,7 @@ class ContactSet:
         mean load 0.70 ms instead of 1.04; rigid reversals of table1 and table3 0.6 and 0.3 ms
         instead of 0.9 and 0.4)."""
         q = self.contact_load[self.active]
-        diagonals = self.diagonal_rolling
-        tilt = np.where(q[:, 0] >= q[:, 1], diagonals[0, :, 0], diagonals[1, :, 0])
+        tilt = self.heavier_rolling[:, 0]
         least = np.where((q[:, 0] > 0.0) & (q[:, 1] > 0.0), -WARM_ROLLING, WARM_ROLLING)
         return ~(u[:, 0] * tilt >= least * tilt * tilt)
 

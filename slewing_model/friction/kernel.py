@@ -365,7 +365,7 @@ WARM_ROLLING = 0.5
 
 
 def _diagonal_rolling(rb, alpha, sign, w_o, w_i, big_r, ls, out):
-    """``ContactSet.diagonal_rolling`` of one ball and diagonal (its outer contact's angle
+    """``ContactSet.heavier_rolling`` of one ball and diagonal (its outer contact's angle
     ``alpha``, ``sign`` 1 for diagonal 1, -1 for diagonal 2), into ``out`` (3,)."""
     n_r, n_z = math.cos(alpha), sign * math.sin(alpha)
     w_c = 0.5 * (w_o + w_i) + (w_o - w_i) * rb * n_r / (2.0 * big_r)
