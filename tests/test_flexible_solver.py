@@ -178,7 +178,7 @@ def test_held_rings_start_balances_the_moving_ring_and_lowers_the_energy(bearing
     f_scaled = solver.scaled_load(after)
     start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
     assert start.peak_residual > bime.HELD_START * max(np.abs(f_scaled).max(), start.peak_force)
-    held = solver._held_rings_start(start, after, f_scaled)
+    held = solver._held_rings_start(start, after, f_scaled, np.abs(f_scaled).max())
     assert held.total < start.total
     assert np.array_equal(held.y, start.y)
     # the rigid solve stops at a relative residual of 1e-6 of the loads
@@ -195,7 +195,7 @@ def test_held_rings_start_is_not_taken_where_the_loads_grow_in_their_direction(b
     f_scaled = solver.scaled_load(after)
     start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
     assert start.peak_residual > bime.HELD_START * max(np.abs(f_scaled).max(), start.peak_force)
-    assert solver._held_rings_start(start, after, f_scaled) is start
+    assert solver._held_rings_start(start, after, f_scaled, np.abs(f_scaled).max()) is start
 
 
 @pytest.mark.parametrize("before, after", REVERSALS)

@@ -375,10 +375,10 @@ class BimeSolver:
         if initial is None:
             self.pending_operator = None                  # a cold solve depends on nothing before it
         point = self._evaluate(qs, y, f_scaled)
-        if flexible and initial is not None and point.any_loaded:
-            point = self._held_rings_start(point, loads, f_scaled)
-        handed_back = False                               # the compiled loop stopped before this iteration
         load_scale = max(map(abs, f_scaled.tolist()))
+        if flexible and initial is not None and point.any_loaded:
+            point = self._held_rings_start(point, loads, f_scaled, load_scale)
+        handed_back = False                               # the compiled loop stopped before this iteration
         while True:
             grad_q, mismatch = point.gradient, point.mismatch
             scale = max(load_scale, point.peak_force, 1e-300)
@@ -460,7 +460,7 @@ class BimeSolver:
             rigid._separation = self._separation - ring_motion.reshape(self._separation.shape)
         return rigid
 
-    def _held_rings_start(self, p: "_Point", loads: Loads, f_scaled: np.ndarray) -> "_Point":
+    def _held_rings_start(self, p: "_Point", loads: Loads, f_scaled: np.ndarray, load_scale: float) -> "_Point":
         """The start of a warm solve: ``p``, or where ``p`` is far from its equilibrium (relative
         residual above :data:`HELD_START`: the loads jumped) and it loads other contacts, the moving
         ring's equilibrium under the new loads with the rings held as they are deformed.
@@ -475,8 +475,7 @@ class BimeSolver:
         reversal: 56 of 109; 14 Newton iterations become 9). Where the loads grow in their
         direction (a jump, the first step from zero loads) it loads no new contacts, and its steps
         would take more iterations than the old equilibrium's."""
-        scale = max(max(map(abs, f_scaled.tolist())), p.peak_force)
-        if p.peak_residual <= HELD_START * scale:
+        if p.peak_residual <= HELD_START * max(load_scale, p.peak_force):
             return p
         self._work_left -= HELD_WORK          # a bounded solve counts the rigid solve's time as operator work
         try:
