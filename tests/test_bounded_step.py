@@ -36,15 +36,18 @@ class OperatorWork:
     (:func:`~slewing_model.rings.reduced_operator.forming_work`), the stages of its inverse each call ran
     (:func:`~slewing_model.rings.reduced_operator.stage_work`, from the stage before and after the
     call, of the pending operator's method), bordering (:func:`~slewing_model.rings.reduced_operator.bordering_work`). ``largest``: the
-    largest stage run since the last :meth:`take`."""
+    largest stage run since the last :meth:`take`; ``pieces``: how many of these (forming, stages,
+    borderings) were done since then."""
 
     def __init__(self, monkeypatch):
         self.work = self.largest = 0.0
+        self.pieces = 0
 
         def stages(n, first, last, method=0):
             for k in range(first, last):
                 self.work += stage_work(n, k, method)
                 self.largest = max(self.largest, stage_work(n, k, method))
+                self.pieces += 1
 
         def done(result):
             return getattr(result, "stage", len(STAGES))         # an operator: all stages done
@@ -61,6 +64,7 @@ class OperatorWork:
         def started(result, point, compliance, stiffness, active, *rest):
             n = 2 * int(np.count_nonzero(active))
             self.work += bime.forming_work(n)
+            self.pieces += 1
             stages(n, 0, done(result))
 
         def advanced(result, pending, *rest):
@@ -72,6 +76,7 @@ class OperatorWork:
             new_rows = 2 * int(np.count_nonzero(active & ~op.active))
             if result is not None and new_rows:
                 self.work += bordering_work(new_rows, op.rows.size)
+                self.pieces += 1
 
         counted("start_operator", started)
         counted("advance_operator", advanced)
@@ -80,6 +85,7 @@ class OperatorWork:
     def take(self) -> tuple[float, float]:
         work, largest = self.work, self.largest
         self.work = self.largest = 0.0
+        self.pieces = 0
         return work, largest
 
 
@@ -292,5 +298,31 @@ def test_a_bounded_solve_of_small_operators_arrives_as_well(table1, rings, monke
     monkeypatch.setattr(reduced_operator, "LEAF", 10_000)
     results, _ = reversal(table1, rings, "bounded")
     assert results[-1].converged
+    reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
+    assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
+
+
+def test_a_bounded_run_gets_on_where_the_held_start_leaves_less_than_a_stage(table1, rings, monkeypatch):
+    """Each bounded solve does at least one piece of the operator's work (forming ``W``, a stage of its
+    inverse, a bordering), whatever the held-rings start took of its bound. Here the held start is
+    tried in every solve and takes the whole bound. Before, such a run never formed or inverted an
+    operator again: the yaw bearing (180 balls, the first stage of its 720-row operator 1.4e8)
+    answered its start values in every step, all flagged. Now every solve does one such piece and
+    no more, and the run arrives at the cold solution."""
+    monkeypatch.setattr(bime, "HELD_START", 0.0)
+    monkeypatch.setattr(bime, "HELD_WORK", BOUNDED_WORK)
+    work = OperatorWork(monkeypatch)
+    sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
+                                                           step_work="bounded"))
+    sim.step(FORWARD, 0.0, 0.0)
+    work.take()
+    results, pieces = [], []
+    for _ in range(60):
+        results.append(sim.step(REVERSED, 0.0, 0.0).distribution)
+        pieces.append(work.pieces)
+        work.take()
+    first = next(k for k, r in enumerate(results) if r.converged)
+    assert first >= 2 and all(r.converged for r in results[first:])
+    assert all(p == 1 for p in pieces[:first]) and sum(pieces[:first]) >= 2
     reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
     assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)

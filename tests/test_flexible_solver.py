@@ -437,6 +437,33 @@ def test_an_operator_too_ill_conditioned_for_single_precision_is_inverted_in_dou
         assert single > 1.0 and error <= 100 * max(lapack_error, 1e-12)
 
 
+def test_an_operator_singular_in_single_precision_is_made_again_in_double_over_the_next_steps():
+    """Where the solve can wait (``again``: a bounded one), a ``W`` singular in single precision (here two
+    of its rows equal there; the yaw bearing's preload alone, of condition 4e13) comes back as a pending operator through the factor in
+    double (method 2) at stage 0, not inverted at once (32 ms on the yaw bearing's 720 rows, a bounded
+    step's); its stages then give an inverse in double that passes the check."""
+    from slewing_model.rings.reduced_operator import STAGES, PendingOperator, advance_operator, passes_check
+
+    rows = 300
+    rng = np.random.default_rng(3)
+    q, _ = np.linalg.qr(rng.standard_normal((rows, rows)))
+    w = (q * np.logspace(0.0, -3.0, rows)) @ q.T
+    w = 0.5 * (w + w.T)
+    w[:2, :2] = [[1.0, 1.0 - 1e-10], [1.0 - 1e-10, 1.0]]     # two rows equal in single precision
+    w[:2, 2:] = w[2:, :2] = 0.0
+    with pytest.raises(np.linalg.LinAlgError):
+        np.linalg.inv(w[:4, :4].astype(np.float32))
+    pending = PendingOperator(np.arange(rows), np.ones(rows // 2, dtype=bool), np.zeros((rows // 2, 2, 2)), w, 0, ())
+    again = advance_operator(pending, None, None, until=len(STAGES), again=True)
+    assert isinstance(again, PendingOperator) and (again.method, again.stage) == (2, 0)
+    for stage in range(1, len(STAGES) + 1):                 # one stage a step
+        again = advance_operator(again, None, None, until=stage, again=True)
+    inverse = again.parts[0]
+    assert inverse.dtype == np.float64 and passes_check(w, inverse)
+    # double precision's: within a few round-offs times the condition (2e10; in single, singular)
+    assert np.abs(inverse @ w - np.eye(rows)).max() <= 10 * np.finfo(float).eps * np.linalg.cond(w)
+
+
 def test_a_start_at_zero_loads_whose_operator_is_singular_in_single_precision(monkeypatch):
     """The yaw bearing started at zero loads (an FMU's start values): the operator of its preload
     alone (condition 4e13) is singular in single precision and is inverted in double; the next step,

@@ -176,6 +176,7 @@ class BimeSolver:
         self.kernel = kernel
         self.step_work = step_work
         self._work_left = math.inf   # per solve: the ring operator's work still allowed (BOUNDED_WORK)
+        self._operator_work_done = False   # per solve: a piece of operator work done (_advance, _spend)
         self._compiled = use_compiled(kernel, "kernel")    # the per-contact work as compiled loops
         self._arithmetic = COMPILED_ARITHMETIC if self._compiled else NUMPY_ARITHMETIC     # the operator's too
         self.length = bearing.pitch_diameter / 2.0  # scale of rotations in the unknowns
@@ -369,6 +370,7 @@ class BimeSolver:
         iterations = 0
         bounded = self.step_work == "bounded" and initial is not None
         self._work_left = BOUNDED_WORK if bounded else math.inf
+        self._operator_work_done = False
         limit = min(self.max_iterations, BOUNDED_ITERATIONS) if bounded else self.max_iterations
         last_residual = None if initial is None else math.inf  # a warm start may reuse the last operator
         self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
@@ -667,15 +669,17 @@ class BimeSolver:
 
     def _advance(self, pending: PendingOperator, mu: float, until: int, required: bool):
         """The pending operator's stages up to ``until`` (:data:`~slewing_model.rings.reduced_operator.STAGES`),
-        those the solve's work allows (``step_work``: at least one where it spent nothing yet); the
+        those the solve's work allows (``step_work``: at least one where the solve did no operator
+        work yet, whatever else it spent, so that a run of bounded solves always gets on); the
         operator where they are all done and asked for (``until`` the last), else the pending one,
         kept as the solver's and :class:`_WorkSpent` raised where ``required``."""
         n, stage = pending.matrix.shape[0], pending.stage
         while stage < until:
             cost = stage_work(n, stage, pending.method)
-            if cost > self._work_left and self._work_left < BOUNDED_WORK:
+            if cost > self._work_left and self._operator_work_done:
                 break
             self._work_left -= cost
+            self._operator_work_done = True
             stage += 1
         if stage > pending.stage:    # an inverse that misses the check: made again, spread where the solve can
             pending = advance_operator(pending, None, None, until=stage,  # wait or its work is bounded
@@ -689,10 +693,12 @@ class BimeSolver:
 
     def _spend(self, work: float) -> None:
         """Take ``work`` (:data:`BOUNDED_WORK`) from what the solve may still do (``step_work``);
-        :class:`_WorkSpent` where it is not left (nothing is done then)."""
-        if work > self._work_left:
+        :class:`_WorkSpent` where it is not left (nothing is done then), except for the solve's first
+        piece of operator work (as :meth:`_advance`)."""
+        if work > self._work_left and self._operator_work_done:
             raise _WorkSpent
         self._work_left -= work
+        self._operator_work_done = True
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float,
                 converged: bool = True) -> LoadDistribution:

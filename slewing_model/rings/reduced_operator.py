@@ -492,8 +492,9 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     kept in double. An inverse that misses the check is made again through the Cholesky factor:
     with ``again``, as a pending operator of the next method at stage 0 (by halves: 1, in single
     precision; 1: 2, in double), whose stages the next calls run (a solve that can go on without it,
-    or a bounded one: spread over steps as any new operator); else at once, as a ``W`` singular in
-    single precision is."""
+    or a bounded one: spread over steps as any new operator); else at once. A ``W`` singular in
+    single precision (the preload's alone, condition 4e13 on the yaw bearing) is made again so in
+    double (method 2): with ``again`` spread, else at once (:func:`checked_inverse`)."""
     if until is None:
         until = step_end(pending)
     if pending.stage < until:
@@ -509,8 +510,10 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             else:
                 stages = (FACTOR_STAGES if pending.method else STAGES)[pending.stage:until]
                 pending = replace(pending, stage=until, parts=_run_stages(w_mat, stages, pending.parts))
-        except np.linalg.LinAlgError:        # singular in single precision: inverted again at once
-            pending = replace(pending, stage=len(STAGES), parts=(None,))
+        except np.linalg.LinAlgError:        # singular in its precision (single): made again in double,
+            if again and method_precision(pending.method) != np.float64:     # spread where it can be
+                return replace(pending, stage=0, parts=(), method=2, scaled=())
+            pending = replace(pending, stage=len(STAGES), parts=(None,))     # else at once
         if pending.stage == len(STAGES):
             inverse = pending.parts[0]
             if inverse is not None:          # in double (W^-1 = S (S W S)^-1 S for the factor's), checked
