@@ -84,17 +84,22 @@ FINISH_ITERATIONS = 3
 #: iteration past this many in one solve is still slow (docs/speed.md)
 SPREAD_ITERATIONS = 8
 #: what a bounded warm solve (``step_work="bounded"``) may spend of the ring operator's work, and at
-#: least one stage of an inverse on its way: floating-point operations weighted so that they track
+#: least one piece of it (forming ``W``, a stage of its inverse on its way, a bordering), whatever else
+#: it spent: floating-point operations weighted so that they track
 #: time (the stages of a spread inverse of ``W = (A^-1 + M)_aa``:
 #: :func:`~slewing_model.rings.reduced_operator.stage_work`; forming ``W``:
 #: :func:`~slewing_model.rings.reduced_operator.forming_work`;
 #: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
-#: step's answer does not depend on the machine. 1e8, an inverse of about 360 rows (2 ms on one core
-#: here, ``benchmarks/bench_operator.py --stages``; about 2.4 ms within a step, its matrices out of
-#: cache), chosen by the pitch bearing's scenarios of ``benchmarks/bench_realtime.py``: 6.5e7 and 1e8
-#: gave a reversal's slowest step 5.4 and 6.5 ms in the library, 141 and 83 steps of 2000 flagged,
-#: NREL 174 and 29 of 6000 (docs/speed.md, "Issue 31, seventh turn") ...
-BOUNDED_WORK = 1e8
+#: step's answer does not depend on the machine. 8e7, an inverse of about 330 rows (1.6 ms on one core
+#: here, ``benchmarks/bench_operator.py --stages``), chosen by the pitch bearing's scenarios of
+#: ``benchmarks/bench_realtime.py`` with ``benchmarks/bench_bound.py`` (library, caps side by side in
+#: one run; docs/speed.md, "Issue 31, eleventh turn"): against 1e8 the steps slower than 4 NREL
+#: medians 0-4 instead of 2-15 a scenario, the slowest 3.5-4.6 NREL medians instead of 4.4-5.2,
+#: the first step from the start values 4.4-4.7 ms instead of 5.1-5.5; flagged NREL 44 instead of 29
+#: of 6000, a reversal's 54 instead of 36 of 2000. 7e7 flags NREL's 87, and its slowest was no faster.
+#: (Before the held-rings start, 6.5e7 and 1e8 flagged a reversal's 141 and 83 steps, NREL 174 and 29:
+#: the seventh turn.) ...
+BOUNDED_WORK = 8e7
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
 BOUNDED_ITERATIONS = 12

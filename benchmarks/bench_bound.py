@@ -1,0 +1,88 @@
+"""A bounded step's work cap (``BOUNDED_WORK``, issue 31): the slowest steps against the steps flagged,
+for several values of the cap in one run.
+
+A bounded solve (``step_work="bounded"``) spends at most ``BOUNDED_WORK`` of the ring operator's work
+(and always one piece of it: forming ``W``, a stage of its inverse or a bordering), and flags what it
+carries over. A smaller cap makes the slowest steps faster and flags more steps. This steps the pitch
+bearing's real-time scenarios (``bench_realtime.py``) through one library simulator per value of the
+cap, alternating which goes first each step (the library, not the FMU: the cap is a module constant;
+flexible rings, compiled kernels, friction and life on), each started at zero loads as an FMU leaving
+initialization with its start values, and prints per scenario and cap the first step, the median, 99th
+percentile and slowest of the others, how many of them were slower than 4 NREL medians (the issue's
+goal; the NREL median of the first cap, measured in the same run) and the steps flagged.
+
+Run: .venv/bin/python benchmarks/bench_bound.py [--work 1e8 8e7 7e7] [--scenarios nrel reversal ...]
+     (about 3 minutes for three caps)
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_realtime import SCENARIOS, scenario  # noqa: E402
+from timing import print_table  # noqa: E402
+
+
+def run(name: str, caps: list[float]) -> dict:
+    """Per cap: the step times [ms] (the first after the start at zero loads first) and the steps flagged."""
+    from slewing_model import Loads, load_bearing
+    from slewing_model.distribution import bime
+    from slewing_model.rings.superelement import build_superelement
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    case = scenario(name)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="fine", progress=False)
+    settings = SimulatorSettings(ring_model="flexible", load_frame="rotating", life=True, step_work="bounded",
+                                 contact_kernel="auto")
+    sims = [BearingSimulator(bearing, superelement, settings) for _ in caps]
+    for sim in sims:
+        sim.step(Loads(), 0.0, 0.0)                     # the FMU's start values, solved at initialization
+    found = [{"times": [], "flagged": 0} for _ in caps]
+    default = bime.BOUNDED_WORK
+    try:
+        for k in range(case.steps):
+            order = range(len(caps)) if k % 2 else reversed(range(len(caps)))
+            for i in order:
+                bime.BOUNDED_WORK = caps[i]
+                start = time.perf_counter()
+                out = sims[i].step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
+                found[i]["times"].append(1e3 * (time.perf_counter() - start))
+                found[i]["flagged"] += not out.distribution.converged
+    finally:
+        bime.BOUNDED_WORK = default
+    return found
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--work", nargs="*", type=float, default=[1e8, 8e7, 7e7])
+    parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
+    args = parser.parse_args()
+    scenarios = ["nrel"] + [s for s in args.scenarios if s != "nrel"]     # NREL first: its median is the unit
+    results = {name: run(name, args.work) for name in scenarios}
+    nrel_median = float(np.median(results["nrel"][0]["times"][1:]))
+    rows = []
+    for name in scenarios:
+        if name not in args.scenarios:
+            continue
+        for cap, found in zip(args.work, results[name]):
+            times = np.array(found["times"])
+            rest = times[1:]
+            rows.append([name, f"{cap:.3g}", f"{times[0]:.1f}", f"{np.median(rest):.2f}",
+                         f"{np.percentile(rest, 99):.2f}", f"{rest.max():.1f}", f"{rest.max() / nrel_median:.1f}",
+                         str(int(np.sum(rest > 4 * nrel_median))), f"{times[0] / np.median(rest):.0f}",
+                         str(found["flagged"])])
+    print_table(f"Bounded steps by BOUNDED_WORK (pitch bearing, library, alternating each step; NREL median of "
+                f"the first cap {nrel_median:.2f} ms); times in ms",
+                ["scenario", "BOUNDED_WORK", "first step", "median", "p99", "slowest", "slowest / NREL median",
+                 "steps over 4 NREL medians", "first / median", "flagged steps"], rows)
+
+
+if __name__ == "__main__":
+    main()
