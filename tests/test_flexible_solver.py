@@ -129,7 +129,10 @@ def test_simulator_extrapolated_start_reaches_the_cold_solution(bearing):
 def test_extrapolated_start_goes_as_far_as_the_loads_go_on():
     # the start is the last state carried on along its last change by the share of their last
     # change that the loads repeat: the whole of it where they go on, none where they hold or go back
-    from slewing_model.simulation.simulator import extrapolated_start
+    from slewing_model.simulation.simulator import extrapolated_start, load_share
+
+    def start(warm, previous, f, f1, f0):
+        return extrapolated_start(warm, previous, load_share(f, f1, f0))
 
     rng = np.random.default_rng(7)
     warm, previous = rng.normal(size=9), rng.normal(size=9)
@@ -138,14 +141,13 @@ def test_extrapolated_start_goes_as_far_as_the_loads_go_on():
     cases = {"go on": (f1 + change, 1.0), "hold": (f1, 0.0), "go back": (f0, 0.0), "half": (f1 + 0.5 * change, 0.5),
              "twice as fast": (f1 + 2.0 * change, 1.0)}
     for name, (f, share) in cases.items():
-        assert np.allclose(extrapolated_start(warm, previous, f, f1, f0), warm + share * (warm - previous),
+        assert np.allclose(start(warm, previous, f, f1, f0), warm + share * (warm - previous),
                            rtol=1e-12, atol=1e-12), name
     side = np.array([-change[1], change[0], 0.0, 0.0, 0.0])          # a change across the last: none of it
-    assert np.array_equal(extrapolated_start(warm, previous, f1 + side - side @ change / (change @ change) * change,
-                                             f1, f0), warm)
+    assert np.array_equal(start(warm, previous, f1 + side - side @ change / (change @ change) * change, f1, f0), warm)
     # loads that held: the state moved with psi alone, carried on whole; no previous state: the last
-    assert np.allclose(extrapolated_start(warm, previous, f1 + change, f1, f1.copy()), 2.0 * warm - previous)
-    assert extrapolated_start(warm, None, f1, f1, f0) is warm
+    assert np.allclose(start(warm, previous, f1 + change, f1, f1.copy()), 2.0 * warm - previous)
+    assert start(warm, None, f1, f1, f0) is warm
 
 
 def test_a_step_that_holds_the_loads_after_a_jump_starts_at_its_equilibrium(bearing):

@@ -116,3 +116,42 @@ def test_state_taken_while_a_new_operator_is_pending_repeats_the_steps():
         again = [step(j) for j in range(k, k + 5)]
         for (q1, d1, t1), (q2, d2, t2) in zip(first, again):
             assert np.array_equal(q1, q2) and np.array_equal(d1, d2) and t1 == t2
+
+
+def test_the_friction_start_carried_on_is_nearer_the_balls_motions_of_the_step():
+    """The friction torque of a step starts from the last two steps' ball motions carried on as far as
+    the loads go on (``simulator.extrapolated_motion``). For the pitch bearing's blade-root series it
+    is about half as far from the step's ball motions as the last step's are (the median over the
+    steps of the balls' median distance: 0.55; 1 where the loads turn back, share 0). Every step's
+    torque is checked against a tight solve by :func:`test_every_step_matches_a_tight_solve`."""
+    from slewing_model.simulation.simulator import extrapolated_motion, load_share
+
+    case = CASES["pitch"](STEPS)
+    bearing = load_bearing(case.bearing)
+    sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"), _settings(case))
+    states, loads, ratios = [], [], []
+    for k in range(case.steps):
+        f = Loads(*case.loads[k]).rotated(case.psi[k])
+        loads.append(sim.solver.scaled_load(f))
+        sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k])
+        states.append(sim.get_state()["friction"])
+        if k >= 2:
+            start = extrapolated_motion(states[-2], states[-3], load_share(loads[-1], loads[-2], loads[-3]))
+            rolled = (states[-1][:, 3] != 0) & (states[-2][:, 3] != 0) & (states[-3][:, 3] != 0)
+            carried = np.linalg.norm((start - states[-1])[rolled], axis=1)
+            last = np.linalg.norm((states[-2] - states[-1])[rolled], axis=1)
+            ratios.append(np.median(carried) / np.median(last))
+    assert np.median(ratios) < 0.7
+
+
+def test_a_ball_newly_loaded_or_unloaded_keeps_its_last_motion():
+    """... a ball newly loaded keeps its last motion (none: it is started cold), a ball unloaded none."""
+    from slewing_model.simulation.simulator import extrapolated_motion
+
+    rng = np.random.default_rng(5)
+    warm, previous = rng.normal(size=(6, 4)), rng.normal(size=(6, 4))
+    warm[4], previous[5] = 0.0, 0.0              # ball 5 unloaded in the last step, ball 6 loaded in it
+    start = extrapolated_motion(warm, previous, 0.5)
+    assert np.allclose(start[:4], warm[:4] + 0.5 * (warm[:4] - previous[:4]), rtol=1e-14, atol=0)
+    assert np.array_equal(start[4:], warm[4:])
+    assert extrapolated_motion(warm, None, 0.5) is warm

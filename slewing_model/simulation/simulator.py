@@ -31,6 +31,9 @@ LOAD_FRAMES = ("fixed", "rotating")
 BOUNDED_FRICTION_ITERATIONS = 4
 #: loads whose change in a step is below this share of their size held in it (:func:`extrapolated_start`)
 HELD_LOADS = 1e-9
+#: the column of a ball's orbital speed in the friction torque's state (``FrictionTorque.state``: ``w_r``,
+#: ``w_t``, ``w_z``, ``w_c`` per unit of speed), zero for a ball that carries no load
+ORBITAL = 3
 
 
 @dataclass(frozen=True)
@@ -204,6 +207,8 @@ class BearingSimulator:
         self._loads: tuple = (None, None)              # the scaled loads of _warm and of _previous
         self._warm_converged = True                    # _warm an equilibrium (not a bounded step's iterate)
         self._friction_warm: np.ndarray | None = None  # ball kinematics of the last step
+        self._friction_previous: np.ndarray | None = None   # ... and of the step before (both equilibria)
+        self._friction_converged = True                # _friction_warm an equilibrium (not capped)
         self._psi = 0.0
         self.last: StepResult | None = None
         self.life = None
@@ -250,18 +255,22 @@ class BearingSimulator:
             if psi != self._psi or self._warm is None:
                 self.solver.set_rotation(psi)
             load = self.solver.scaled_load(loads)
-            distribution = self.solver.solve(loads, initial=extrapolated_start(self._warm, self._previous, load,
-                                                                               *self._loads))
+            share = load_share(load, *self._loads)
+            distribution = self.solver.solve(loads, initial=extrapolated_start(self._warm, self._previous, share))
             magnitude = self.settings.seal_torque
             if self.settings.friction_coefficient > 0.0:
                 friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
                                            omega=1.0, seal_torque=self.settings.seal_torque,
-                                           initial=self._friction_warm, tol=self.settings.friction_tolerance,
-                                           kernel=self.settings.friction_kernel,
+                                           initial=extrapolated_motion(self._friction_warm, self._friction_previous,
+                                                                       share),
+                                           tol=self.settings.friction_tolerance, kernel=self.settings.friction_kernel,
                                            **({} if distribution.converged else
                                               {"max_iterations": BOUNDED_FRICTION_ITERATIONS}))
                 magnitude = friction.magnitude
-                self._friction_warm = friction.state
+                converged = friction.converged and distribution.converged
+                # a capped torque's motions (a flagged step's) are no point to extrapolate from or to
+                self._friction_previous = self._friction_warm if converged and self._friction_converged else None
+                self._friction_warm, self._friction_converged = friction.state, converged
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         if self.life is not None:
             self.life.step(None, psi, distribution)
@@ -285,6 +294,7 @@ class BearingSimulator:
                 "warm_converged": self._warm_converged, "psi": self._psi,
                 "operator": None if operator is None else operator.as_tuple(),
                 "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm,
+                "friction_previous": self._friction_previous, "friction_converged": self._friction_converged,
                 "life": None if self.life is None else self.life.get_state()}
 
     def set_state(self, state: dict) -> None:
@@ -300,13 +310,33 @@ class BearingSimulator:
         pending = state.get("pending")
         self.solver.pending_operator = None if pending is None else PendingOperator.from_tuple(pending)
         self._friction_warm = None if state["friction"] is None else np.asarray(state["friction"], dtype=float)
+        previous = state.get("friction_previous")
+        self._friction_previous = None if previous is None else np.asarray(previous, dtype=float)
+        self._friction_converged = bool(state.get("friction_converged", True))
         if self.life is not None and state.get("life") is not None:
             self.life.set_state(state["life"])
 
 
-def extrapolated_start(warm, previous, load, last_load, load_before):
+def load_share(load, last_load, load_before) -> float:
+    """The share of the last step's change that this step's loads repeat: their change projected on
+    their last one, ``s = (f - f1) . (f1 - f0) / |f1 - f0|^2`` in [0, 1] (``f`` this step's scaled
+    loads (:meth:`~slewing_model.distribution.bime.BimeSolver.scaled_load`), ``f1`` those of the last
+    state, ``f0`` of the one before; :func:`extrapolated_start`). Loads that held in the last step
+    (their change below :data:`HELD_LOADS` of their size) take the whole last change: the state then
+    follows ``psi``; so do states kept before their loads were (``f1`` or ``f0`` None)."""
+    if last_load is None or load_before is None:
+        return 1.0
+    change = last_load - load_before
+    size = float(change @ change)
+    if size <= (HELD_LOADS * float(np.max(np.abs(last_load)))) ** 2:
+        return 1.0
+    return min(max(float((load - last_load) @ change) / size, 0.0), 1.0)
+
+
+def extrapolated_start(warm, previous, share: float = 1.0):
     """The start of a step's solve: the last state ``warm`` carried on along its last change
-    ``warm - previous`` as far as the loads go on along theirs.
+    ``warm - previous`` as far as the loads go on along theirs, ``warm + share (warm - previous)``
+    (``share``: :func:`load_share`).
 
     The states of slowly varying inputs lie on a smooth curve: started from ``2 warm - previous``
     the start error is of second order in the step (measured, it halves the Newton iterations).
@@ -314,23 +344,28 @@ def extrapolated_start(warm, previous, load, last_load, load_before):
     hold in this one (a moment reversed, a load switched, the first step after a start at other
     loads), that extrapolation repeats the jump, a start as far off as the jump itself (after a
     moment reversal: 21 Newton iterations and 28 ms instead of none). So the last change is taken
-    by the share ``s`` of it that the loads repeat, their change projected on their last one,
-    ``s = (f - f1) . (f1 - f0) / |f1 - f0|^2`` in [0, 1] (``f`` this step's scaled loads
-    (:meth:`~slewing_model.distribution.bime.BimeSolver.scaled_load`), ``f1`` those of ``warm``,
-    ``f0`` of ``previous``): ``warm + s (warm - previous)``, the least-squares extrapolation of
-    the inputs carried to the state. Loads that held in the last step (their change below
-    :data:`HELD_LOADS` of their size) take the whole last change: the state then follows ``psi``.
-    Without ``previous``: ``warm``; without the loads of both states (a state kept before they
-    were): the whole change, as before."""
+    by the share of it that the loads repeat, the least-squares extrapolation of the inputs carried
+    to the state. Without ``previous``: ``warm``."""
     if previous is None or warm is None or previous.shape != warm.shape:
         return warm
-    share = 1.0
-    if last_load is not None and load_before is not None:
-        change = last_load - load_before
-        size = float(change @ change)
-        if size > (HELD_LOADS * float(np.max(np.abs(last_load)))) ** 2:
-            share = min(max(float((load - last_load) @ change) / size, 0.0), 1.0)
     return warm + share * (warm - previous)
+
+
+def extrapolated_motion(warm, previous, share: float = 1.0):
+    """The warm start of a step's friction torque (its balls' motions per unit of speed, (B, 4):
+    ``FrictionTorque.state``): :func:`extrapolated_start` of the last two steps' motions, ball by ball
+    where the ball rolled in both (a ball newly loaded, or unloaded, has no motion to carry on; it
+    keeps the last one, which the friction torque starts cold where it is none).
+
+    The balls' motions follow the loads as the load distribution does: carried on, the warm start of
+    the pitch bearing's NREL series is within the friction's tolerance for most balls at once (one
+    Newton iteration where two were usual: the balls' minimisation 241 -> 183 us a step, 243 -> 164
+    us for turbulent loads; docs/speed.md, "Issue 31, eleventh turn"). Where the friction of either
+    step stopped short (a flagged step's, capped) there is no ``previous``: ``warm``."""
+    if previous is None or warm is None or previous.shape != warm.shape:
+        return warm
+    rolled = (warm[:, ORBITAL] != 0.0) & (previous[:, ORBITAL] != 0.0)      # a loaded ball orbits
+    return warm + (share * rolled)[:, None] * (warm - previous)
 
 
 def encode_state(value):
