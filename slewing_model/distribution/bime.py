@@ -114,6 +114,8 @@ HELD_NEW_CONTACTS = 0.25
 #: 0.9 ms on the pitch bearing, about half a step's operator work; benchmarks/bench_held_start.py)
 HELD_WORK = 5e7
 STEP_WORK = ("complete", "bounded")
+#: what :meth:`BimeSolver.set_rotation` sets: a solver at the same rotation may take them (BimeSolver._rigid_solver)
+ROTATION_ARRAYS = ("assembly", "_moving_centre", "_separation", "reference_stiffness", "jacobian", "_jacobian_rows")
 #: the ring of contacts 1..4
 CONTACT_RING = np.array(["outer" if c in RING_CONTACTS["outer"] else "inner" for c in (1, 2, 3, 4)])
 INNER_CONTACT = CONTACT_RING == "inner"
@@ -204,6 +206,7 @@ class BimeSolver:
         self._turn_tolerance = 0.0 if rigid_turn else APPROXIMATE_TURN
         self._stage_due = self._spread = False  # per solve: a stage of the pending operator is due; it may be spread
         self.assembly: Assembly | None = None
+        self._rigid: BimeSolver | None = None   # the rigid-ring solver of the starting guesses (_rigid_solver)
         self.set_rotation(psi, cage_angle)
 
     @property
@@ -458,11 +461,19 @@ class BimeSolver:
 
     def _rigid_solver(self, ring_motion: np.ndarray | None = None) -> "BimeSolver":
         """A rigid-ring solver at this rotation for a starting guess (no capacity checks), its
-        grooves moved by ``ring_motion`` (``M y``, 4B) where given: the rings held as they are deformed."""
-        rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi, cage_angle=self.assembly.cage_angle, rtol=1e-6,
-                           max_iterations=self.max_iterations, kernel=self.kernel)
-        rigid.edge_angle = np.full(4, np.pi)
-        rigid.pressure_limit = math.inf
+        grooves moved by ``ring_motion`` (``M y``, 4B) where given: the rings held as they are deformed.
+        Made once and kept (it holds nothing from one solve to the next); it takes this solver's
+        assembly at its rotation (:meth:`set_rotation`'s arrays) instead of assembling it again
+        (0.3 of the held-rings start's 1 ms, :meth:`_held_rings_start`)."""
+        rigid = self._rigid
+        if rigid is None:
+            rigid = self._rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi,
+                                             cage_angle=self.assembly.cage_angle, rtol=1e-6,
+                                             max_iterations=self.max_iterations, kernel=self.kernel)
+            rigid.edge_angle = np.full(4, np.pi)
+            rigid.pressure_limit = math.inf
+        for name in ROTATION_ARRAYS:
+            setattr(rigid, name, getattr(self, name))
         if ring_motion is not None:
             rigid._separation = self._separation - ring_motion.reshape(self._separation.shape)
         return rigid
