@@ -333,10 +333,10 @@ def load_share(load, last_load, load_before) -> float:
     return min(max(float((load - last_load) @ change) / size, 0.0), 1.0)
 
 
-def extrapolated_start(warm, previous, share: float = 1.0):
+def extrapolated_start(warm, previous, share=1.0):
     """The start of a step's solve: the last state ``warm`` carried on along its last change
     ``warm - previous`` as far as the loads go on along theirs, ``warm + share (warm - previous)``
-    (``share``: :func:`load_share`).
+    (``share``: :func:`load_share`; or an array that broadcasts against the states, a share per row).
 
     The states of slowly varying inputs lie on a smooth curve: started from ``2 warm - previous``
     the start error is of second order in the step (measured, it halves the Newton iterations).
@@ -365,7 +365,7 @@ def extrapolated_motion(warm, previous, share: float = 1.0):
     if previous is None or warm is None or previous.shape != warm.shape:
         return warm
     rolled = (warm[:, ORBITAL] != 0.0) & (previous[:, ORBITAL] != 0.0)      # a loaded ball orbits
-    return warm + (share * rolled)[:, None] * (warm - previous)
+    return extrapolated_start(warm, previous, (share * rolled)[:, None])
 
 
 def encode_state(value):
