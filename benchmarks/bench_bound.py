@@ -18,45 +18,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_realtime import SCENARIOS, scenario  # noqa: E402
+from bench_realtime import SCENARIOS, step_variants  # noqa: E402
 from timing import print_table  # noqa: E402
-
-
-def run(name: str, caps: list[float]) -> dict:
-    """Per cap: the step times [ms] (the first after the start at zero loads first) and the steps flagged."""
-    from slewing_model import Loads, load_bearing
-    from slewing_model.distribution import bime
-    from slewing_model.rings.superelement import build_superelement
-    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
-
-    case = scenario(name)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="fine", progress=False)
-    settings = SimulatorSettings(ring_model="flexible", load_frame="rotating", life=True, step_work="bounded",
-                                 contact_kernel="auto")
-    sims = [BearingSimulator(bearing, superelement, settings) for _ in caps]
-    for sim in sims:
-        sim.step(Loads(), 0.0, 0.0)                     # the FMU's start values, solved at initialization
-    found = [{"times": [], "flagged": 0} for _ in caps]
-    default = bime.BOUNDED_WORK
-    try:
-        for k in range(case.steps):
-            order = range(len(caps)) if k % 2 else reversed(range(len(caps)))
-            for i in order:
-                bime.BOUNDED_WORK = caps[i]
-                start = time.perf_counter()
-                out = sims[i].step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
-                found[i]["times"].append(1e3 * (time.perf_counter() - start))
-                found[i]["flagged"] += not out.distribution.converged
-    finally:
-        bime.BOUNDED_WORK = default
-    return found
 
 
 def main() -> None:
@@ -65,7 +33,8 @@ def main() -> None:
     parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
     args = parser.parse_args()
     scenarios = ["nrel"] + [s for s in args.scenarios if s != "nrel"]     # NREL first: its median is the unit
-    results = {name: run(name, args.work) for name in scenarios}
+    results = {name: step_variants(name, "bounded", [{"BOUNDED_WORK": cap} for cap in args.work], start_values=True)
+               for name in scenarios}
     nrel_median = float(np.median(results["nrel"][0]["times"][1:]))
     rows = []
     for name in scenarios:

@@ -15,44 +15,13 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_realtime import SCENARIOS, scenario  # noqa: E402
+from bench_realtime import SCENARIOS, step_variants  # noqa: E402
 from timing import print_table  # noqa: E402
-
-
-def run(name: str, step_work: str) -> dict:
-    """Per version ("on", "off"): step times [ms] (the first, cold, left out), flagged steps, and
-    the iterations of the slowest step."""
-    from slewing_model import Loads, load_bearing
-    from slewing_model.distribution import bime
-    from slewing_model.rings.superelement import build_superelement
-    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
-
-    case = scenario(name)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="fine", progress=False)
-    held_start = {"on": bime.HELD_START, "off": math.inf}
-    sims = {version: BearingSimulator(bearing, superelement, SimulatorSettings(
-        ring_model="flexible", load_frame="rotating", life=True, step_work=step_work, contact_kernel="auto"))
-        for version in held_start}
-    found = {version: {"times": [], "flagged": 0, "iterations": []} for version in held_start}
-    try:
-        for k in range(case.steps):
-            for version in (("on", "off") if k % 2 else ("off", "on")):
-                bime.HELD_START = held_start[version]
-                start = time.perf_counter()
-                out = sims[version].step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
-                found[version]["times"].append(1e3 * (time.perf_counter() - start))
-                found[version]["flagged"] += not out.distribution.converged
-                found[version]["iterations"].append(out.distribution.iterations)
-    finally:
-        bime.HELD_START = held_start["on"]
-    return found
 
 
 def main() -> None:
@@ -62,7 +31,7 @@ def main() -> None:
     rows = []
     for name in args.scenarios:
         for step_work in ("complete", "bounded"):
-            found = run(name, step_work)
+            found = dict(zip(("on", "off"), step_variants(name, step_work, [{}, {"HELD_START": math.inf}])))
             for version in ("on", "off"):
                 times = np.array(found[version]["times"][1:])
                 slowest = int(np.argmax(times)) + 1

@@ -101,6 +101,47 @@ def scenario(name: str, duration: float = 20.0) -> Case:
     raise ValueError(f"scenario {name!r}: must be one of {', '.join(SCENARIOS)}")
 
 
+def step_variants(name: str, step_work: str, variants: list[dict], start_values: bool = False) -> list[dict]:
+    """The scenario ``name`` stepped through one library simulator per variant (the pitch bearing, flexible
+    rings, compiled kernels, friction and life on), each variant a set of the load distribution's module
+    constants (``{"BOUNDED_WORK": 8e7}``, :mod:`slewing_model.distribution.bime`) set before each of its
+    steps, the order of the variants reversed every other step so that all see the same machine load.
+    ``start_values``: each simulator first solves zero loads, as an FMU leaving initialization with its
+    start values. Per variant: the step times [ms], the steps flagged and each step's Newton iterations."""
+    import time
+
+    from slewing_model import Loads, load_bearing
+    from slewing_model.distribution import bime
+    from slewing_model.rings.superelement import build_superelement
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    case = scenario(name)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="fine", progress=False)
+    settings = SimulatorSettings(ring_model="flexible", load_frame="rotating", life=True, step_work=step_work,
+                                 contact_kernel="auto")
+    sims = [BearingSimulator(bearing, superelement, settings) for _ in variants]
+    if start_values:
+        for sim in sims:
+            sim.step(Loads(), 0.0, 0.0)
+    found = [{"times": [], "flagged": 0, "iterations": []} for _ in variants]
+    defaults = {key: getattr(bime, key) for variant in variants for key in variant}
+    try:
+        for k in range(case.steps):
+            for i in (range(len(variants)) if k % 2 else reversed(range(len(variants)))):
+                for key, value in variants[i].items():
+                    setattr(bime, key, value)
+                start = time.perf_counter()
+                out = sims[i].step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
+                found[i]["times"].append(1e3 * (time.perf_counter() - start))
+                found[i]["flagged"] += not out.distribution.converged
+                found[i]["iterations"].append(out.distribution.iterations)
+    finally:
+        for key, value in defaults.items():
+            setattr(bime, key, value)
+    return found
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--baseline", default=DEFAULT_BASELINE, help="git revision of the baseline FMU, or 'none'")
