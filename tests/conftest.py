@@ -82,21 +82,27 @@ def table3_host_fmu(tmp_path_factory):
     return _build_table3(tmp_path_factory, "SlewingBearing_table3_host.fmu", runtime="host")
 
 
-def simulators_per_kernel(name: str, steps: int, setting: str):
-    """A benchmark case (``benchmarks/cases.py``, coarse superelement, free rings) and two simulators
-    of it that differ only in the kernel ``setting`` (``"friction_kernel"`` or ``"contact_kernel"``):
-    ``{"numpy": ..., "compiled": ...}``."""
+def benchmark_case(name: str, steps: int):
+    """A benchmark case (``benchmarks/cases.py``) of ``steps`` steps, its bearing and the bearing's
+    coarse superelement (free rings)."""
     import sys
 
     sys.path.insert(0, str(ROOT / "benchmarks"))
     from cases import CASES
     from slewing_model import load_bearing
-    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
     from slewing_model.rings.superelement import build_superelement
 
     case = CASES[name](steps)
     bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    return case, bearing, build_superelement(bearing, mesh="coarse", bc="free")
+
+
+def simulators_per_kernel(name: str, steps: int, setting: str):
+    """A benchmark case (:func:`benchmark_case`) and two simulators of it that differ only in the
+    kernel ``setting`` (``"friction_kernel"`` or ``"contact_kernel"``): ``{"numpy": ..., "compiled": ...}``."""
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    case, bearing, superelement = benchmark_case(name, steps)
     frame = "rotating" if case.parameters["load_frame"] == 2 else "fixed"
     return case, {k: BearingSimulator(bearing, superelement, SimulatorSettings(
         ring_model="flexible", load_frame=frame, **{setting: k})) for k in ("numpy", "compiled")}

@@ -330,25 +330,15 @@ def test_a_bounded_run_gets_on_where_the_held_start_leaves_less_than_a_stage(tab
     assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
 
 
-def test_the_yaw_bearing_bounded_from_zero_loads_arrives(monkeypatch):
+def test_the_yaw_bearing_bounded_from_zero_loads_arrives():
     """The 180-ball yaw bearing started at zero loads (an FMU's start values), then its tower-top loads
-    held, bounded: every step keeps to its bound and the run arrives at the complete step's
-    equilibrium. Its preload's operator has 720 rows, one stage of its inverse more than the bound
-    leaves after the held-rings start: before, no operator was ever formed or inverted again, and
-    every step answered the start values (residual 1), flagged."""
-    import sys
+    held, bounded: the run arrives at the complete step's equilibrium and stays there. Its preload's
+    operator has 720 rows, one stage of its inverse more than the bound leaves after the held-rings
+    start: before, no operator was ever formed or inverted again, and every step answered the start
+    values (residual 1), flagged."""
+    from conftest import benchmark_case
 
-    from slewing_model import load_bearing
-    from slewing_model.rings.superelement import build_superelement
-
-    from conftest import ROOT
-
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from cases import CASES
-
-    case = CASES["yaw"](1)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    case, bearing, superelement = benchmark_case("yaw", 1)
     loads, psi, omega = Loads(*case.loads[0]), case.psi[0], case.omega[0]
     results = {}
     for step_work in ("bounded", "complete"):

@@ -474,22 +474,13 @@ def test_a_start_at_zero_loads_forms_no_operator_of_the_preload_alone(monkeypatc
     precision (it was inverted in double, 32-53 ms). The step reaches the equilibrium a simulator with
     double-precision operators gives (both to the simulator's tolerance, 1e-7: to 1e-6 of the tilts).
     Before the singular case was handled, it raised LinAlgError."""
-    import sys
-
-    from slewing_model import load_bearing
     from slewing_model.distribution import bime
     from slewing_model.rings import reduced_operator
-    from slewing_model.rings.superelement import build_superelement
     from slewing_model.simulation.simulator import BearingSimulator
 
-    from conftest import ROOT
+    from conftest import benchmark_case
 
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from cases import CASES
-
-    case = CASES["yaw"](1)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    case, bearing, superelement = benchmark_case("yaw", 1)
     formed = []
     start_operator = bime.start_operator
 

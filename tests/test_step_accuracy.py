@@ -17,7 +17,7 @@ from slewing_model.distribution.assembly import assemble
 from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 from slewing_model.rings.superelement import build_superelement
 
-from conftest import ROOT
+from conftest import ROOT, benchmark_case
 from statics import load_on_moving_ring
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -126,9 +126,8 @@ def test_the_friction_start_carried_on_is_nearer_the_balls_motions_of_the_step()
     torque is checked against a tight solve by :func:`test_every_step_matches_a_tight_solve`."""
     from slewing_model.simulation.simulator import extrapolated_motion, load_share
 
-    case = CASES["pitch"](STEPS)
-    bearing = load_bearing(case.bearing)
-    sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"), _settings(case))
+    case, bearing, superelement = benchmark_case("pitch", STEPS)
+    sim = BearingSimulator(bearing, superelement, _settings(case))
     states, loads, ratios = [], [], []
     for k in range(case.steps):
         f = Loads(*case.loads[k]).rotated(case.psi[k])
