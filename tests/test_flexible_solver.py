@@ -170,16 +170,23 @@ REVERSALS = [(Loads(Fz=5e4, Mx=2e4), Loads(Fz=5e4, Mx=-2e4)),
              (Loads(Fx=2e4, Fz=5e4, My=1e4), Loads(Fx=-2e4, Fz=5e4, My=-1e4))]
 
 
-@pytest.mark.parametrize("before, after", REVERSALS)
-def test_held_rings_start_balances_the_moving_ring_and_lowers_the_energy(bearing, before, after):
-    # a warm start far from its equilibrium (a moment reversed) first moves the moving ring to its
-    # equilibrium under the new loads with the rings held: force balance on (X, Y, Z, rx, ry) there,
-    # and a total energy (eq 20) below the start's; the ring forces are untouched
+def _far_start(bearing, before, after):
+    """A solver of ``bearing`` (synthetic rings) at the equilibrium of ``before``, that point under
+    ``after`` (far from its equilibrium: residual above HELD_START) and the scaled loads of ``after``."""
     solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
     first = solver.solve(before)
     f_scaled = solver.scaled_load(after)
     start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
     assert start.peak_residual > bime.HELD_START * max(np.abs(f_scaled).max(), start.peak_force)
+    return solver, start, f_scaled
+
+
+@pytest.mark.parametrize("before, after", REVERSALS)
+def test_held_rings_start_balances_the_moving_ring_and_lowers_the_energy(bearing, before, after):
+    # a warm start far from its equilibrium (a moment reversed) first moves the moving ring to its
+    # equilibrium under the new loads with the rings held: force balance on (X, Y, Z, rx, ry) there,
+    # and a total energy (eq 20) below the start's; the ring forces are untouched
+    solver, start, f_scaled = _far_start(bearing, before, after)
     held = solver._held_rings_start(start, after, f_scaled, np.abs(f_scaled).max())
     assert held.total < start.total
     assert np.array_equal(held.y, start.y)
@@ -190,13 +197,9 @@ def test_held_rings_start_balances_the_moving_ring_and_lowers_the_energy(bearing
 def test_held_rings_start_is_not_taken_where_the_loads_grow_in_their_direction(bearing):
     # three times the load: far from its equilibrium, but the moving ring's equilibrium with the rings
     # held loads no contact that was open, and the Newton steps from the old equilibrium serve better
-    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
     before = Loads(Fx=2e4, Fz=5e4, My=1e4)
-    first = solver.solve(before)
     after = Loads(*(3.0 * before.as_array()))
-    f_scaled = solver.scaled_load(after)
-    start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
-    assert start.peak_residual > bime.HELD_START * max(np.abs(f_scaled).max(), start.peak_force)
+    solver, start, f_scaled = _far_start(bearing, before, after)
     assert solver._held_rings_start(start, after, f_scaled, np.abs(f_scaled).max()) is start
 
 
@@ -440,10 +443,11 @@ def test_an_operator_too_ill_conditioned_for_single_precision_is_inverted_in_dou
 
 
 def test_an_operator_singular_in_single_precision_is_made_again_in_double_over_the_next_steps():
-    """Where the solve can wait (``again``: a bounded one), a ``W`` singular in single precision (here two
-    of its rows equal there; the yaw bearing's preload alone, of condition 4e13) comes back as a pending operator through the factor in
-    double (method 2) at stage 0, not inverted at once (32 ms on the yaw bearing's 720 rows, a bounded
-    step's); its stages then give an inverse in double that passes the check."""
+    """Where the solve can wait (``again``: a bounded one), a ``W`` singular in single precision (here
+    two of its rows equal there; the yaw bearing's preload alone, of condition 4e13) comes back as a
+    pending operator through the factor in double (method 2) at stage 0, not inverted at once (32 ms
+    on the yaw bearing's 720 rows, a bounded step's); its stages then give an inverse in double that
+    passes the check."""
     from slewing_model.rings.reduced_operator import STAGES, PendingOperator, advance_operator, passes_check
 
     rows = 300
@@ -474,7 +478,6 @@ def test_a_start_at_zero_loads_forms_no_operator_of_the_preload_alone(monkeypatc
     precision (it was inverted in double, 32-53 ms). The step reaches the equilibrium a simulator with
     double-precision operators gives (both to the simulator's tolerance, 1e-7: to 1e-6 of the tilts).
     Before the singular case was handled, it raised LinAlgError."""
-    from slewing_model.distribution import bime
     from slewing_model.rings import reduced_operator
     from slewing_model.simulation.simulator import BearingSimulator
 
