@@ -124,7 +124,7 @@ def test_the_friction_start_carried_on_is_nearer_the_balls_motions_of_the_step()
     is about half as far from the step's ball motions as the last step's are (the median over the
     steps of the balls' median distance: 0.55; 1 where the loads turn back, share 0). Every step's
     torque is checked against a tight solve by :func:`test_every_step_matches_a_tight_solve`."""
-    from slewing_model.simulation.simulator import extrapolated_motion, load_share
+    from slewing_model.simulation.simulator import ORBITAL, extrapolated_motion, load_share
 
     case, bearing, superelement = benchmark_case("pitch", STEPS)
     sim = BearingSimulator(bearing, superelement, _settings(case))
@@ -136,7 +136,7 @@ def test_the_friction_start_carried_on_is_nearer_the_balls_motions_of_the_step()
         states.append(sim.get_state()["friction"])
         if k >= 2:
             start = extrapolated_motion(states[-2], states[-3], load_share(loads[-1], loads[-2], loads[-3]))
-            rolled = (states[-1][:, 3] != 0) & (states[-2][:, 3] != 0) & (states[-3][:, 3] != 0)
+            rolled = np.all([state[:, ORBITAL] != 0 for state in states[-3:]], axis=0)     # loaded in all three
             carried = np.linalg.norm((start - states[-1])[rolled], axis=1)
             last = np.linalg.norm((states[-2] - states[-1])[rolled], axis=1)
             ratios.append(np.median(carried) / np.median(last))
