@@ -1,0 +1,190 @@
+"""Where a co-simulation step's time goes, and what of it one compiled call could save (issue 31).
+
+The pitch bearing as the FMU runs it (flexible rings, loads in the blade-root frame, friction and
+life on, complete steps), stepped through the library's simulator under a scenario of
+``bench_realtime.py`` (``nrel``, ``turbulence``, ...). Each part of a step is timed where it is
+called (the method wrapped for the run):
+
+- ``set_rotation``: the solver's assembly at the ring's angle;
+- ``solve``, and within it the compiled Newton iterations with the kept operator
+  (``kept iterations``), the start and line-search evaluations (``evaluate``), the operator's turn
+  (``turned``), the results (``result``) and the rest (the Python between them);
+- ``friction``, and within it the one compiled call of the balls' equilibrium and torque;
+- ``life``: the raceway map and damage;
+- ``simulator``: the step's own bookkeeping (the warm starts, the state), what is left of the step.
+
+Steps that form, border or invert an operator (their time is that work's: ``bench_operator.py``)
+are counted apart; the table is of the other steps, the usual ones. The compiled calls are then
+called again with the arguments they had in those steps, each several times in a row ("hot": its
+data in the cache, no Python around it): the sum of the hot calls is what a step made of one
+compiled call would still cost, the floor of issue 31's "one compiled call", against the median of
+the step as it runs now. The gap between a call in the step and the same call hot is the cost of
+its cache misses in the step: the Newton iterations evict the friction's data and back.
+
+Run: .venv/bin/python benchmarks/bench_step_parts.py [--scenarios nrel turbulence] [--steps 3000]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_realtime import scenario  # noqa: E402
+from timing import print_table  # noqa: E402
+
+from slewing_model import Loads, load_bearing  # noqa: E402
+from slewing_model.distribution import bime  # noqa: E402
+from slewing_model.friction import ball_kinematics, torque  # noqa: E402
+from slewing_model.life.duty import LifeAccumulator  # noqa: E402
+from slewing_model.rings.superelement import build_superelement  # noqa: E402
+from slewing_model.simulation import simulator  # noqa: E402
+
+#: the parts timed, (label, owner, attribute); a label with a leading space is a part of the one above
+PARTS = (
+    ("set_rotation", bime.BimeSolver, "set_rotation"),
+    ("solve", bime.BimeSolver, "solve"),
+    (" kept iterations", bime.BimeSolver, "_kept_iterations"),
+    (" evaluate", bime.BimeSolver, "_evaluate"),
+    (" turned", bime.BimeSolver, "_turned"),
+    (" result", bime.BimeSolver, "_result"),
+    ("friction", simulator, "friction_torque"),
+    (" compiled call", torque, "warm_friction_step"),
+    ("life", LifeAccumulator, "step"),
+)
+#: what marks a step with operator work
+OPERATOR_WORK = ((bime.BimeSolver, "_start_operator"), (bime.BimeSolver, "_advance"), (bime, "update_operator"))
+#: the compiled calls replayed hot: (label, module, factory name)
+COMPILED = ((" kept iterations", bime, "compiled_kept_iterations"),
+            (" compiled call", ball_kinematics, "compiled_friction_step"))
+REPLAYS = 5
+
+
+@contextmanager
+def patched(owner, name, wrapper):
+    original = getattr(owner, name)
+    setattr(owner, name, wrapper(original))
+    try:
+        yield
+    finally:
+        setattr(owner, name, original)
+
+
+def timer(label, spent):
+    def wrap(original):
+        def timed(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return original(*args, **kwargs)
+            finally:
+                spent[label] = spent.get(label, 0.0) + time.perf_counter() - start
+        return timed
+    return wrap
+
+
+def counter(seen):
+    def wrap(original):
+        def counted(*args, **kwargs):
+            seen.append(1)
+            return original(*args, **kwargs)
+        return counted
+    return wrap
+
+
+def recorder(label, calls):
+    """The factory of a compiled loop, whose loop records its arguments (copied) for the replay where
+    ``calls`` is a list (the steps sampled for it; their own times are not used)."""
+    def wrap(factory):
+        def recording_factory():
+            loop = factory()
+            if calls.get("list") is None:
+                return loop
+
+            def recording(*args):
+                calls["list"].append((label, loop, [a.copy() if isinstance(a, np.ndarray) else a for a in args]))
+                return loop(*args)
+            return recording
+        return recording_factory
+    return wrap
+
+
+def run(name: str, steps: int) -> dict:
+    case = scenario(name)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="fine", progress=False)
+    sim = simulator.BearingSimulator(bearing, superelement, simulator.SimulatorSettings(
+        ring_model="flexible", load_frame="rotating", life=True, step_work="complete", contact_kernel="auto"))
+    spent, seen, calls = {}, [], {}
+    usual = {"step": []}
+    replay = []
+    with ExitStack() as stack:
+        for label, owner, attribute in PARTS:
+            stack.enter_context(patched(owner, attribute, timer(label, spent)))
+        for owner, attribute in OPERATOR_WORK:
+            stack.enter_context(patched(owner, attribute, counter(seen)))
+        for label, module, factory in COMPILED:
+            stack.enter_context(patched(module, factory, recorder(label, calls)))
+        for k in range(min(steps, case.steps)):
+            spent.clear()
+            seen.clear()
+            sampled = k >= 50 and k % 10 == 5      # its compiled calls recorded for the replay, not timed
+            calls["list"] = [] if sampled else None
+            start = time.perf_counter()
+            sim.step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
+            total = time.perf_counter() - start
+            if k < 50 or seen:                 # the first steps, and those with operator work, apart
+                continue
+            if sampled:
+                replay.append(calls["list"])
+                continue
+            usual["step"].append(total)
+            for label, _, _ in PARTS:
+                usual.setdefault(label, []).append(spent.get(label, 0.0))
+    hot = {label: [] for label, _, _ in COMPILED}
+    for step_calls in replay:
+        per_label = {label: 0.0 for label in hot}
+        for label, loop, args in step_calls:
+            times = []
+            for _ in range(REPLAYS):
+                fresh = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+                start = time.perf_counter()
+                loop(*fresh)
+                times.append(time.perf_counter() - start)
+            per_label[label] += min(times[1:])         # the first call of a row warms the cache
+        for label, value in per_label.items():
+            hot[label].append(value)
+    return {"usual": {k: 1e6 * np.asarray(v) for k, v in usual.items()},
+            "hot": {k: 1e6 * np.asarray(v) for k, v in hot.items()}, "steps": len(usual["step"])}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenarios", nargs="+", default=["nrel", "turbulence"])
+    parser.add_argument("--steps", type=int, default=3000)
+    args = parser.parse_args()
+    for name in args.scenarios:
+        found = run(name, args.steps)
+        usual, hot = found["usual"], found["hot"]
+        step = float(np.median(usual["step"]))
+        parts = {label: float(np.mean(usual[label])) for label, _, _ in PARTS}
+        rows = [["step", f"{step:.0f}", f"{np.mean(usual['step']):.0f}", "", ""]]
+        for label, _, _ in PARTS:
+            hot_cell = f"{np.median(hot[label]):.0f}" if label in hot else ""
+            rows.append([label, "", f"{parts[label]:.0f}", f"{parts[label] / np.mean(usual['step']):.2f}", hot_cell])
+        top = sum(v for label, v in parts.items() if not label.startswith(" "))
+        inside = {"solve": (" kept iterations", " evaluate", " turned", " result"), "friction": (" compiled call",)}
+        for whole, pieces in inside.items():
+            rows.append([f" {whole}: the rest", "", f"{parts[whole] - sum(parts[p] for p in pieces):.0f}", "", ""])
+        rows.append(["simulator (the step less its parts)", "", f"{np.mean(usual['step']) - top:.0f}", "", ""])
+        print_table(f"{name}: {found['steps']} steps without operator work, us", ["part", "median", "mean",
+                                                                                   "share of the mean", "hot"], rows)
+        floor = sum(float(np.median(v)) for v in hot.values())
+        print(f"the compiled calls hot: {floor:.0f} us, {floor / step:.2f} of the median step ({step:.0f} us)")
+
+
+if __name__ == "__main__":
+    main()
