@@ -9,6 +9,7 @@ import pytest
 from slewing_model import BimeSolver, Loads, solve
 import slewing_model.distribution.bime as bime
 from slewing_model.distribution.bime import solve_dense_newton
+from slewing_model.numerics.compiled import AVAILABLE
 from conftest import symmetric_block_circulant
 from synthetic_rings import synthetic_superelement
 
@@ -170,10 +171,10 @@ REVERSALS = [(Loads(Fz=5e4, Mx=2e4), Loads(Fz=5e4, Mx=-2e4)),
              (Loads(Fx=2e4, Fz=5e4, My=1e4), Loads(Fx=-2e4, Fz=5e4, My=-1e4))]
 
 
-def _far_start(bearing, before, after):
-    """A solver of ``bearing`` (synthetic rings) at the equilibrium of ``before``, that point under
-    ``after`` (far from its equilibrium: residual above HELD_START) and the scaled loads of ``after``."""
-    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count))
+def _far_start(bearing, before, after, kernel="numpy"):
+    """A solver of ``bearing`` (synthetic rings; its loops ``kernel``) at the equilibrium of ``before``, that
+    point under ``after`` (far from its equilibrium: residual above HELD_START) and the scaled loads of ``after``."""
+    solver = BimeSolver(bearing, synthetic_superelement(bearing.ball_count), kernel=kernel)
     first = solver.solve(before)
     f_scaled = solver.scaled_load(after)
     start = solver._evaluate(first.state[:5], first.state[5:], f_scaled)
@@ -192,6 +193,24 @@ def test_held_rings_start_balances_the_moving_ring_and_lowers_the_energy(bearing
     assert np.array_equal(held.y, start.y)
     # the rigid solve stops at a relative residual of 1e-6 of the loads
     assert np.abs(held.gradient).max() <= 1e-5 * np.abs(f_scaled).max()
+
+
+@pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
+@pytest.mark.parametrize("before, after", REVERSALS)
+def test_held_rings_start_compiled_is_the_rigid_solve(bearing, before, after, monkeypatch):
+    # the compiled loop of the held-rings start (kernel._held_rings_solve) takes the steps of the rigid
+    # solver's numpy code on the held grooves (BimeSolver._rigid_solver): the same moving ring's
+    # displacement to round-off, where both stop at the rigid tolerance of 1e-6
+    solver, start, f_scaled = _far_start(bearing, before, after, kernel="compiled")
+    calls = []
+    loop = bime.compiled_held_rings_solve()
+    monkeypatch.setattr(bime, "compiled_held_rings_solve", lambda: lambda *args: calls.append(1) or loop(*args))
+    compiled = solver._held_rings_start(start, after, f_scaled, np.abs(f_scaled).max())
+    assert calls == [1]
+    monkeypatch.setattr(solver, "_compiled", False)
+    numpy_ = solver._held_rings_start(start, after, f_scaled, np.abs(f_scaled).max())
+    assert compiled is not start and numpy_ is not start
+    np.testing.assert_allclose(compiled.qs, numpy_.qs, rtol=0, atol=1e-10 * np.abs(numpy_.qs).max())
 
 
 def test_held_rings_start_is_not_taken_where_the_loads_grow_in_their_direction(bearing):

@@ -55,8 +55,8 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from ..bearing.contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .kernel import (
-    COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_ring_times, compiled_trial_point,
-    contact_results,
+    COMPILED_ARITHMETIC, compiled_held_rings_solve, compiled_jacobian, compiled_kept_iterations, compiled_ring_times,
+    compiled_trial_point, contact_results,
 )
 from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -108,10 +108,23 @@ BOUNDED_ITERATIONS = 12
 #: start at 1e-3-1e-2, a reversal at 2, NREL's first step from zero loads at 1, a load 1.5 times
 #: the last at 0.33
 HELD_START = 0.5
+#: a Newton step's longest move of the moving ring, in ball diameters (a step across a clearance is
+#: limited, then checked by the energy)
+TRUST_LENGTH = 0.02
+#: the Newton steps' damping ``mu``, relative to the springs' reference stiffness (``mu I`` keeps the
+#: moving ring's equations regular where no contact holds a direction)
+DAMPING = 1e-12
+#: the relative tolerance of the rigid solves that start a flexible one (the cold start's, the held-rings start's)
+RIGID_START_TOLERANCE = 1e-6
 #: ... and kept where more than this share of the diagonals it loads were open at the start
 HELD_NEW_CONTACTS = 0.25
-#: the held-rings start's rigid solve counts as this much of a bounded solve's BOUNDED_WORK (its time:
-#: 0.9 ms on the pitch bearing, about half a step's operator work; benchmarks/bench_held_start.py)
+#: the held-rings start's rigid solve counts as this much of a bounded solve's BOUNDED_WORK. Sized by its
+#: time when it was 0.9 ms on the pitch bearing (about half a step's operator work;
+#: benchmarks/bench_held_start.py); compiled since (kernel._held_rings_solve), it takes 0.15 ms, but a step
+#: that tries it is a step after a jump, whose Newton iterations and friction's cold balls cost more too:
+#: charged by its time alone (1e7), the reversal's bounded run flagged 41 steps instead of 54, but 8-17 of its
+#: steps took more than 4.2 ms instead of 2-5, the slowest 5.1-5.2 ms against 4.5-4.7, and its first step
+#: from the start values 5.4-5.5 ms against 4.1-4.6 (three runs; docs/speed.md, "Issue 31, twelfth turn")
 HELD_WORK = 5e7
 STEP_WORK = ("complete", "bounded")
 #: what :meth:`BimeSolver.set_rotation` sets: a solver at the same rotation may take them (BimeSolver._rigid_solver)
@@ -373,8 +386,8 @@ class BimeSolver:
             qs = rigid.solve(loads).state[:5].copy()
             y = rigid._evaluate(qs, y, f_scaled).force.ravel()
 
-        trust = 0.02 * dw
-        mu = 1e-12 * self.reference_stiffness
+        trust = TRUST_LENGTH * dw
+        mu = DAMPING * self.reference_stiffness
         iterations = 0
         bounded = self.step_work == "bounded" and initial is not None
         self._work_left = BOUNDED_WORK if bounded else math.inf
@@ -468,7 +481,7 @@ class BimeSolver:
         rigid = self._rigid
         if rigid is None:
             rigid = self._rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi,
-                                             cage_angle=self.assembly.cage_angle, rtol=1e-6,
+                                             cage_angle=self.assembly.cage_angle, rtol=RIGID_START_TOLERANCE,
                                              max_iterations=self.max_iterations, kernel=self.kernel)
             rigid.edge_angle = np.full(4, np.pi)
             rigid.pressure_limit = math.inf
@@ -488,7 +501,8 @@ class BimeSolver:
         iterations and operators. Re-solving the moving ring's displacement ``(X, Y, Z, rx, ry)``
         with the ring forces held (a rigid-ring solve on the deformed grooves) is a step of block
         descent on the total energy (eq 20) that finds most of the new contact set at the cost of
-        a rigid solve (about 1 ms). It is taken where it lowers the energy and loads contacts that
+        a rigid solve (0.15 ms compiled, :func:`~slewing_model.distribution.kernel._held_rings_solve`;
+        0.7 ms with numpy's rigid solver). It is taken where it lowers the energy and loads contacts that
         were open: more than :data:`HELD_NEW_CONTACTS` of its loaded diagonals (the pitch bearing's
         reversal: 56 of 109; 14 Newton iterations become 9). Where the loads grow in their
         direction (a jump, the first step from zero loads) it loads no new contacts, and its steps
@@ -500,11 +514,21 @@ class BimeSolver:
         11 ms, against 8 and 6 ms; complete: 53 against 20 ms)."""
         if p.peak_residual <= HELD_START * max(load_scale, p.peak_force):
             return p
-        self._work_left -= HELD_WORK          # a bounded solve counts the rigid solve's time as operator work
-        try:
-            qs = self._rigid_solver(p.ring_motion).solve(loads, initial=p.qs).state[:5].copy()
-        except NoEquilibriumError:
-            return p
+        self._work_left -= HELD_WORK          # a bounded solve counts the held start as operator work
+        if self._compiled:                    # the rigid solve's iterations in one compiled loop
+            dw = self.bearing.ball_diameter
+            rules = np.array([RIGID_START_TOLERANCE, load_scale, TRUST_LENGTH * dw, dw * dw,
+                              DAMPING * self.reference_stiffness, self.max_iterations])
+            qs, _, found = compiled_held_rings_solve()(
+                self._separation, self._jacobian_rows, p.qs, p.y, p.ring_motion, self.assembly.natural_length,
+                self.assembly.stiffness, f_scaled, self._loaded_from, rules)
+            if not found:
+                return p
+        else:
+            try:
+                qs = self._rigid_solver(p.ring_motion).solve(loads, initial=p.qs).state[:5].copy()
+            except NoEquilibriumError:
+                return p
         held = self._evaluate(qs, p.y, f_scaled, p.ring_motion)
         newly_loaded = int(np.count_nonzero(held.loaded & ~p.loaded))
         no_operator = self._reduced is None and self.pending_operator is None

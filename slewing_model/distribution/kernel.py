@@ -15,7 +15,8 @@ of operations, one loop each:
   (:func:`_trial_point`), the modified Newton step (:func:`_newton_step`); and the iterations
   that keep the reduced operator as they are, one after the other in one loop
   (:func:`_kept_iterations`, with the ring compliance's product :func:`_ring_times`: numba has
-  no FFT, so by a real DFT with tables);
+  no FFT, so by a real DFT with tables); the moving ring's equilibrium with the rings held, the
+  start of a solve after a jump of the loads (:func:`_held_rings_solve`);
 * the operator (:data:`COMPILED_ARITHMETIC`, numpy's :data:`slewing_model.rings.reduced_operator.NUMPY_ARITHMETIC`):
   formed (:func:`_operator_matrix`), coupled to the ring's motions (:func:`_operator_coupling`),
   turned with the ring (:func:`_column_turn`), bordered by contacts that close
@@ -719,6 +720,104 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
             np.array([total, energy_scale, peak_force, peak_residual, n_loaded]))
 
 
+_HELD_SIGNATURE = ("Tuple((f8[:], i8, b1))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:, :], f8[:, :], f8[:], f8, "
+                   "f8[:])")
+
+
+def _held_rings_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, stiffness, f_scaled,
+                      loaded_from, rules):
+    """The moving ring's equilibrium with the rings held as they are deformed, from ``qs``: the rigid
+    model's solve of ``BimeSolver.solve`` (:mod:`slewing_model.distribution.bime`) on the grooves moved by
+    the ring motion ``M y`` (``ring_motion``; ``y`` the ring forces, held), the held-rings start of
+    ``BimeSolver._held_rings_start``. Each iteration the Newton step of the rigid model
+    (``BimeSolver._rigid_direction``: ``(sum J^T A J + mu I) dq = -(J^T f - F)``, ``A`` the springs'
+    2 x 2 stiffness, eqs 7-8), limited to the trust length, and the backtracking line search on the
+    energy (eq 20 with the rings' term held), at :func:`_trial_point`'s springs; the stop rule on
+    the largest of ``|J^T f - F|`` over the largest of the loads and the springs' forces.
+
+    ``rules``: the tolerance, the load scale, the trust length, the squared ball diameter, ``mu``
+    and the iterations allowed. Returns ``qs`` reached, the iterations and whether it converged
+    (False where the rigid solve raises NoEquilibriumError: no convergence, a line search that
+    fails, a moving ring beyond the ball diameter, a residual not finite; or a singular step)."""
+    rtol, load_scale, trust, dw2, mu = rules[0], rules[1], rules[2], rules[3], rules[4]
+    max_iterations = int(rules[5])
+    n_balls = separation.shape[0]
+    still, still_y = np.zeros(5), np.zeros(y.size)
+    (qs, _, _, _, delta, q, _, n, length, gradient, _, _, terms) = _trial_point(
+        separation, jacobian_rows, qs, still, y, still_y, ring_motion, still_y, 0.0, natural_length, stiffness,
+        f_scaled, loaded_from)
+    total, energy_scale = terms[0] - terms[2], terms[0] + abs(terms[2])
+    hessian = np.empty((5, 5))
+    block = np.empty((2, 2))
+    iterations = 0
+    while True:
+        peak_force = peak_residual = 0.0
+        for b in range(n_balls):
+            for d in range(2):
+                peak_force = max(peak_force, q[b, d])
+        for k in range(5):
+            peak_residual = max(peak_residual, abs(gradient[k]))
+        if not math.isfinite(gradient.sum()):
+            peak_residual = math.nan
+        scale = max(load_scale, peak_force, 1e-300)
+        residual = peak_residual / scale
+        if not math.isfinite(residual):
+            return qs, iterations, False
+        if residual <= rtol or scale == 1e-300:
+            return qs, iterations, True
+        if iterations >= max_iterations:
+            return qs, iterations, False
+        iterations += 1
+        hessian[:, :] = 0.0
+        for b in range(n_balls):
+            for d in range(2):
+                closed = max(delta[b, d], 0.0)
+                k_normal = 1.5 * stiffness[b, d] * math.sqrt(closed)         # d q / d delta (eq 8)
+                across = q[b, d] / length[b, d]
+                for r in range(2):
+                    for c in range(2):
+                        nn = n[b, d, r] * n[b, d, c]
+                        block[r, c] = k_normal * nn + across * ((1.0 if r == c else 0.0) - nn)
+                row = 4 * b + 2 * d
+                for k in range(5):
+                    for m in range(5):
+                        value = 0.0
+                        for r in range(2):
+                            for c in range(2):
+                                value += jacobian_rows[row + r, k] * block[r, c] * jacobian_rows[row + c, m]
+                        hessian[k, m] += value
+        for k in range(5):
+            hessian[k, k] += mu
+        ok, step = _solve_small(hessian, -gradient.reshape(5, 1))
+        if not ok:
+            return qs, iterations, False
+        dq = step[:, 0].copy()
+        slope = 0.0
+        for k in range(5):
+            slope += gradient[k] * dq[k]
+        norm = math.sqrt(dq[0] ** 2 + dq[1] ** 2 + dq[2] ** 2 + dq[3] ** 2 + dq[4] ** 2)
+        if norm > trust:
+            dq *= trust / norm
+            slope *= trust / norm
+        t = 1.0
+        accepted = False
+        for _ in range(60):
+            (qs_t, _, _, _, delta_t, q_t, _, n_t, length_t, gradient_t, _, _, terms_t) = _trial_point(
+                separation, jacobian_rows, qs, dq, y, still_y, ring_motion, still_y, t, natural_length, stiffness,
+                f_scaled, loaded_from)
+            total_t, scale_t = terms_t[0] - terms_t[2], terms_t[0] + abs(terms_t[2])
+            if total_t <= total + 1e-4 * t * min(slope, 0.0) + 1e-12 * max(energy_scale, scale_t):
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            return qs, iterations, False
+        qs, delta, q, n, length, gradient = qs_t, delta_t, q_t, n_t, length_t, gradient_t
+        total, energy_scale = total_t, scale_t
+        if qs[0] ** 2 + qs[1] ** 2 + qs[2] ** 2 + qs[3] ** 2 + qs[4] ** 2 > dw2:
+            return qs, iterations, False
+
+
 #: the helpers the load distribution's loops call
 _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_periodic_interp",
             "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse")
@@ -746,6 +845,7 @@ compiled_contact_results = loop_factory(KERNELS, _compile, _contact_results, _RE
 compiled_add_groove_errors = loop_factory(KERNELS, _compile, _add_groove_errors, _GROOVE_ERRORS_SIGNATURE)
 compiled_ring_times = loop_factory(KERNELS, _compile, _ring_times, _RING_TIMES_SIGNATURE)
 compiled_kept_iterations = loop_factory(KERNELS, _compile, _kept_iterations, _KEPT_SIGNATURE)
+compiled_held_rings_solve = loop_factory(KERNELS, _compile, _held_rings_solve, _HELD_SIGNATURE)
 
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------
