@@ -55,7 +55,7 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from ..bearing.contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .kernel import (
-    COMPILED_ARITHMETIC, compiled_held_rings_solve, compiled_jacobian, compiled_kept_iterations, compiled_ring_times,
+    COMPILED_ARITHMETIC, compiled_rigid_solve, compiled_jacobian, compiled_kept_iterations, compiled_ring_times,
     compiled_trial_point, contact_results,
 )
 from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
@@ -120,7 +120,7 @@ RIGID_START_TOLERANCE = 1e-6
 HELD_NEW_CONTACTS = 0.25
 #: the held-rings start's rigid solve counts as this much of a bounded solve's BOUNDED_WORK. Sized by its
 #: time when it was 0.9 ms on the pitch bearing (about half a step's operator work;
-#: benchmarks/bench_held_start.py); compiled since (kernel._held_rings_solve), it takes 0.15 ms, but a step
+#: benchmarks/bench_held_start.py); compiled since (kernel._rigid_solve), it takes 0.15 ms, but a step
 #: that tries it is a step after a jump, whose Newton iterations and friction's cold balls cost more too:
 #: charged by its time alone (1e7), the reversal's bounded run flagged 41 steps instead of 54, but 8-17 of its
 #: steps took more than 4.2 ms instead of 2-5, the slowest 5.1-5.2 ms against 4.5-4.7, and its first step
@@ -397,8 +397,18 @@ class BimeSolver:
         self._stage_due = self._spread = initial is not None    # a new operator's inverse may be spread over steps
         if initial is None:
             self.pending_operator = None                  # a cold solve depends on nothing before it
-        point = self._evaluate(qs, y, f_scaled)
         load_scale = max(map(abs, f_scaled.tolist()))
+        if not flexible and self._compiled:
+            # the rigid model's iterations in one compiled loop; where it stops short, the loop below runs them
+            # again from the start and answers, or raises, as it always did
+            still = np.zeros(4 * n_balls)
+            found = self._compiled_rigid_solve(qs, still, still, f_scaled, load_scale, self.rtol, limit)
+            if found is not None:
+                qs, done, e, delta, q, (total, peak_force, peak_residual) = found
+                end = _Point(qs, y, e, delta, q, None, None, None, None, total, None, None, None, peak_force,
+                             peak_residual, None, None)               # what _result reads of it
+                return self._result(loads, end, done, peak_residual / max(load_scale, peak_force, 1e-300))
+        point = self._evaluate(qs, y, f_scaled)
         if flexible and initial is not None and point.any_loaded:
             point = self._held_rings_start(point, loads, f_scaled, load_scale)
         handed_back = False                               # the compiled loop stopped before this iteration
@@ -501,7 +511,7 @@ class BimeSolver:
         iterations and operators. Re-solving the moving ring's displacement ``(X, Y, Z, rx, ry)``
         with the ring forces held (a rigid-ring solve on the deformed grooves) is a step of block
         descent on the total energy (eq 20) that finds most of the new contact set at the cost of
-        a rigid solve (0.15 ms compiled, :func:`~slewing_model.distribution.kernel._held_rings_solve`;
+        a rigid solve (0.15 ms compiled, :func:`~slewing_model.distribution.kernel._rigid_solve`;
         0.7 ms with numpy's rigid solver). It is taken where it lowers the energy and loads contacts that
         were open: more than :data:`HELD_NEW_CONTACTS` of its loaded diagonals (the pitch bearing's
         reversal: 56 of 109; 14 Newton iterations become 9). Where the loads grow in their
@@ -516,14 +526,11 @@ class BimeSolver:
             return p
         self._work_left -= HELD_WORK          # a bounded solve counts the held start as operator work
         if self._compiled:                    # the rigid solve's iterations in one compiled loop
-            dw = self.bearing.ball_diameter
-            rules = np.array([RIGID_START_TOLERANCE, load_scale, TRUST_LENGTH * dw, dw * dw,
-                              DAMPING * self.reference_stiffness, self.max_iterations])
-            qs, _, found = compiled_held_rings_solve()(
-                self._separation, self._jacobian_rows, p.qs, p.y, p.ring_motion, self.assembly.natural_length,
-                self.assembly.stiffness, f_scaled, self._loaded_from, rules)
-            if not found:
+            found = self._compiled_rigid_solve(p.qs, p.y, p.ring_motion, f_scaled, load_scale, RIGID_START_TOLERANCE,
+                                               self.max_iterations)
+            if found is None:
                 return p
+            qs = found[0]
         else:
             try:
                 qs = self._rigid_solver(p.ring_motion).solve(loads, initial=p.qs).state[:5].copy()
@@ -536,6 +543,19 @@ class BimeSolver:
         if held.total < p.total and (opened or no_operator):
             return held
         return p
+
+    def _compiled_rigid_solve(self, qs, y, ring_motion, f_scaled, load_scale, rtol, limit):
+        """The rigid model's iterations of :meth:`solve` from ``qs`` on the grooves moved by the held ring
+        motion ``ring_motion`` (``M y``), in one compiled loop (:func:`~slewing_model.distribution.kernel._rigid_solve`):
+        the moving ring's displacement reached, the iterations and the springs there (``e``, ``delta``,
+        ``q``, ``(total energy, largest force, largest residual)``), or None where the loop of
+        :meth:`solve` would not converge within ``limit`` iterations or would raise."""
+        dw = self.bearing.ball_diameter
+        rules = np.array([rtol, load_scale, TRUST_LENGTH * dw, dw * dw, DAMPING * self.reference_stiffness, limit])
+        qs, iterations, converged, e, delta, q, terms = compiled_rigid_solve()(
+            self._separation, self._jacobian_rows, qs, y, ring_motion, self.assembly.natural_length,
+            self.assembly.stiffness, f_scaled, self._loaded_from, rules)
+        return (qs, iterations, e, delta, q, terms) if converged else None
 
     def _ring_times(self, v: np.ndarray) -> np.ndarray:
         """``M v``: the ring compliance's product (numpy's, :class:`~slewing_model.rings.compliance.BlockCirculant`;

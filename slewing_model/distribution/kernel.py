@@ -15,8 +15,8 @@ of operations, one loop each:
   (:func:`_trial_point`), the modified Newton step (:func:`_newton_step`); and the iterations
   that keep the reduced operator as they are, one after the other in one loop
   (:func:`_kept_iterations`, with the ring compliance's product :func:`_ring_times`: numba has
-  no FFT, so by a real DFT with tables); the moving ring's equilibrium with the rings held, the
-  start of a solve after a jump of the loads (:func:`_held_rings_solve`);
+  no FFT, so by a real DFT with tables); the rigid model's iterations, which also start a
+  flexible solve after a jump of the loads with the rings held (:func:`_rigid_solve`);
 * the operator (:data:`COMPILED_ARITHMETIC`, numpy's :data:`slewing_model.rings.reduced_operator.NUMPY_ARITHMETIC`):
   formed (:func:`_operator_matrix`), coupled to the ring's motions (:func:`_operator_coupling`),
   turned with the ring (:func:`_column_turn`), bordered by contacts that close
@@ -720,30 +720,31 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
             np.array([total, energy_scale, peak_force, peak_residual, n_loaded]))
 
 
-_HELD_SIGNATURE = ("Tuple((f8[:], i8, b1))(f8[:, :, :], f8[:, :], f8[:], f8[:], f8[:], f8[:, :], f8[:, :], f8[:], f8, "
-                   "f8[:])")
+_RIGID_SIGNATURE = ("Tuple((f8[:], i8, b1, f8[:, :, :], f8[:, :], f8[:, :], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], "
+                    "f8[:], f8[:, :], f8[:, :], f8[:], f8, f8[:])")
 
 
-def _held_rings_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, stiffness, f_scaled,
-                      loaded_from, rules):
-    """The moving ring's equilibrium with the rings held as they are deformed, from ``qs``: the rigid
-    model's solve of ``BimeSolver.solve`` (:mod:`slewing_model.distribution.bime`) on the grooves moved by
-    the ring motion ``M y`` (``ring_motion``; ``y`` the ring forces, held), the held-rings start of
-    ``BimeSolver._held_rings_start``. Each iteration the Newton step of the rigid model
-    (``BimeSolver._rigid_direction``: ``(sum J^T A J + mu I) dq = -(J^T f - F)``, ``A`` the springs'
-    2 x 2 stiffness, eqs 7-8), limited to the trust length, and the backtracking line search on the
-    energy (eq 20 with the rings' term held), at :func:`_trial_point`'s springs; the stop rule on
+def _rigid_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, stiffness, f_scaled, loaded_from,
+                 rules):
+    """The rigid model's solve of ``BimeSolver.solve`` (:mod:`slewing_model.distribution.bime`) from ``qs``,
+    on grooves moved by a held ring motion ``M y`` (``ring_motion``, ``y`` the ring forces; zero for the
+    rigid model itself): the moving ring's equilibrium with the rings held as they are deformed, the
+    held-rings start of ``BimeSolver._held_rings_start``. Each iteration the Newton step of the rigid
+    model (``BimeSolver._rigid_direction``: ``(sum J^T A J + mu I) dq = -(J^T f - F)``, ``A`` the
+    springs' 2 x 2 stiffness, eqs 7-8), limited to the trust length, and the backtracking line search
+    on the energy (eq 20, the rings' term held), at :func:`_trial_point`'s springs; the stop rule on
     the largest of ``|J^T f - F|`` over the largest of the loads and the springs' forces.
 
     ``rules``: the tolerance, the load scale, the trust length, the squared ball diameter, ``mu``
-    and the iterations allowed. Returns ``qs`` reached, the iterations and whether it converged
-    (False where the rigid solve raises NoEquilibriumError: no convergence, a line search that
-    fails, a moving ring beyond the ball diameter, a residual not finite; or a singular step)."""
+    and the iterations allowed. Returns ``qs`` reached, the iterations, whether it converged (False
+    where the solver's loop raises NoEquilibriumError: no convergence, a line search that fails, a
+    moving ring beyond the ball diameter, a residual not finite; or a singular step), and at ``qs``
+    the springs' ``e``, ``delta``, ``q`` and ``(total energy, largest force, largest residual)``."""
     rtol, load_scale, trust, dw2, mu = rules[0], rules[1], rules[2], rules[3], rules[4]
     max_iterations = int(rules[5])
     n_balls = separation.shape[0]
     still, still_y = np.zeros(5), np.zeros(y.size)
-    (qs, _, _, _, delta, q, _, n, length, gradient, _, _, terms) = _trial_point(
+    (qs, _, _, e, delta, q, _, n, length, gradient, _, _, terms) = _trial_point(
         separation, jacobian_rows, qs, still, y, still_y, ring_motion, still_y, 0.0, natural_length, stiffness,
         f_scaled, loaded_from)
     total, energy_scale = terms[0] - terms[2], terms[0] + abs(terms[2])
@@ -761,12 +762,13 @@ def _held_rings_solve(separation, jacobian_rows, qs, y, ring_motion, natural_len
             peak_residual = math.nan
         scale = max(load_scale, peak_force, 1e-300)
         residual = peak_residual / scale
+        point = np.array([total, peak_force, peak_residual])
         if not math.isfinite(residual):
-            return qs, iterations, False
+            return qs, iterations, False, e, delta, q, point
         if residual <= rtol or scale == 1e-300:
-            return qs, iterations, True
+            return qs, iterations, True, e, delta, q, point
         if iterations >= max_iterations:
-            return qs, iterations, False
+            return qs, iterations, False, e, delta, q, point
         iterations += 1
         hessian[:, :] = 0.0
         for b in range(n_balls):
@@ -790,7 +792,7 @@ def _held_rings_solve(separation, jacobian_rows, qs, y, ring_motion, natural_len
             hessian[k, k] += mu
         ok, step = _solve_small(hessian, -gradient.reshape(5, 1))
         if not ok:
-            return qs, iterations, False
+            return qs, iterations, False, e, delta, q, point
         dq = step[:, 0].copy()
         slope = 0.0
         for k in range(5):
@@ -802,7 +804,7 @@ def _held_rings_solve(separation, jacobian_rows, qs, y, ring_motion, natural_len
         t = 1.0
         accepted = False
         for _ in range(60):
-            (qs_t, _, _, _, delta_t, q_t, _, n_t, length_t, gradient_t, _, _, terms_t) = _trial_point(
+            (qs_t, _, _, e_t, delta_t, q_t, _, n_t, length_t, gradient_t, _, _, terms_t) = _trial_point(
                 separation, jacobian_rows, qs, dq, y, still_y, ring_motion, still_y, t, natural_length, stiffness,
                 f_scaled, loaded_from)
             total_t, scale_t = terms_t[0] - terms_t[2], terms_t[0] + abs(terms_t[2])
@@ -811,11 +813,11 @@ def _held_rings_solve(separation, jacobian_rows, qs, y, ring_motion, natural_len
                 break
             t *= 0.5
         if not accepted:
-            return qs, iterations, False
-        qs, delta, q, n, length, gradient = qs_t, delta_t, q_t, n_t, length_t, gradient_t
+            return qs, iterations, False, e, delta, q, point
+        qs, e, delta, q, n, length, gradient = qs_t, e_t, delta_t, q_t, n_t, length_t, gradient_t
         total, energy_scale = total_t, scale_t
         if qs[0] ** 2 + qs[1] ** 2 + qs[2] ** 2 + qs[3] ** 2 + qs[4] ** 2 > dw2:
-            return qs, iterations, False
+            return qs, iterations, False, e, delta, q, point
 
 
 #: the helpers the load distribution's loops call
@@ -845,7 +847,7 @@ compiled_contact_results = loop_factory(KERNELS, _compile, _contact_results, _RE
 compiled_add_groove_errors = loop_factory(KERNELS, _compile, _add_groove_errors, _GROOVE_ERRORS_SIGNATURE)
 compiled_ring_times = loop_factory(KERNELS, _compile, _ring_times, _RING_TIMES_SIGNATURE)
 compiled_kept_iterations = loop_factory(KERNELS, _compile, _kept_iterations, _KEPT_SIGNATURE)
-compiled_held_rings_solve = loop_factory(KERNELS, _compile, _held_rings_solve, _HELD_SIGNATURE)
+compiled_rigid_solve = loop_factory(KERNELS, _compile, _rigid_solve, _RIGID_SIGNATURE)
 
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------
