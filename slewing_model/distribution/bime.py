@@ -55,7 +55,7 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from ..bearing.contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .kernel import (
-    COMPILED_ARITHMETIC, compiled_rigid_solve, compiled_jacobian, compiled_kept_iterations, compiled_ring_times,
+    COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_rigid_solve, compiled_ring_times,
     compiled_trial_point, contact_results,
 )
 from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
