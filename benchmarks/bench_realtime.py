@@ -129,7 +129,7 @@ def step_variants(name: str, step_work: str, variants: list[dict], start_values:
     try:
         for k in range(case.steps):
             for i in (range(len(variants)) if k % 2 else reversed(range(len(variants)))):
-                for key, value in variants[i].items():
+                for key, value in {**defaults, **variants[i]}.items():      # a variant without a key: its default
                     setattr(bime, key, value)
                 start = time.perf_counter()
                 out = sims[i].step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
