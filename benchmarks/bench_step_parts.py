@@ -14,12 +14,14 @@ called (the method wrapped for the run):
 - ``simulator``: the step's own bookkeeping (the warm starts, the state), what is left of the step.
 
 Steps that form, border or invert an operator (their time is that work's: ``bench_operator.py``)
-are counted apart; the table is of the other steps, the usual ones. The compiled calls are then
-called again with the arguments they had in those steps, each several times in a row ("hot": its
-data in the cache, no Python around it): the sum of the hot calls is what a step made of one
-compiled call would still cost, the floor of issue 31's "one compiled call", against the median of
-the step as it runs now. The gap between a call in the step and the same call hot is the cost of
-its cache misses in the step: the Newton iterations evict the friction's data and back.
+are counted apart; the table is of the other steps, the usual ones. The compiled calls (the two big
+ones, and the other loops a step calls from Python: the start's trial point, the ring product, the
+operator's turn, the contacts' results, the life map) are then called again with the arguments they had in those steps,
+each several times in a row ("hot": its data and code in the cache, no Python around it): the sum
+of the hot calls is what a step made of one compiled call would still cost, the floor of issue
+31's "one compiled call", against the median of the step as it runs now. The gap between a call in
+the step and the same call hot is what the step's cold caches cost it (the other parts' data and
+code ran in between).
 
 Run: .venv/bin/python benchmarks/bench_step_parts.py [--scenarios nrel turbulence] [--steps 3000]
 """
@@ -39,7 +41,9 @@ from timing import print_table  # noqa: E402
 
 from slewing_model import Loads, load_bearing  # noqa: E402
 from slewing_model.distribution import bime  # noqa: E402
+from slewing_model.distribution import kernel as distribution_kernel  # noqa: E402
 from slewing_model.friction import ball_kinematics, torque  # noqa: E402
+from slewing_model.life import raceway_map  # noqa: E402
 from slewing_model.life.duty import LifeAccumulator  # noqa: E402
 from slewing_model.rings.superelement import build_superelement  # noqa: E402
 from slewing_model.simulation import simulator  # noqa: E402
@@ -56,11 +60,17 @@ PARTS = (
     (" compiled call", torque, "warm_friction_step"),
     ("life", LifeAccumulator, "step"),
 )
+#: the label of the other compiled loops a step calls from Python (the start's trial point, the ring product,
+#: the operator's turn, the contacts' results, the life map), replayed hot together
+OTHER = "the other compiled loops"
 #: what marks a step with operator work
 OPERATOR_WORK = ((bime.BimeSolver, "_start_operator"), (bime.BimeSolver, "_advance"), (bime, "update_operator"))
 #: the compiled calls replayed hot: (label, module, factory name)
 COMPILED = ((" kept iterations", bime, "compiled_kept_iterations"),
-            (" compiled call", ball_kinematics, "compiled_friction_step"))
+            (" compiled call", ball_kinematics, "compiled_friction_step"),
+            (OTHER, bime, "compiled_trial_point"), (OTHER, bime, "compiled_ring_times"),
+            (OTHER, distribution_kernel, "compiled_column_turn"), (OTHER, distribution_kernel, "compiled_contact_results"),
+            (OTHER, raceway_map, "compiled_map_update"))
 REPLAYS = 5
 
 
@@ -175,6 +185,7 @@ def main() -> None:
         for label, _, _ in PARTS:
             hot_cell = f"{np.median(hot[label]):.0f}" if label in hot else ""
             rows.append([label, "", f"{parts[label]:.0f}", f"{parts[label] / np.mean(usual['step']):.2f}", hot_cell])
+        rows.append([OTHER, "", "", "", f"{np.median(hot[OTHER]):.0f}"])
         top = sum(v for label, v in parts.items() if not label.startswith(" "))
         inside = {"solve": (" kept iterations", " evaluate", " turned", " result"), "friction": (" compiled call",)}
         for whole, pieces in inside.items():
@@ -182,7 +193,7 @@ def main() -> None:
         rows.append(["simulator (the step less its parts)", "", f"{np.mean(usual['step']) - top:.0f}", "", ""])
         print_table(f"{name}: {found['steps']} steps without operator work, us", ["part", "median", "mean",
                                                                                    "share of the mean", "hot"], rows)
-        floor = sum(float(np.median(v)) for v in hot.values())
+        floor = float(np.median(np.sum([hot[label] for label in hot], axis=0)))
         print(f"the compiled calls hot: {floor:.0f} us, {floor / step:.2f} of the median step ({step:.0f} us)")
 
 
