@@ -485,9 +485,11 @@ class BimeSolver:
     def _rigid_solver(self, ring_motion: np.ndarray | None = None) -> "BimeSolver":
         """A rigid-ring solver at this rotation for a starting guess (no capacity checks), its
         grooves moved by ``ring_motion`` (``M y``, 4B) where given: the rings held as they are deformed.
-        Made once and kept (it holds nothing from one solve to the next); it takes this solver's
-        assembly at its rotation (:meth:`set_rotation`'s arrays) instead of assembling it again
-        (0.3 of the held-rings start's 1 ms, :meth:`_held_rings_start`)."""
+        The cold start's, and the held-rings start's with numpy's loops (with the compiled ones that
+        start runs the rigid model's loop itself, :meth:`_compiled_rigid_solve`, without the result a
+        solve makes). Made once and kept (it holds nothing from one solve to the next); it takes this
+        solver's assembly at its rotation (:meth:`set_rotation`'s arrays) instead of assembling it
+        again (0.3 of the numpy held start's 1 ms when this was measured)."""
         rigid = self._rigid
         if rigid is None:
             rigid = self._rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi,
@@ -741,12 +743,7 @@ class BimeSolver:
         operator where they are all done and asked for (``until`` the last), else the pending one,
         kept as the solver's and :class:`_WorkSpent` raised where ``required``."""
         n, stage = pending.matrix.shape[0], pending.stage
-        while stage < until:
-            cost = stage_work(n, stage, pending.method)
-            if cost > self._work_left and self._operator_work_done:
-                break
-            self._work_left -= cost
-            self._operator_work_done = True
+        while stage < until and self._take(stage_work(n, stage, pending.method)):
             stage += 1
         if stage > pending.stage:    # an inverse that misses the check: made again, spread where the solve can
             pending = advance_operator(pending, None, None, until=stage,  # wait or its work is bounded
@@ -762,10 +759,17 @@ class BimeSolver:
         """Take ``work`` (:data:`BOUNDED_WORK`) from what the solve may still do (``step_work``);
         :class:`_WorkSpent` where it is not left (nothing is done then), except for the solve's first
         piece of operator work (as :meth:`_advance`)."""
-        if work > self._work_left and self._operator_work_done:
+        if not self._take(work):
             raise _WorkSpent
+
+    def _take(self, work: float) -> bool:
+        """Whether the solve may do ``work`` more of operator work (:data:`BOUNDED_WORK`): where it is
+        left, or it is the solve's first piece; taken from what is left if so."""
+        if work > self._work_left and self._operator_work_done:
+            return False
         self._work_left -= work
         self._operator_work_done = True
+        return True
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float,
                 converged: bool = True) -> LoadDistribution:
