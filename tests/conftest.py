@@ -34,6 +34,18 @@ def double_operator(monkeypatch):
     monkeypatch.setattr(reduced_operator, "OPERATOR_PRECISION", np.float64)
 
 
+@pytest.fixture
+def rigid_loop_calls(monkeypatch):
+    """The calls of the rigid model's compiled loop (``distribution.kernel._rigid_solve``), counted: a
+    list that gains an entry each time a solver runs it."""
+    from slewing_model.distribution import bime
+
+    calls = []
+    loop = bime.compiled_rigid_solve()
+    monkeypatch.setattr(bime, "compiled_rigid_solve", lambda: lambda *args: calls.append(1) or loop(*args))
+    return calls
+
+
 @pytest.fixture(autouse=True, scope="session")
 def _cache_dir(tmp_path_factory):
     # superelements built by the tests go to a private cache, not the user's

@@ -320,19 +320,15 @@ def test_steps_with_compiled_contacts_equal_the_numpy_steps(name, monkeypatch, d
     assert sum(kept) >= total // 2, (sum(kept), total)     # most iterations ran in the compiled loop
 
 
-
-def test_rigid_solves_in_one_loop_equal_the_numpy_ones(pitch, monkeypatch):
+def test_rigid_solves_in_one_loop_equal_the_numpy_ones(pitch, rigid_loop_calls):
     """The rigid model's iterations in one compiled loop (``kernel._rigid_solve``) against the solver's
     numpy loop: cold and warm solves of the pitch bearing under loads that load one diagonal, both,
     and reverse the moment take the same iterations to the same displacement and contact loads to
     round-off; where the loop would run out of iterations, the numpy loop runs and refuses with its
     message."""
-    from slewing_model.distribution import NoEquilibriumError, bime
+    from slewing_model.distribution import NoEquilibriumError
 
     bearing = pitch[0]
-    calls = []
-    loop = bime.compiled_rigid_solve()
-    monkeypatch.setattr(bime, "compiled_rigid_solve", lambda: lambda *args: calls.append(1) or loop(*args))
     solvers = {kernel: BimeSolver(bearing, None, psi=0.3, kernel=kernel) for kernel in ("numpy", "compiled")}
     sequence = [Loads(Fz=3e5), Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6), Loads(Fx=2e5, Fz=-3e5, Mx=-4e6, My=1.5e6),
                 Loads(Fx=2.2e5, Fz=-3.1e5, Mx=-4.1e6, My=1.4e6)]
@@ -347,7 +343,7 @@ def test_rigid_solves_in_one_loop_equal_the_numpy_ones(pitch, monkeypatch):
         assert np.abs(got.displacement - ref.displacement).max() <= 1e-9 * np.abs(ref.displacement).max()
         assert np.abs(got.contact_load - ref.contact_load).max() <= 1e-9 * ref.max_ball_load
         assert got.residual <= solvers["compiled"].rtol
-    assert len(calls) == len(sequence)
+    assert len(rigid_loop_calls) == len(sequence)
     messages = []
     for solver in solvers.values():
         solver.max_iterations = 2
