@@ -266,8 +266,11 @@ SPREAD_STAGES = (2, len(STAGES))
 #: :data:`OPERATOR_PRECISION`: an inverse of a half recurses down to LAPACK's leaves and runs at
 #: about a third of a double product's rate (single: 1.3 times faster), ``S`` and the join add passes
 #: over the matrix; single precision runs the products 2.2 times, the join 2 times faster than double
-#: (which had 3, 1, 1.5, 3, 1, 1.5)
-STAGE_WEIGHT = (2.3, 0.45, 0.7, 2.3, 0.45, 0.75)
+#: (which had 3, 1, 1.5, 3, 1, 1.5). Measured again in issue 31's thirteenth turn (two runs, operators
+#: of 356-424 rows): the stages ran at 39-49 million a millisecond, the join at 25-26, not 55: the
+#: weights were (2.3, 0.45, 0.7, 2.3, 0.45, 0.75), and a bounded step's operator work took 1.3 times the
+#: time its bound said (the join twice)
+STAGE_WEIGHT = (2.6, 0.63, 0.78, 2.6, 0.63, 1.6)
 
 
 def inverse_work(n: int) -> float:
@@ -422,9 +425,9 @@ def method_precision(method: int):
 
 def forming_work(rows: int) -> float:
     """The work of forming ``W`` on ``rows`` rows (gathering ``M_aa``, adding the springs'
-    compliance), as :func:`stage_work` counts it: ``80 n^2`` (measured against the stages,
-    ``benchmarks/bench_operator.py --stages``)."""
-    return 80.0 * rows * rows
+    compliance), as :func:`stage_work` counts it: ``85 n^2`` (measured against the stages,
+    ``benchmarks/bench_operator.py --stages``; 80 before the thirteenth turn's measurement)."""
+    return 85.0 * rows * rows
 
 
 @dataclass(frozen=True)
