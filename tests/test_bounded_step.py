@@ -351,3 +351,35 @@ def test_the_yaw_bearing_bounded_from_zero_loads_arrives():
     assert all(r.converged for r in bounded[first:])
     assert bounded[-1].max_ball_load == pytest.approx(complete.max_ball_load, rel=1e-6)
     assert np.abs(bounded[-1].displacement - complete.displacement).max() <= 1e-6 * np.abs(complete.displacement).max()
+
+
+def test_a_bounded_steps_newton_iterations_count_in_its_work(table1, rings, monkeypatch):
+    """A bounded solve's Newton iterations take from its bound as its operator work does
+    (``bime.ITERATION_WEIGHT``): once it has done its one piece of operator work, it starts an
+    iteration only where the work left covers it. Here an iteration costs the whole bound: every step
+    stops after the iteration that did its one piece, where with the iterations free some steps do
+    several pieces; the run still arrives at the cold solution."""
+    work = OperatorWork(monkeypatch)
+
+    def run():
+        sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
+                                                               step_work="bounded"))
+        sim.step(FORWARD, 0.0, 0.0)
+        work.take()
+        results, pieces = [], []
+        for _ in range(60):
+            results.append(sim.step(REVERSED, 0.0, 0.0).distribution)
+            work.take()
+            pieces.append(work.taken_pieces)
+        return results, pieces
+
+    monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, 0.0))
+    _, free = run()
+    assert max(free) > 1                                     # the case discriminates
+    monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, BOUNDED_WORK / table1.ball_count))
+    results, pieces = run()
+    assert max(pieces) == 1
+    first = next(k for k, r in enumerate(results) if r.converged)
+    assert all(r.converged for r in results[first:])
+    reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
+    assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)

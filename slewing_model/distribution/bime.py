@@ -83,23 +83,23 @@ FINISH_ITERATIONS = 3
 #: with the one it has (:class:`slewing_model.rings.reduced_operator.PendingOperator`); all at once when an
 #: iteration past this many in one solve is still slow (docs/speed.md)
 SPREAD_ITERATIONS = 8
-#: what a bounded warm solve (``step_work="bounded"``) may spend of the ring operator's work, and at
+#: what a bounded warm solve (``step_work="bounded"``) may spend of work: the ring operator's, and at
 #: least one piece of it (forming ``W``, a stage of its inverse on its way, a bordering), whatever else
-#: it spent: floating-point operations weighted so that they track
-#: time (the stages of a spread inverse of ``W = (A^-1 + M)_aa``:
+#: it spent; and, since issue 31's thirteenth turn, its Newton iterations' (:data:`ITERATION_WEIGHT`): once
+#: it has done operator work it starts an iteration only where the work left covers it. Floating-point
+#: operations weighted so that they track time, some 55 million a millisecond on one core here (the
+#: stages of a spread inverse of ``W = (A^-1 + M)_aa``:
 #: :func:`~slewing_model.rings.reduced_operator.stage_work`; forming ``W``:
 #: :func:`~slewing_model.rings.reduced_operator.forming_work`;
 #: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
-#: step's answer does not depend on the machine. 8e7, an inverse of about 330 rows (1.6 ms on one core
-#: here, ``benchmarks/bench_operator.py --stages``), chosen by the pitch bearing's scenarios of
-#: ``benchmarks/bench_realtime.py`` with ``benchmarks/bench_bound.py`` (library, caps side by side in
-#: one run; docs/speed.md, "Issue 31, eleventh turn"): against 1e8 the steps slower than 4 NREL
-#: medians 0-4 instead of 2-15 a scenario, the slowest 3.5-4.6 NREL medians instead of 4.4-5.2,
-#: the first step from the start values 4.4-4.7 ms instead of 5.1-5.5; flagged NREL 44 instead of 29
-#: of 6000, a reversal's 54 instead of 36 of 2000. 7e7 flags NREL's 87, and its slowest was no faster.
-#: (Before the held-rings start, 6.5e7 and 1e8 flagged a reversal's 141 and 83 steps, NREL 174 and 29:
-#: the seventh turn.) ...
-BOUNDED_WORK = 8e7
+#: step's answer does not depend on the machine. 1.1e8, about 2 ms, chosen by the pitch bearing's
+#: scenarios of ``benchmarks/bench_realtime.py`` with ``benchmarks/bench_bound.py`` (library, caps side
+#: by side in one run; docs/speed.md, "Issue 31, thirteenth turn"): 9e7 flagged NREL's 183 steps of
+#: 6000, 1e8 55, 1.1e8 37, 1.2e8 28, and the slowest steps grew with the cap from 1e8 (3.0-4.7 NREL
+#: medians, 3.8-4.0 at 1.1e8, 4.0-4.3 at 1.2e8). Before, 8e7 of operator work alone, with the iterations
+#: free and the stages counted at 0.75 of their time (the eleventh turn's choice: against 1e8 the
+#: steps slower than 4 NREL medians 0-4 instead of 2-15 a scenario; 7e7 flagged NREL's 87). ...
+BOUNDED_WORK = 1.1e8
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
 BOUNDED_ITERATIONS = 12
@@ -126,6 +126,11 @@ HELD_NEW_CONTACTS = 0.25
 #: steps took more than 4.2 ms instead of 2-5, the slowest 5.1-5.2 ms against 4.5-4.7, and its first step
 #: from the start values 5.4-5.5 ms against 4.1-4.6 (three runs; docs/speed.md, "Issue 31, twelfth turn")
 HELD_WORK = 5e7
+#: a bounded solve's Newton iterations count against BOUNDED_WORK too, each (BimeSolver._iteration_work)
+#: its product with the operator's inverse, ``2 n^2`` for ``n`` rows, times the first, and its trial point and
+#: ring products, the second times the balls: 2.9e6 for the pitch bearing's kept operator (368 rows, 150
+#: balls), whose iterations took 55 us each in a step (``benchmarks/bench_step_parts.py``: 254 us for 4.6)
+ITERATION_WEIGHT = (5.0, 1.1e4)
 STEP_WORK = ("complete", "bounded")
 #: what :meth:`BimeSolver.set_rotation` sets: a solver at the same rotation may take them (BimeSolver._rigid_solver)
 ROTATION_ARRAYS = ("assembly", "_moving_centre", "_separation", "reference_stiffness", "jacobian", "_jacobian_rows")
@@ -172,8 +177,8 @@ class BimeSolver:
         How much a warm solve may do. "complete": Newton to ``rtol``, however many iterations
         and ring operator inversions that takes (the pitch bearing's moment reversed in one step:
         9 and 5, from the held-rings start of :meth:`_held_rings_start`). "bounded" (real time): at
-        most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of the operator's work
-        (a new operator's inverse spread over as many solves as that takes); a solve that would
+        most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of work, the operator's
+        and the iterations' (a new operator's inverse spread over as many solves as that takes); a solve that would
         need more returns its last iterate with ``converged=False`` and its ``residual``, keeps its operator
         (and one being inverted), and the next warm solve goes on from there. A cold solve
         (no ``initial``) is always complete.
@@ -195,7 +200,7 @@ class BimeSolver:
         self.pressure_limit = pressure_limit
         self.kernel = kernel
         self.step_work = step_work
-        self._work_left = math.inf   # per solve: the ring operator's work still allowed (BOUNDED_WORK)
+        self._work_left = math.inf   # per solve: the work still allowed (BOUNDED_WORK: the operator's, the iterations')
         self._operator_work_done = False   # per solve: a piece of operator work done (_advance, _spend)
         self._compiled = use_compiled(kernel, "kernel")    # the per-contact work as compiled loops
         self._arithmetic = COMPILED_ARITHMETIC if self._compiled else NUMPY_ARITHMETIC     # the operator's too
@@ -421,7 +426,7 @@ class BimeSolver:
                                          f"({residual}) after {iterations} Newton iterations")
             if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
-            if iterations >= limit:
+            if iterations >= limit or (bounded and flexible and not self._iteration_affordable(point)):
                 if bounded:                               # the rest is the next solve's
                     return self._result(loads, point, iterations, residual, converged=False)
                 raise NoEquilibriumError(
@@ -434,14 +439,19 @@ class BimeSolver:
                 if self._kept_operator_serves():
                     # the iterations that keep the operator, in one compiled loop, as far as they go; the
                     # one it stopped before is this loop's (handed_back)
-                    done, point, last_residual = self._kept_iterations(point, f_scaled, load_scale, trust,
-                                                                       last_residual, iterations, limit)
+                    cost = self._iteration_work(point)
+                    done, point, last_residual = self._kept_iterations(
+                        point, f_scaled, load_scale, trust, last_residual, iterations,
+                        self._iteration_limit(iterations, limit, cost) if bounded else limit)
+                    self._work_left -= done * cost
                     handed_back = True
                     if done:
                         iterations += done
                         continue
             handed_back = False
             iterations += 1
+            if bounded and flexible:
+                self._work_left -= self._iteration_work(point)
 
             if flexible:
                 fresh = _refresh_due(residual, last_residual, self.rtol)
@@ -754,6 +764,27 @@ class BimeSolver:
             self.pending_operator = pending
             raise _WorkSpent
         return pending
+
+    def _iteration_work(self, p: "_Point") -> float:
+        """The work of a Newton iteration from ``p`` (:data:`BOUNDED_WORK`, as the operator's work is
+        counted: about time): its product with the reduced operator's inverse, ``2 n^2`` for ``n`` rows
+        (the kept operator's, or two a loaded diagonal), and its line search's trial point and ring
+        products, which go with the balls (:data:`ITERATION_WEIGHT`)."""
+        rows = self._reduced.rows.size if self._reduced is not None else 2 * int(np.count_nonzero(p.loaded))
+        return ITERATION_WEIGHT[0] * 2.0 * rows * rows + ITERATION_WEIGHT[1] * self.bearing.ball_count
+
+    def _iteration_affordable(self, p: "_Point") -> bool:
+        """Whether a bounded solve may do a Newton iteration from ``p``: where it has the work left
+        (:meth:`_iteration_work`), or it has done no operator work yet (an iteration may do its one
+        piece, that a run of bounded solves always gets on; :meth:`_take`)."""
+        return not self._operator_work_done or self._work_left >= self._iteration_work(p)
+
+    def _iteration_limit(self, iterations: int, limit: int, cost: float) -> int:
+        """The iterations a bounded solve may reach with the kept operator, each of work ``cost``
+        (:meth:`_iteration_affordable`)."""
+        if not self._operator_work_done or cost <= 0.0:
+            return limit
+        return min(limit, iterations + max(int(self._work_left // cost), 0))
 
     def _spend(self, work: float) -> None:
         """Take ``work`` (:data:`BOUNDED_WORK`) from what the solve may still do (``step_work``);
