@@ -426,7 +426,8 @@ class BimeSolver:
                                          f"({residual}) after {iterations} Newton iterations")
             if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                 break
-            if iterations >= limit or (bounded and flexible and not self._iteration_affordable(point)):
+            cost = self._iteration_work(point) if bounded and flexible else 0.0     # an iteration's of the bound
+            if iterations >= limit or self._affordable_iterations(cost) < 1:
                 if bounded:                               # the rest is the next solve's
                     return self._result(loads, point, iterations, residual, converged=False)
                 raise NoEquilibriumError(
@@ -439,10 +440,9 @@ class BimeSolver:
                 if self._kept_operator_serves():
                     # the iterations that keep the operator, in one compiled loop, as far as they go; the
                     # one it stopped before is this loop's (handed_back)
-                    cost = self._iteration_work(point)
                     done, point, last_residual = self._kept_iterations(
                         point, f_scaled, load_scale, trust, last_residual, iterations,
-                        self._iteration_limit(iterations, limit, cost) if bounded else limit)
+                        int(min(limit, iterations + self._affordable_iterations(cost))))
                     self._work_left -= done * cost
                     handed_back = True
                     if done:
@@ -450,8 +450,7 @@ class BimeSolver:
                         continue
             handed_back = False
             iterations += 1
-            if bounded and flexible:
-                self._work_left -= self._iteration_work(point)
+            self._work_left -= cost
 
             if flexible:
                 fresh = _refresh_due(residual, last_residual, self.rtol)
@@ -773,18 +772,14 @@ class BimeSolver:
         rows = self._reduced.rows.size if self._reduced is not None else 2 * int(np.count_nonzero(p.loaded))
         return ITERATION_WEIGHT[0] * 2.0 * rows * rows + ITERATION_WEIGHT[1] * self.bearing.ball_count
 
-    def _iteration_affordable(self, p: "_Point") -> bool:
-        """Whether a bounded solve may do a Newton iteration from ``p``: where it has the work left
-        (:meth:`_iteration_work`), or it has done no operator work yet (an iteration may do its one
-        piece, that a run of bounded solves always gets on; :meth:`_take`)."""
-        return not self._operator_work_done or self._work_left >= self._iteration_work(p)
-
-    def _iteration_limit(self, iterations: int, limit: int, cost: float) -> int:
-        """The iterations a bounded solve may reach with the kept operator, each of work ``cost``
-        (:meth:`_iteration_affordable`)."""
-        if not self._operator_work_done or cost <= 0.0:
-            return limit
-        return min(limit, iterations + max(int(self._work_left // cost), 0))
+    def _affordable_iterations(self, cost: float) -> float:
+        """How many more Newton iterations of work ``cost`` each (:meth:`_iteration_work`; 0 in a
+        complete solve) the solve may start: those the work left covers, once it has done operator
+        work; before, any (an iteration may do its one piece, that a run of bounded solves always
+        gets on; :meth:`_take`)."""
+        if cost <= 0.0 or not self._operator_work_done:
+            return math.inf
+        return max(self._work_left // cost, 0.0)
 
     def _spend(self, work: float) -> None:
         """Take ``work`` (:data:`BOUNDED_WORK`) from what the solve may still do (``step_work``);
