@@ -383,3 +383,25 @@ def test_a_bounded_steps_newton_iterations_count_in_its_work(table1, rings, monk
     assert all(r.converged for r in results[first:])
     reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
     assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
+
+
+@pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
+def test_a_bounded_run_takes_the_same_steps_with_numpy_and_compiled_loops(table1, rings, monkeypatch):
+    """The work a bounded solve counts, its iterations' and its operator's, is the same whichever runs
+    its loops (numpy's loop of iterations, or the compiled loop of the kept ones with the limit the work
+    left allows): the moment reversed and back twice, every step the same iterations, the same flag and
+    the same state to round-off. An iteration here costs a fifth of the bound, that the limit binds."""
+    monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, BOUNDED_WORK / 5 / table1.ball_count))
+    runs = []
+    for kernel in ("numpy", "auto"):
+        sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
+                                                               step_work="bounded", contact_kernel=kernel))
+        sim.step(FORWARD, 0.0, 0.0)
+        runs.append([sim.step(REVERSED if (k // 10) % 2 == 0 else FORWARD, 0.0, 0.0).distribution
+                     for k in range(40)])
+    with_numpy, compiled = runs
+    assert any(not r.converged for r in compiled)             # the bound was met
+    assert [r.iterations for r in with_numpy] == [r.iterations for r in compiled]
+    assert [r.converged for r in with_numpy] == [r.converged for r in compiled]
+    for a, b in zip(with_numpy, compiled):
+        assert np.allclose(a.state, b.state, rtol=0, atol=1e-9 * np.abs(b.state).max())
