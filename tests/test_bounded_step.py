@@ -37,11 +37,13 @@ class OperatorWork:
     (:func:`~slewing_model.rings.reduced_operator.stage_work`, from the stage before and after the
     call, of the pending operator's method), bordering (:func:`~slewing_model.rings.reduced_operator.bordering_work`). ``largest``: the
     largest stage run since the last :meth:`take`; ``pieces``: how many of these (forming, stages,
-    borderings) were done since then (``taken_pieces``: up to the last :meth:`take`)."""
+    borderings) were done since then (``taken_pieces``: up to the last :meth:`take`; ``pieces_taken``:
+    at each :meth:`take`)."""
 
     def __init__(self, monkeypatch):
         self.work = self.largest = 0.0
         self.pieces = self.taken_pieces = 0
+        self.pieces_taken = []
 
         def stages(n, first, last, method=0):
             for k in range(first, last):
@@ -86,6 +88,7 @@ class OperatorWork:
         work, largest = self.work, self.largest
         self.work = self.largest = 0.0
         self.taken_pieces, self.pieces = self.pieces, 0
+        self.pieces_taken.append(self.taken_pieces)
         return work, largest
 
 
@@ -314,15 +317,8 @@ def test_a_bounded_run_gets_on_where_the_held_start_leaves_less_than_a_stage(tab
     monkeypatch.setattr(bime, "HELD_START", 0.0)
     monkeypatch.setattr(bime, "HELD_WORK", BOUNDED_WORK)
     work = OperatorWork(monkeypatch)
-    sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
-                                                           step_work="bounded"))
-    sim.step(FORWARD, 0.0, 0.0)
-    work.take()
-    results, pieces = [], []
-    for _ in range(60):
-        results.append(sim.step(REVERSED, 0.0, 0.0).distribution)
-        pieces.append(work.pieces)
-        work.take()
+    results, _ = reversal(table1, rings, "bounded", work, steps=60)
+    pieces = work.pieces_taken[-60:]
     first = next(k for k, r in enumerate(results) if r.converged)
     assert first >= 2 and all(r.converged for r in results[first:])
     assert all(p == 1 for p in pieces[:first]) and sum(pieces[:first]) >= 2
@@ -360,25 +356,12 @@ def test_a_bounded_steps_newton_iterations_count_in_its_work(table1, rings, monk
     stops after the iteration that did its one piece, where with the iterations free some steps do
     several pieces; the run still arrives at the cold solution."""
     work = OperatorWork(monkeypatch)
-
-    def run():
-        sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
-                                                               step_work="bounded"))
-        sim.step(FORWARD, 0.0, 0.0)
-        work.take()
-        results, pieces = [], []
-        for _ in range(60):
-            results.append(sim.step(REVERSED, 0.0, 0.0).distribution)
-            work.take()
-            pieces.append(work.taken_pieces)
-        return results, pieces
-
     monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, 0.0))
-    _, free = run()
-    assert max(free) > 1                                     # the case discriminates
+    reversal(table1, rings, "bounded", work, steps=60)
+    assert max(work.pieces_taken[-60:]) > 1                  # the case discriminates
     monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, BOUNDED_WORK / table1.ball_count))
-    results, pieces = run()
-    assert max(pieces) == 1
+    results, _ = reversal(table1, rings, "bounded", work, steps=60)
+    assert max(work.pieces_taken[-60:]) == 1
     first = next(k for k, r in enumerate(results) if r.converged)
     assert all(r.converged for r in results[first:])
     reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
