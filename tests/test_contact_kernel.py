@@ -132,12 +132,19 @@ def test_compiled_contact_results_equal_the_numpy_ones(pitch, table3, which):
     assert first == second
 
 
-def test_compiled_newton_step_equals_the_numpy_step(pitch):
-    """The modified Newton step with a kept operator, formed or bordered by contacts that closed (whose
-    inverse is symmetric to round-off only), at an iterate away from the operator's own; and the
-    operator's matrix and coupling formed by the compiled loops."""
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_compiled_newton_step_equals_the_numpy_step(pitch, precision, monkeypatch):
+    """The modified Newton step with a kept operator, formed or bordered by contacts that closed (in
+    double precision its inverse is symmetric to round-off only; in single, the operator's own
+    precision, its inverse is kept in single, reduced_operator.kept_precision), at an iterate away
+    from the operator's own; and the operator's matrix and coupling formed by the compiled loops."""
     from slewing_model.distribution.kernel import newton_step as compiled_step
+    from slewing_model.rings import reduced_operator
     from slewing_model.rings.reduced_operator import assemble_operator, newton_step, update_operator
+
+    if precision == "double":
+        monkeypatch.setattr(reduced_operator, "OPERATOR_PRECISION", np.float64)
+    assert reduced_operator.OPERATOR_PRECISION == (np.float64 if precision == "double" else np.float32)
 
     bearing, superelement = pitch
     loads = Loads(Fx=2e5, Fz=-3e5, Mx=4e6, My=-1.5e6)
@@ -153,7 +160,9 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch):
     formed = assemble_operator(*args, solver.jacobian, masks[1], mu)
     bordered = update_operator(formed, *args, solver.jacobian, masks[2], mu)
     assert bordered is not None and bordered.rows.size == 2 * loaded.size
-    assert not np.array_equal(bordered.inverse, bordered.inverse.T)          # symmetric to round-off only
+    if precision == "double":
+        assert not np.array_equal(bordered.inverse, bordered.inverse.T)      # symmetric to round-off only
+    assert formed.inverse.dtype == bordered.inverse.dtype == reduced_operator.OPERATOR_PRECISION
     off = solver._evaluate(1.01 * state[:5], 0.98 * state[5:], f_scaled)
     # a new operator's W and springs' compliance, formed by the compiled loop: the same bit for bit
     from slewing_model.distribution.kernel import operator_matrix as compiled_matrix

@@ -56,7 +56,7 @@ from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from ..bearing.contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .kernel import (
     COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_rigid_solve, compiled_ring_times,
-    compiled_trial_point, contact_results,
+    compiled_trial_point, contact_results, product_inverses,
 )
 from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -602,7 +602,7 @@ class BimeSolver:
         (done, last_residual, qs, y, my, e, delta, q, force, n, length, gradient, mismatch, loaded,
          terms) = compiled_kept_iterations()(
             self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
-            np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
+            *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
             op.schur_inverse, op.active, *self._product_operands, p.qs, p.y, p.ring_motion, p.e, p.delta, p.q,
             p.force, p.n, p.length, p.gradient, p.mismatch, p.loaded, terms, rules, iterations, limit)
         if not done:

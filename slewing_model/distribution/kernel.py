@@ -121,8 +121,8 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
 
 
 def _symmetric_times(matrix, vectors):
-    """``(M V)^T`` (k, n) for a symmetric ``M`` (n, n) and ``V^T = vectors`` (k, n), summed column by
-    column, ``sum_j v_j M_j`` with ``M``'s rows for its columns: a loop of vector operations, where
+    """``(M V)^T`` (k, n) for a symmetric ``M`` (n, n; double or single precision) and ``V^T = vectors``
+    (k, n), summed in double column by column, ``sum_j v_j M_j`` with ``M``'s rows for its columns: a loop of vector operations, where
     a row's dot product is one chain of additions. ``M`` symmetric to round-off (a bordered
     ``W^-1``) gives ``M^T V``, which differs from ``M V`` by round-off."""
     k, n = vectors.shape
@@ -135,18 +135,20 @@ def _symmetric_times(matrix, vectors):
     return out
 
 
-_NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], f8[:], "
-                     "f8[:], f8[:], f8[:])")
+_NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], "
+                     "f8[:, :], f8[:], f8[:], f8[:], f8[:])")
 
 
-def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_inverse, force, y, off_motion,
-                 f_scaled):
+def _newton_step(inverse, single_inverse, contact_compliance, rows, jacobian, coupling, schur_inverse, force, y,
+                 off_motion, f_scaled):
     """The modified Newton step with a kept reduced operator, in increments: ``dq`` (5,) and the
     contact forces after the step (``y.size``,), zero off the operator's ``rows``: the formulas of
     :func:`slewing_model.rings.reduced_operator.newton_step` (``force``, ``y`` and ``off_motion``, the
     ring motion of ``y`` off the rows or zeros, flat, (4B,)).
 
-    ``W^-1 rhs`` is summed column by column (:func:`_symmetric_times`)."""
+    ``W^-1`` is ``inverse`` (double) or, where that is empty, ``single_inverse``
+    (:func:`slewing_model.rings.reduced_operator.kept_precision`; :func:`product_inverses`);
+    ``W^-1 rhs`` is summed in double, column by column (:func:`_symmetric_times`)."""
     n = rows.size
     rhs = np.empty(n)
     for k in range(n // 2):                 # A^-1 (f - y) of each diagonal, + (M y_off) on its rows
@@ -156,7 +158,10 @@ def _newton_step(inverse, contact_compliance, rows, jacobian, coupling, schur_in
         for c in range(2):
             rhs[2 * k + c] = (contact_compliance[k, c, 0] * m0 + contact_compliance[k, c, 1] * m1
                               + off_motion[rows[2 * k + c]])
-    w = _symmetric_times(inverse, rhs.reshape(1, n))[0]
+    if inverse.shape[0] == n:
+        w = _symmetric_times(inverse, rhs.reshape(1, n))[0]
+    else:
+        w = _symmetric_times(single_inverse, rhs.reshape(1, n))[0]
     for i in range(n):
         w[i] += y[rows[i]]
     t = f_scaled.copy()                     # F - J_a^T w
@@ -628,14 +633,14 @@ _KEPT_SIGNATURE = (
     "Tuple((i8, f8, f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
     "f8[:, ::1], f8[::1], f8[::1], b1[::1], f8[::1]))("
     "f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
-    "f8[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
+    "f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
     "f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
     "f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], "
     "f8[::1], f8[::1], b1[::1], f8[:], f8[:], i8, i8)")
 
 
 def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_scaled, loaded_from,
-                     inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse, op_active,
+                     inverse, single_inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse, op_active,
                      cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag,
                      qs, y, ring_motion, e, delta, q, force, n, length, gradient, mismatch, loaded, terms, rules,
                      iterations, max_iterations):
@@ -681,8 +686,8 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
             break
         off_motion = _off_motion(rows, op_active, y, cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real,
                                  harmonic_imag)
-        dq, y_new = _newton_step(inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse,
-                                 force.reshape(-1), y, off_motion, f_scaled)
+        dq, y_new = _newton_step(inverse, single_inverse, contact_compliance, rows, op_jacobian, coupling,
+                                 schur_inverse, force.reshape(-1), y, off_motion, f_scaled)
         dy = y_new - y
         m_dy = _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, dy)
         slope_q = slope_y = 0.0                    # g . dq - (f - y) . M dy, as two dot products
@@ -852,10 +857,22 @@ compiled_rigid_solve = loop_factory(KERNELS, _compile, _rigid_solve, _RIGID_SIGN
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------
 
+_NO_DOUBLE, _NO_SINGLE = np.zeros((0, 0)), np.zeros((0, 0), np.float32)
+
+
+def product_inverses(inverse):
+    """A kept operator's ``W^-1`` as the compiled Newton step takes it (:func:`_newton_step`): the pair
+    (double, single), the one of its precision (:func:`slewing_model.rings.reduced_operator.kept_precision`)
+    and an empty one."""
+    if inverse.dtype == np.float32:
+        return _NO_DOUBLE, np.ascontiguousarray(inverse)
+    return np.ascontiguousarray(inverse, dtype=np.float64), _NO_SINGLE
+
+
 def newton_step(op, point, f_scaled, off_motion=None):
     """:func:`slewing_model.rings.reduced_operator.newton_step` by the compiled loop."""
     y = point.y
-    return compiled_newton_step()(np.ascontiguousarray(op.inverse), op.contact_compliance, op.rows, op.jacobian,
+    return compiled_newton_step()(*product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian,
                                   op.coupling, op.schur_inverse, point.force.reshape(-1), y,
                                   np.zeros(y.size) if off_motion is None else off_motion, f_scaled)
 
@@ -879,7 +896,7 @@ def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu
     if b_mat.shape[1] >= BORDER_BLAS_ROWS:
         return _numpy_bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
     bordered, new_coupling, schur_inverse = compiled_bordered_inverse()(
-        np.ascontiguousarray(inverse), b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
+        np.ascontiguousarray(inverse, dtype=np.float64), b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
     if bordered.size == 0:
         raise np.linalg.LinAlgError("singular matrix in bordering the reduced operator")
     return bordered, new_coupling, schur_inverse
@@ -897,7 +914,7 @@ def operator_matrix(point, compliance, stiffness, active):
 def operator_coupling(inverse, ja, mu):
     """:func:`slewing_model.rings.reduced_operator.operator_coupling` by the compiled loop (a singular
     complement, not met, raises numpy's LinAlgError as the numpy one does)."""
-    coupling, schur_inverse = compiled_operator_coupling()(np.ascontiguousarray(inverse), ja, mu)
+    coupling, schur_inverse = compiled_operator_coupling()(np.ascontiguousarray(inverse, dtype=np.float64), ja, mu)
     if schur_inverse.size == 0:
         raise np.linalg.LinAlgError("singular matrix: the Schur complement of the reduced operator")
     return coupling, schur_inverse

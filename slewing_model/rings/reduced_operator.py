@@ -43,8 +43,11 @@ class ReducedOperator:
     contact_compliance : ndarray (n/2, 2, 2)
         ``A^-1`` of the operator's diagonals, in its order, when each entered.
     inverse : ndarray (n, n)
-        ``W^-1 = (A^-1 + M)_aa^-1``, double; computed in :data:`OPERATOR_PRECISION` (checked,
-        :func:`checked_inverse`), so within about ``1e-7 cond(W)`` of the exact inverse.
+        ``W^-1 = (A^-1 + M)_aa^-1``, computed in :data:`OPERATOR_PRECISION` (checked,
+        :func:`checked_inverse`), so within about ``1e-7 cond(W)`` of the exact inverse; kept in
+        the precision it was computed in (:func:`kept_precision`): single for an inverse by halves
+        that passed the check, double for one made again, and for what bordering makes of either
+        the precision it had. Its products sum in double.
     jacobian : ndarray (n, 5)
         ``J_a`` (scaled rotations) when the coupling was formed.
     coupling : ndarray (n, 5)
@@ -171,6 +174,23 @@ def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
 #: Cholesky factor, in single precision and if need be in double (:func:`checked_inverse`;
 #: docs/speed.md, "Issue 31, sixth and seventh turns")
 OPERATOR_PRECISION = np.float32
+
+
+
+def kept_precision(inverse: np.ndarray) -> np.ndarray:
+    """``inverse`` as a :class:`ReducedOperator` keeps it: in single precision where it was computed
+    so (an inverse by halves in :data:`OPERATOR_PRECISION`, which passed the check), else in double.
+
+    The Newton iterations with a kept operator multiply by it 4-5 times a step, and the product
+    reads all of it (the pitch bearing's 368 rows: 1.08 MB in double, from beyond the core's cache
+    at a step's first iteration): kept in single precision it reads half, in products that still
+    sum in double (the pitch bearing's complete steps 0.93 of the time, docs/speed.md, "Issue 31,
+    fourteenth turn"). An inverse computed in single precision loses nothing so kept; one bordered
+    in double from it (:func:`update_operator`) is rounded back, an error of ``6e-8`` relative per
+    entry against the ``1e-7 cond(W)`` it already had. An inverse made in double (:func:`checked_inverse`:
+    ``W`` too ill-conditioned for single precision) stays double."""
+    return inverse if inverse.dtype == np.float32 else inverse.astype(np.float64, copy=False)
+
 
 #: below this size :func:`spd_inverse` calls LAPACK's inverse
 LEAF = 64
@@ -492,7 +512,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     with its coupling to the Jacobian (4B, 5) of now (``jacobian`` None: the pending operator,
     inverted). A ``W`` of :data:`LEAF` rows or fewer is inverted in one stage. The stages run in
     :func:`method_precision`; the inverse, once done, is checked (:func:`checked_inverse`) and
-    kept in double. An inverse that misses the check is made again through the Cholesky factor:
+    kept as :func:`kept_precision` keeps it. An inverse that misses the check is made again through the Cholesky factor:
     with ``again``, as a pending operator of the next method at stage 0 (by halves: 1, in single
     precision; 1: 2, in double), whose stages the next calls run (a solve that can go on without it,
     or a bounded one: spread over steps as any new operator); else at once. A ``W`` singular in
@@ -519,9 +539,8 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             pending = replace(pending, stage=len(STAGES), parts=(None,))     # else at once
         if pending.stage == len(STAGES):
             inverse = pending.parts[0]
-            if inverse is not None:          # in double (W^-1 = S (S W S)^-1 S for the factor's), checked
-                inverse = (_unscaled(inverse, pending.scaled[1]) if pending.method
-                           else inverse.astype(np.float64, copy=False))
+            if inverse is not None:          # kept as made (W^-1 = S (S W S)^-1 S in double for the factor's), checked
+                inverse = _unscaled(inverse, pending.scaled[1]) if pending.method else kept_precision(inverse)
                 if not passes_check(pending.matrix, inverse):
                     if again and method_precision(pending.method) != np.float64:
                         return replace(pending, stage=0, parts=(), method=pending.method + 1, scaled=())
@@ -637,6 +656,7 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     new_jacobian = jacobian.reshape(-1, 5)[new_rows]
     inverse, coupling, schur_inverse = _arithmetic(arithmetic).border(
         op.inverse, b_mat, c_mat, op.jacobian, op.coupling, new_jacobian, mu)
+    inverse = inverse.astype(op.inverse.dtype, copy=False)           # kept in the precision it had
     # the kept rows keep the Jacobian their coupling is for (a nearly turned one: turned_operator)
     return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
                            np.concatenate([op.jacobian, new_jacobian]), coupling, schur_inverse)
