@@ -295,17 +295,27 @@ def _jacobian(ball_angle, moving_centre, length, sign):
     return jac
 
 
-_BORDER_SIGNATURE = ("Tuple((f8[:, ::1], f8[:, :], f8[:, :]))(f8[:, ::1], f8[:, :], f8[:, :], f8[:, :], f8[:, :], "
-                     "f8[:, :], f8)")
+_BORDER_SIGNATURE = ("Tuple((b1, f8[:, :], f8[:, :]))(f8[:, ::1], f4[:, ::1], f8[:, :], f8[:, :], f8[:, :], "
+                     "f8[:, :], f8[:, :], f8, f8[:, ::1], f4[:, ::1])")
 
 
-def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
+def _bordered_inverse(inverse, single_inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu, bordered,
+                      single_bordered):
     """:func:`slewing_model.rings.reduced_operator.bordered_inverse` as one compiled loop: the same blocks,
     with ``W^-1 B`` summed column by column (:func:`_symmetric_times`) and ``W^-1 + X S X^T``
     written in one pass over ``W^-1`` (numpy's product and sum take three, with a temporary the
-    size of ``W^-1``)."""
+    size of ``W^-1``).
+
+    ``W^-1`` is ``inverse`` (double) or, where that is empty, ``single_inverse`` (:func:`_newton_step`);
+    the new inverse is written into ``bordered``, or ``single_bordered`` (rounded), the one of the
+    same precision ((n + r, n + r), the other empty). Returns whether the complements were regular,
+    the new coupling and the new Schur complement's inverse."""
     n, r = b_mat.shape
-    x_t = _symmetric_times(inverse, np.ascontiguousarray(b_mat.T))        # X^T = (W^-1 B)^T
+    b_t = np.ascontiguousarray(b_mat.T)
+    if inverse.shape[0] == n:
+        x_t = _symmetric_times(inverse, b_t)                            # X^T = (W^-1 B)^T
+    else:
+        x_t = _symmetric_times(single_inverse, b_t)
     reduced = np.empty((r, r))                     # C - B^T X
     for k in range(r):
         for m in range(r):
@@ -316,7 +326,7 @@ def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, m
     found, schur = _solve_small(reduced, np.eye(r))
     empty = np.empty((0, 0))
     if not found:
-        return np.empty((0, 0)), empty, empty
+        return False, empty, empty
     for k in range(r):                             # exactly symmetric
         for m in range(k + 1, r):
             schur[k, m] = schur[m, k] = 0.5 * (schur[k, m] + schur[m, k])
@@ -325,20 +335,10 @@ def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, m
         for k in range(r):
             for m in range(r):
                 xs[i, k] += x_t[m, i] * schur[m, k]
-    bordered = np.empty((n + r, n + r))
-    for i in range(n):
-        for j in range(n):
-            bordered[i, j] = inverse[i, j]
-        for k in range(r):
-            factor = xs[i, k]
-            for j in range(n):
-                bordered[i, j] += factor * x_t[k, j]
-        for k in range(r):
-            bordered[i, n + k] = -xs[i, k]
-            bordered[n + k, i] = -xs[i, k]
-    for k in range(r):
-        for m in range(r):
-            bordered[n + k, n + m] = schur[k, m]
+    if inverse.shape[0] == n:
+        _bordered_blocks(inverse, x_t, xs, schur, bordered)
+    else:
+        _bordered_blocks(single_inverse, x_t, xs, schur, single_bordered)
     d = np.empty((r, 5))                           # J_r - X^T J
     for k in range(r):
         for c in range(5):
@@ -362,8 +362,30 @@ def _bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, m
     ja[n:] = new_jacobian
     found, schur_inverse = _schur_inverse(ja, new_coupling, mu)
     if not found:
-        return np.empty((0, 0)), empty, empty
-    return bordered, new_coupling, schur_inverse
+        return False, empty, empty
+    return True, new_coupling, schur_inverse
+
+
+def _bordered_blocks(inverse, x_t, xs, schur, bordered):
+    """``[[W^-1 + X S X^T, -X S], [-S X^T, S]]`` into ``bordered`` (of ``inverse``'s precision: each
+    entry summed in double, then stored), :func:`_bordered_inverse`'s."""
+    n, r = xs.shape
+    row = np.empty(n)
+    for i in range(n):
+        for j in range(n):
+            row[j] = inverse[i, j]
+        for k in range(r):
+            factor = xs[i, k]
+            for j in range(n):
+                row[j] += factor * x_t[k, j]
+        for j in range(n):
+            bordered[i, j] = row[j]
+        for k in range(r):
+            bordered[i, n + k] = -xs[i, k]
+            bordered[n + k, i] = -xs[i, k]
+    for k in range(r):
+        for m in range(r):
+            bordered[n + k, n + m] = schur[k, m]
 
 
 _MATRIX_SIGNATURE = ("Tuple((f8[:, :, :], f8[:, :]))(f8[:, :, ::1], i8[:], f8[:, :], f8[:], f8[:], f8[:], f8[:])")
@@ -826,8 +848,8 @@ def _rigid_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, 
 
 
 #: the helpers the load distribution's loops call
-_HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_periodic_interp",
-            "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse")
+_HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_bordered_blocks",
+            "_periodic_interp", "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse")
 
 
 #: numpy's floating-point semantics: a division by zero gives inf or NaN as the numpy code does,
@@ -895,9 +917,12 @@ def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu
     :data:`BORDER_BLAS_ROWS` new rows on."""
     if b_mat.shape[1] >= BORDER_BLAS_ROWS:
         return _numpy_bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
-    bordered, new_coupling, schur_inverse = compiled_bordered_inverse()(
-        np.ascontiguousarray(inverse, dtype=np.float64), b_mat, c_mat, jacobian, coupling, new_jacobian, mu)
-    if bordered.size == 0:
+    size = sum(b_mat.shape)
+    bordered = np.empty((size, size), dtype=np.float32 if inverse.dtype == np.float32 else np.float64)
+    both = (_NO_DOUBLE, bordered) if bordered.dtype == np.float32 else (bordered, _NO_SINGLE)
+    found, new_coupling, schur_inverse = compiled_bordered_inverse()(
+        *product_inverses(inverse), b_mat, c_mat, jacobian, coupling, new_jacobian, mu, *both)
+    if not found:
         raise np.linalg.LinAlgError("singular matrix in bordering the reduced operator")
     return bordered, new_coupling, schur_inverse
 
