@@ -398,3 +398,55 @@ def test_a_bounded_run_takes_the_same_steps_with_numpy_and_compiled_loops(table1
     assert [r.converged for r in with_numpy] == [r.converged for r in compiled]
     for a, b in zip(with_numpy, compiled):
         assert np.allclose(a.state, b.state, rtol=0, atol=1e-9 * np.abs(b.state).max())
+
+
+@pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
+@pytest.mark.parametrize("step_work", ["complete", "bounded"])
+def test_the_usual_step_in_one_compiled_call_takes_the_same_steps(table1, rings, step_work, monkeypatch):
+    """A warm solve with a kept operator runs its loops in one compiled call (``bime.WARM_CALL``,
+    ``kernel._warm_solve``): the same loops in the same order as one by one from Python, so the same
+    numbers bit for bit, step after step. The steps go through every way the call ends: at an
+    equilibrium, its kept iterations stopped short (a new operator due, contacts closing, the bound),
+    a start far off (a reversal: the held-rings start), and a turn of the ring that the kept operator
+    cannot follow by a column turn (grooves with errors turning with the ring)."""
+    from slewing_model.bearing.manufacturing import synthetic_errors
+    from slewing_model.distribution import kernel
+
+    if step_work == "bounded":                 # an iteration costs a fifth of the bound: the limit binds
+        monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, BOUNDED_WORK / 5 / table1.ball_count))
+    # the errors move with the ring: a column turn fits them to about 4e-8 a step, above this tolerance
+    monkeypatch.setattr(bime, "APPROXIMATE_TURN", 1e-9)
+    bearing = table1.with_errors(synthetic_errors(table1.ball_count, seed=2))
+    ended = []
+    original = bime.compiled_warm_solve
+
+    def recorded():
+        call = original()
+
+        def run(*args):
+            out = call(*args)
+            ended.append(out[0])
+            return out
+        return run
+    monkeypatch.setattr(bime, "compiled_warm_solve", recorded)
+    steps = np.arange(40)                      # the ring turns, holds (the moment reversed and back), turns
+    angles = 0.005 * np.minimum(steps, 10) + 0.005 * np.maximum(steps - 30, 0)
+    scale = 1.0 + 0.15 * np.sin(steps)
+    loads = [Loads(**{k: v * s * (-1.0 if k[0] == "M" and 15 <= i < 25 else 1.0)
+                      for k, v in vars(FORWARD).items()}) for i, s in zip(steps, scale)]
+    runs = []
+    for one_call in (False, True):
+        sim = BearingSimulator(bearing, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
+                                                                 step_work=step_work))
+        sim.step(FORWARD, 0.0, 0.0)
+        monkeypatch.setattr(bime, "WARM_CALL", one_call)
+        # each step's result, and the work its solve had left (the iterations' and the operator's counted)
+        runs.append([(sim.step(f, psi, 0.0).distribution, sim.solver._work_left) for f, psi in zip(loads, angles)])
+    (one_by_one, left), (in_one_call, left_one_call) = (zip(*run) for run in runs)
+    assert left == left_one_call
+    assert set(ended) == {kernel.WARM_CONVERGED, kernel.WARM_STOPPED, kernel.WARM_FAR, kernel.WARM_NOT_TURNED}
+    if step_work == "bounded":
+        assert any(not r.converged for r in in_one_call)
+    for a, b in zip(one_by_one, in_one_call):
+        assert (a.iterations, a.converged) == (b.iterations, b.converged)
+        assert np.array_equal(a.state, b.state) and np.array_equal(a.contact_pressure, b.contact_pressure)

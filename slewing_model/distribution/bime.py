@@ -55,8 +55,9 @@ import numpy as np
 from .assembly import Assembly, INNER_SLOT, OUTER_SLOT, assemble
 from ..bearing.contact import ISO76_PRESSURE_LIMIT, contact_deflection, hertz_ellipse
 from .kernel import (
-    COMPILED_ARITHMETIC, compiled_jacobian, compiled_kept_iterations, compiled_rigid_solve, compiled_ring_times,
-    compiled_trial_point, contact_results, product_inverses,
+    COMPILED_ARITHMETIC, WARM_CONVERGED, WARM_FAR, WARM_STOPPED, compiled_contact_results, compiled_jacobian,
+    compiled_kept_iterations, compiled_rigid_solve, compiled_ring_times, compiled_trial_point, compiled_warm_solve,
+    contact_tables, product_inverses,
 )
 from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
@@ -132,6 +133,10 @@ HELD_WORK = 5e7
 #: balls), whose iterations took 55 us each in a step (``benchmarks/bench_step_parts.py``: 254 us for 4.6)
 ITERATION_WEIGHT = (5.0, 1.1e4)
 STEP_WORK = ("complete", "bounded")
+#: a warm solve with a kept operator and no stage of a new one due (a co-simulation's usual step) runs its
+#: compiled loops in one call (BimeSolver._warm_solve): the same loops in the same order, the same numbers;
+#: False runs them one by one from Python, as a solve that hands back does (a test compares the two)
+WARM_CALL = True
 #: what :meth:`BimeSolver.set_rotation` sets: a solver at the same rotation may take them (BimeSolver._rigid_solver)
 ROTATION_ARRAYS = ("assembly", "_moving_centre", "_separation", "reference_stiffness", "jacobian", "_jacobian_rows")
 #: the ring of contacts 1..4
@@ -413,10 +418,19 @@ class BimeSolver:
                 end = _Point(qs, y, e, delta, q, None, None, None, None, total, None, None, None, peak_force,
                              peak_residual, None, None)               # what _result reads of it
                 return self._result(loads, end, done, peak_residual / max(load_scale, peak_force, 1e-300))
-        point = self._evaluate(qs, y, f_scaled)
-        if flexible and initial is not None and point.any_loaded:
-            point = self._held_rings_start(point, loads, f_scaled, load_scale)
         handed_back = False                               # the compiled loop stopped before this iteration
+        point, held = None, flexible and initial is not None
+        if (WARM_CALL and held and self._reduced is not None and self._product_operands is not None
+                and self.pending_operator is None):
+            # the usual step (a kept operator, no stage due): its loops in one compiled call, as far as they go
+            found = self._warm_solve(loads, qs, y, f_scaled, load_scale, mu, trust, limit, bounded)
+            if isinstance(found, LoadDistribution):
+                return found
+            point, iterations, last_residual, handed_back, held = found
+        if point is None:
+            point = self._evaluate(qs, y, f_scaled)
+        if held and point.any_loaded:
+            point = self._held_rings_start(point, loads, f_scaled, load_scale)
         while True:
             grad_q, mismatch = point.gradient, point.mismatch
             scale = max(load_scale, point.peak_force, 1e-300)
@@ -611,6 +625,46 @@ class BimeSolver:
         return done, _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch,
                             peak_force, peak_residual, loaded, n_loaded > 0, my), last_residual
 
+    def _warm_solve(self, loads: Loads, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray, load_scale: float,
+                    mu: float, trust: float, limit: int, bounded: bool):
+        """The start of a warm solve with a kept operator (:meth:`solve`) in one compiled call
+        (:func:`~slewing_model.distribution.kernel._warm_solve`): the start evaluated, the held-rings
+        start's test, the operator turned with the ring, its iterations and, at an equilibrium, the
+        result (returned). Else where :meth:`solve` goes on: the point reached, the iterations done,
+        the last residual, whether the kept loop stopped before the next iteration, and whether the
+        held-rings start is still to be tried (a start far off)."""
+        a, op, b = self.assembly, self._reduced, self.bearing
+        dw = b.ball_diameter
+        rules = np.array([self.rtol, load_scale, trust, dw * dw, REFRESH, FINISH_ITERATIONS, HELD_START, mu,
+                          self._turn_tolerance])
+        (status, done, last_residual, turned, changed, qs, y, my, e, delta, q, force, n, length, gradient, mismatch,
+         loaded, terms, coupling, schur_inverse, jacobian, *contacts) = compiled_warm_solve()(
+            self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
+            *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
+            op.schur_inverse, op.active, *self._product_operands, qs, y, rules, limit,
+            self._reduced_jacobian is not self._jacobian_rows, *self._contact_arguments())
+        if turned:
+            if changed:
+                self._reduced = ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian,
+                                                coupling, schur_inverse)
+            self._reduced_jacobian = self._jacobian_rows
+        total, energy_scale, peak_force, peak_residual, n_loaded = terms
+        point = _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch, peak_force,
+                       peak_residual, loaded, n_loaded > 0, my)
+        if bounded:
+            self._work_left -= done * self._iteration_work(point)
+        if status == WARM_CONVERGED:
+            return self._result(loads, point, done, peak_residual / max(load_scale, peak_force, 1e-300),
+                                contacts=contacts)
+        return point, done, last_residual, status == WARM_STOPPED, status == WARM_FAR
+
+    def _contact_arguments(self) -> tuple:
+        """What the compiled contacts' results take of the bearing beside the springs
+        (:func:`~slewing_model.distribution.kernel._contact_results`)."""
+        a, b = self.assembly, self.bearing
+        return (a.contact_stiffness, a.ball_diameter, a.groove_radius, b.pitch_diameter, INNER_CONTACT,
+                *contact_tables(b.youngs_modulus, b.poisson_ratio), self.edge_angle)
+
     def _evaluate(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray, my: np.ndarray | None = None,
                   direction: tuple | None = None, t: float = 0.0) -> "_Point":
         """Contact terms, total energy and residuals at the unknowns ``(qs, y)``, or at the trial
@@ -798,14 +852,16 @@ class BimeSolver:
         return True
 
     def _result(self, loads: Loads, p: "_Point", iterations: int, residual: float,
-                converged: bool = True) -> LoadDistribution:
+                converged: bool = True, contacts: tuple | None = None) -> LoadDistribution:
+        """The load distribution at ``p`` (its contacts' results ``contacts`` where the compiled loop
+        gave them, :meth:`_warm_solve`)."""
         a = self.assembly
         qs, y, e, delta, q = p.qs, p.y, p.e, p.delta, p.q
         b = self.bearing
         if self._compiled:                    # the same formulas, one compiled loop (contact_kernel)
-            (contact_load, contact_angle, deflection, semi_a, semi_b, pressure, truncated, first_off) = contact_results(
-                q, e, a.contact_stiffness, a.ball_diameter, a.groove_radius, b.pitch_diameter, INNER_CONTACT,
-                b.youngs_modulus, b.poisson_ratio, self.edge_angle)
+            if contacts is None:
+                contacts = compiled_contact_results()(q, e, *self._contact_arguments())
+            (contact_load, contact_angle, deflection, semi_a, semi_b, pressure, truncated, first_off) = contacts
             off = None if first_off < 0 else divmod(first_off, 4)
         else:
             # per contact 1..4 from the diagonals: contacts (1,3) <- diagonal 1, (2,4) <- diagonal 2

@@ -747,6 +747,97 @@ def _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_sca
             np.array([total, energy_scale, peak_force, peak_residual, n_loaded]))
 
 
+#: what :func:`_warm_solve` reports: an equilibrium (its contacts' results too), the kept iterations
+#: stopped short of it (the solver goes on from the point reached), a start far from it (the held-rings
+#: start's), a kept operator that no column turn follows (its coupling is formed anew)
+WARM_CONVERGED, WARM_STOPPED, WARM_FAR, WARM_NOT_TURNED = 0, 1, 2, 3
+
+_WARM_SIGNATURE = (
+    "Tuple((i8, i8, f8, b1, b1, f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
+    "f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], "
+    "f8[:, :], f8[:, :], b1[:, :], i8))("
+    "f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
+    "f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
+    "f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
+    "f8[::1], f8[::1], f8[:], i8, b1, f8[:, :], f8[:], f8[:, :], f8, b1[:], f8, f8[:], f8[:], f8[:], f8[:])")
+
+
+def _warm_solve(separation, jacobian_rows, natural_length, stiffness, f_scaled, loaded_from,
+                inverse, single_inverse, contact_compliance, rows, op_jacobian, coupling, schur_inverse, op_active,
+                cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, qs, y, rules, limit,
+                turn, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner, modulus, f_table,
+                log_kappa_table, e_table, edge_angle):
+    """The usual warm solve of ``BimeSolver.solve`` (:mod:`slewing_model.distribution.bime`) in one call,
+    the loops it calls one by one, in its order and with its arguments: the start ``(qs, y)`` evaluated
+    (the ring product :func:`_ring_times`, :func:`_trial_point`), the held-rings start's test, the stop
+    rule, the kept operator turned with the ring (:func:`_column_turn`, where ``turn``), its iterations
+    (:func:`_kept_iterations`, up to ``limit``) and the contacts' results at the equilibrium
+    (:func:`_contact_results`).
+
+    ``rules``: the tolerance, the load scale, the trust length, the squared ball diameter, the refresh
+    threshold, the finish iterations, the held start's threshold, ``mu`` and the turn's tolerance. Returns a
+    status (:data:`WARM_CONVERGED`, :data:`WARM_STOPPED`: the solver goes on from the point reached, the
+    kept loop having stopped before that iteration; :data:`WARM_FAR`, :data:`WARM_NOT_TURNED`: at the
+    start, which it returns), the iterations done, the last residual, whether the operator was turned
+    (its Jacobian now this one's) and whether its coupling changed, the point (as :func:`_kept_iterations`
+    returns it, and its total energy, energy scale, largest force, largest residual and loaded diagonals),
+    the operator's coupling, Schur complement's inverse and Jacobian, and the contacts' results (empty
+    unless converged)."""
+    rtol, load_scale, held_start, mu, turn_tolerance = rules[0], rules[1], rules[6], rules[7], rules[8]
+    still_q, still_y = np.zeros(5), np.zeros(y.size)
+    motion = _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, harmonic_imag, y)
+    (qs, y, motion, e, delta, q, force, n, length, gradient, mismatch, loaded, start) = _trial_point(
+        separation, jacobian_rows, qs, still_q, y, still_y, motion, still_y, 0.0, natural_length, stiffness, f_scaled,
+        loaded_from)
+    energy, ring, work = start[0], start[1], start[2]
+    terms = np.array([energy + ring - work, energy + ring + abs(work), start[3], start[4], start[5]])
+    empty_2, empty_b = np.empty((0, 4)), np.empty((0, 4), np.bool_)
+    no_results = (empty_2, empty_2, empty_2, empty_2, empty_2, empty_2, empty_b, -1)
+    peak_force, peak_residual = terms[2], terms[3]
+    status = WARM_STOPPED
+    if terms[4] > 0 and not peak_residual <= held_start * max(load_scale, peak_force):
+        status = WARM_FAR
+    scale = max(load_scale, peak_force, 1e-300)
+    converged = status == WARM_STOPPED and (peak_residual / scale <= rtol or scale == 1e-300)
+    turned = changed = False
+    if status == WARM_STOPPED and not converged and turn:          # the kept operator follows the ring
+        same = op_jacobian.shape[0] == rows.size
+        for i in range(rows.size):
+            for c in range(5):
+                same = same and op_jacobian[i, c] == jacobian_rows[rows[i], c]
+        if not same:
+            new = np.empty((rows.size, 5))
+            for i in range(rows.size):
+                new[i] = jacobian_rows[rows[i]]
+            found, new_coupling, new_schur, new_jacobian = _column_turn(op_jacobian, new, coupling, mu,
+                                                                       turn_tolerance)
+            if not found:
+                status = WARM_NOT_TURNED
+            else:
+                coupling, schur_inverse, op_jacobian, changed = new_coupling, new_schur, new_jacobian, True
+        turned = status == WARM_STOPPED
+    done, last_residual = 0, math.inf
+    if status == WARM_STOPPED and not converged:
+        kept_terms = np.array([terms[0], terms[1], peak_force, peak_residual, 1.0 if terms[4] > 0 else 0.0])
+        kept_rules = np.array([rules[0], rules[1], rules[2], rules[3], rules[4], rules[5], math.inf])
+        (done, last_residual, qs, y, motion, e, delta, q, force, n, length, gradient, mismatch, loaded,
+         terms) = _kept_iterations(separation, jacobian_rows, natural_length, stiffness, f_scaled, loaded_from,
+                                   inverse, single_inverse, contact_compliance, rows, op_jacobian, coupling,
+                                   schur_inverse, op_active, cos_table, sin_table, cos_by_ball, sin_by_ball,
+                                   harmonic_real, harmonic_imag, qs, y, motion, e, delta, q, force, n, length,
+                                   gradient, mismatch, loaded, kept_terms, kept_rules, 0, limit)
+        scale = max(load_scale, terms[2], 1e-300)
+        converged = terms[3] / scale <= rtol or scale == 1e-300
+    results = no_results
+    if converged:
+        status = WARM_CONVERGED
+        results = _contact_results(q, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner,
+                                   modulus, f_table, log_kappa_table, e_table, edge_angle)
+    return (status, done, last_residual, turned, changed, qs, y, motion, e, delta, q, force, n, length, gradient,
+            mismatch, loaded, terms, coupling, schur_inverse, op_jacobian, results[0], results[1], results[2],
+            results[3], results[4], results[5], results[6], results[7])
+
+
 _RIGID_SIGNATURE = ("Tuple((f8[:], i8, b1, f8[:, :, :], f8[:, :], f8[:, :], f8[:]))(f8[:, :, :], f8[:, :], f8[:], f8[:], "
                     "f8[:], f8[:, :], f8[:, :], f8[:], f8, f8[:])")
 
@@ -849,7 +940,8 @@ def _rigid_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, 
 
 #: the helpers the load distribution's loops call
 _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_bordered_blocks",
-            "_periodic_interp", "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse")
+            "_periodic_interp", "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse",
+            "_column_turn", "_kept_iterations", "_contact_results")
 
 
 #: numpy's floating-point semantics: a division by zero gives inf or NaN as the numpy code does,
@@ -875,6 +967,7 @@ compiled_add_groove_errors = loop_factory(KERNELS, _compile, _add_groove_errors,
 compiled_ring_times = loop_factory(KERNELS, _compile, _ring_times, _RING_TIMES_SIGNATURE)
 compiled_kept_iterations = loop_factory(KERNELS, _compile, _kept_iterations, _KEPT_SIGNATURE)
 compiled_rigid_solve = loop_factory(KERNELS, _compile, _rigid_solve, _RIGID_SIGNATURE)
+compiled_warm_solve = loop_factory(KERNELS, _compile, _warm_solve, _WARM_SIGNATURE)
 
 
 # ---- the loops with the interfaces of the numpy functions they stand for ----------------------
@@ -955,13 +1048,11 @@ def add_groove_errors(centre, theta, error_map, contacts):
     return None if error_map.groove_radius is None else values[:, 4:6]
 
 
-def contact_results(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner, youngs_modulus,
-                    poisson_ratio, edge_angle):
-    """:func:`_contact_results` by the compiled loop: the moduli as :func:`slewing_model.bearing.contact.hertz_ellipse`
-    takes them, ``inner`` (4,) which contacts are on the inner ring."""
-    return compiled_contact_results()(load, e, contact_stiffness, ball_diameter, groove_radius, pitch_diameter, inner,
-                                      effective_modulus(youngs_modulus, poisson_ratio), _F_TABLE, _LOG_KAPPA,
-                                      _E_TABLE, edge_angle)
+def contact_tables(youngs_modulus, poisson_ratio) -> tuple:
+    """What :func:`_contact_results` takes of the Hertz contact: the modulus as
+    :func:`slewing_model.bearing.contact.hertz_ellipse` takes it, and its tables."""
+    return effective_modulus(youngs_modulus, poisson_ratio), _F_TABLE, _LOG_KAPPA, _E_TABLE
+
 
 #: the reduced operator's arithmetic as compiled loops (:class:`slewing_model.rings.reduced_operator.OperatorArithmetic`)
 COMPILED_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
