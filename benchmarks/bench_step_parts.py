@@ -6,16 +6,19 @@ life on, complete steps), stepped through the library's simulator under a scenar
 called (the method wrapped for the run):
 
 - ``set_rotation``: the solver's assembly at the ring's angle;
-- ``solve``, and within it the compiled Newton iterations with the kept operator
-  (``kept iterations``), the start and line-search evaluations (``evaluate``), the operator's turn
-  (``turned``), the results (``result``) and the rest (the Python between them);
+- ``solve``, and within it the usual warm solve's one compiled call (``one call``: the start, the
+  operator's turn, the kept iterations and, at the equilibrium, the contacts' results) and where it
+  stops short or is not taken, the compiled Newton iterations with the kept operator (``kept
+  iterations``), the start and line-search evaluations (``evaluate``), the operator's turn
+  (``turned``), the results (``result``, which at an equilibrium of the one call only words it), and
+  the rest (the Python between them);
 - ``friction``, and within it the one compiled call of the balls' equilibrium and torque;
 - ``life``: the raceway map and damage;
 - ``simulator``: the step's own bookkeeping (the warm starts, the state), what is left of the step.
 
 Steps that form, border or invert an operator (their time is that work's: ``bench_operator.py``)
 are counted apart; the table is of the other steps, the usual ones. The compiled calls (the two big
-ones, and the other loops a step calls from Python: the start's trial point, the ring product, the
+ones, the solve's and the friction's, and the other loops a step calls from Python: the start's trial point, the ring product, the
 operator's turn, the contacts' results, the life map) are then called again with the arguments they had in those steps,
 each several times in a row ("hot": its data and code in the cache, no Python around it): the sum
 of the hot calls is what a step made of one compiled call would still cost, the floor of issue
@@ -52,6 +55,7 @@ from slewing_model.simulation import simulator  # noqa: E402
 PARTS = (
     ("set_rotation", bime.BimeSolver, "set_rotation"),
     ("solve", bime.BimeSolver, "solve"),
+    (" one call", bime.BimeSolver, "_warm_solve"),
     (" kept iterations", bime.BimeSolver, "_kept_iterations"),
     (" evaluate", bime.BimeSolver, "_evaluate"),
     (" turned", bime.BimeSolver, "_turned"),
@@ -66,7 +70,7 @@ OTHER = "the other compiled loops"
 #: what marks a step with operator work
 OPERATOR_WORK = ((bime.BimeSolver, "_start_operator"), (bime.BimeSolver, "_advance"), (bime, "update_operator"))
 #: the compiled calls replayed hot: (label, module, factory name)
-COMPILED = ((" kept iterations", bime, "compiled_kept_iterations"),
+COMPILED = ((" one call", bime, "compiled_warm_solve"), (" kept iterations", bime, "compiled_kept_iterations"),
             (" compiled call", ball_kinematics, "compiled_friction_step"),
             (OTHER, bime, "compiled_trial_point"), (OTHER, bime, "compiled_ring_times"),
             (OTHER, distribution_kernel, "compiled_column_turn"), (OTHER, distribution_kernel, "compiled_contact_results"),
@@ -187,7 +191,8 @@ def main() -> None:
             rows.append([label, "", f"{parts[label]:.0f}", f"{parts[label] / np.mean(usual['step']):.2f}", hot_cell])
         rows.append([OTHER, "", "", "", f"{np.median(hot[OTHER]):.0f}"])
         top = sum(v for label, v in parts.items() if not label.startswith(" "))
-        inside = {"solve": (" kept iterations", " evaluate", " turned", " result"), "friction": (" compiled call",)}
+        inside = {"solve": (" one call", " kept iterations", " evaluate", " turned", " result"),
+                  "friction": (" compiled call",)}
         for whole, pieces in inside.items():
             rows.append([f" {whole}: the rest", "", f"{parts[whole] - sum(parts[p] for p in pieces):.0f}", "", ""])
         rows.append(["simulator (the step less its parts)", "", f"{np.mean(usual['step']) - top:.0f}", "", ""])
