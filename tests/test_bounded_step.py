@@ -263,15 +263,15 @@ def test_bordered_inverse_is_the_inverse_of_the_bordered_matrix(new_rows):
         assert np.allclose(bordered, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
         assert np.allclose(coupling, expected @ np.vstack([jacobian, new_jacobian]), atol=1e-12)
     # an inverse kept in single precision (reduced_operator.kept_precision): bordered in double from its
-    # entries, the same blocks as numpy's from the same entries, the compiled loop storing them in single
+    # entries, the same blocks as from the same entries in double, stored in single
     single = args[0].astype(np.float32)
     want = bordered_inverse(single.astype(np.float64), *args[1:])
-    got = compiled_bordered_inverse(single, *args[1:])
-    if new_rows < BORDER_BLAS_ROWS:                     # (by BLAS: numpy's, in double, rounded by its caller)
+    for bordering in (compiled_bordered_inverse, bordered_inverse):
+        got = bordering(single, *args[1:])
         assert got[0].dtype == np.float32
-    assert np.abs(got[0] - want[0].astype(np.float32)).max() <= 1e-6 * np.abs(want[0]).max()
-    for a, b in zip(got[1:], want[1:]):
-        assert np.allclose(a, b, rtol=0, atol=1e-11 * np.abs(b).max())
+        assert np.abs(got[0] - want[0].astype(np.float32)).max() <= 1e-6 * np.abs(want[0]).max()
+        for a, b in zip(got[1:], want[1:]):
+            assert np.allclose(a, b, rtol=0, atol=1e-11 * np.abs(b).max())
 
 
 def test_a_flagged_step_caps_its_friction_and_the_steps_after_arrive_at_the_complete_torque(table1, rings,

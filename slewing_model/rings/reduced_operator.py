@@ -655,8 +655,7 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     _add_blocks(c_mat, new_a_inv)
     new_jacobian = jacobian.reshape(-1, 5)[new_rows]
     inverse, coupling, schur_inverse = _arithmetic(arithmetic).border(
-        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, new_jacobian, mu)
-    inverse = inverse.astype(op.inverse.dtype, copy=False)           # kept in the precision it had
+        op.inverse, b_mat, c_mat, op.jacobian, op.coupling, new_jacobian, mu)        # in the precision it had
     # the kept rows keep the Jacobian their coupling is for (a nearly turned one: turned_operator)
     return ReducedOperator(rows, op.active | closed, np.concatenate([op.contact_compliance, new_a_inv]), inverse,
                            np.concatenate([op.jacobian, new_jacobian]), coupling, schur_inverse)
@@ -691,13 +690,16 @@ def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu
     (n, r)) and ``S = (C - B^T X)^-1`` (``c_mat`` (r, r)), the new inverse
     ``[[W^-1 + X S X^T, -X S], [-S X^T, S]]``, its coupling ``[W^-1 J - X S d, S d]`` with
     ``d = J_r - X^T J`` (``coupling = W^-1 J`` (n, 5), ``jacobian = J``, ``new_jacobian = J_r``
-    (r, 5)) and the new Schur complement's inverse ``(J_new^T W_new^-1 J_new + mu I)^-1``."""
+    (r, 5)) and the new Schur complement's inverse ``(J_new^T W_new^-1 J_new + mu I)^-1``. The blocks
+    are summed in double, the new inverse stored in ``W^-1``'s precision (:func:`kept_precision`)."""
+    stored = inverse.dtype
+    inverse = inverse.astype(np.float64, copy=False)
     x_mat = inverse @ b_mat
     schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
     schur = 0.5 * (schur + schur.T)
     xs = x_mat @ schur
     n, r = b_mat.shape
-    bordered = np.empty((n + r, n + r))
+    bordered = np.empty((n + r, n + r), dtype=stored)
     np.add(inverse, xs @ x_mat.T, out=bordered[:n, :n])
     bordered[:n, n:] = -xs
     bordered[n:, :n] = -xs.T
