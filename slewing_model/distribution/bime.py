@@ -423,10 +423,11 @@ class BimeSolver:
         if (WARM_CALL and held and self._reduced is not None and self._product_operands is not None
                 and self.pending_operator is None):
             # the usual step (a kept operator, no stage due): its loops in one compiled call, as far as they go
-            found = self._warm_solve(loads, qs, y, f_scaled, load_scale, mu, trust, limit, bounded)
-            if isinstance(found, LoadDistribution):
-                return found
-            point, iterations, last_residual, handed_back, held = found
+            point, iterations, last_residual, handed_back, held, contacts = self._warm_solve(
+                qs, y, f_scaled, load_scale, mu, trust, limit, bounded)
+            if contacts is not None:                      # at the equilibrium
+                residual = point.peak_residual / max(load_scale, point.peak_force, 1e-300)
+                return self._result(loads, point, iterations, residual, contacts=contacts)
         if point is None:
             point = self._evaluate(qs, y, f_scaled)
         if held and point.any_loaded:
@@ -613,50 +614,44 @@ class BimeSolver:
         dw = self.bearing.ball_diameter
         rules = np.array([self.rtol, load_scale, trust, dw * dw, REFRESH, FINISH_ITERATIONS, last_residual])
         terms = np.array([p.total, p.energy_scale, p.peak_force, p.peak_residual, float(p.any_loaded)])
-        (done, last_residual, qs, y, my, e, delta, q, force, n, length, gradient, mismatch, loaded,
-         terms) = compiled_kept_iterations()(
+        done, last_residual, *reached = compiled_kept_iterations()(
             self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
             *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
             op.schur_inverse, op.active, *self._product_operands, p.qs, p.y, p.ring_motion, p.e, p.delta, p.q,
             p.force, p.n, p.length, p.gradient, p.mismatch, p.loaded, terms, rules, iterations, limit)
         if not done:
             return 0, p, last_residual
-        total, energy_scale, peak_force, peak_residual, n_loaded = terms
-        return done, _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch,
-                            peak_force, peak_residual, loaded, n_loaded > 0, my), last_residual
+        return done, _compiled_point(*reached), last_residual
 
-    def _warm_solve(self, loads: Loads, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray, load_scale: float,
-                    mu: float, trust: float, limit: int, bounded: bool):
+    def _warm_solve(self, qs: np.ndarray, y: np.ndarray, f_scaled: np.ndarray, load_scale: float, mu: float,
+                    trust: float, limit: int, bounded: bool):
         """The start of a warm solve with a kept operator (:meth:`solve`) in one compiled call
         (:func:`~slewing_model.distribution.kernel._warm_solve`): the start evaluated, the held-rings
         start's test, the operator turned with the ring, its iterations and, at an equilibrium, the
-        result (returned). Else where :meth:`solve` goes on: the point reached, the iterations done,
-        the last residual, whether the kept loop stopped before the next iteration, and whether the
-        held-rings start is still to be tried (a start far off)."""
+        contacts' results. Returns the point reached, the iterations done, the last residual, whether
+        the kept loop stopped before the next iteration, whether the held-rings start is still to be
+        tried (a start far off), and the contacts' results (:func:`~slewing_model.distribution.kernel._contact_results`)
+        where the point is the equilibrium, else None: there :meth:`solve` goes on."""
         a, op, b = self.assembly, self._reduced, self.bearing
         dw = b.ball_diameter
         rules = np.array([self.rtol, load_scale, trust, dw * dw, REFRESH, FINISH_ITERATIONS, HELD_START, mu,
                           self._turn_tolerance])
-        (status, done, last_residual, turned, changed, qs, y, my, e, delta, q, force, n, length, gradient, mismatch,
-         loaded, terms, coupling, schur_inverse, jacobian, *contacts) = compiled_warm_solve()(
+        status, done, last_residual, turned, changed, *found = compiled_warm_solve()(
             self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
             *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
             op.schur_inverse, op.active, *self._product_operands, qs, y, rules, limit,
             self._reduced_jacobian is not self._jacobian_rows, *self._contact_arguments())
+        reached, (coupling, schur_inverse, jacobian), contacts = found[:13], found[13:16], found[16:]
         if turned:
             if changed:
                 self._reduced = ReducedOperator(op.rows, op.active, op.contact_compliance, op.inverse, jacobian,
                                                 coupling, schur_inverse)
             self._reduced_jacobian = self._jacobian_rows
-        total, energy_scale, peak_force, peak_residual, n_loaded = terms
-        point = _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch, peak_force,
-                       peak_residual, loaded, n_loaded > 0, my)
+        point = _compiled_point(*reached)
         if bounded:
             self._work_left -= done * self._iteration_work(point)
-        if status == WARM_CONVERGED:
-            return self._result(loads, point, done, peak_residual / max(load_scale, peak_force, 1e-300),
-                                contacts=contacts)
-        return point, done, last_residual, status == WARM_STOPPED, status == WARM_FAR
+        return (point, done, last_residual, status == WARM_STOPPED, status == WARM_FAR,
+                contacts if status == WARM_CONVERGED else None)
 
     def _contact_arguments(self) -> tuple:
         """What the compiled contacts' results take of the bearing beside the springs
@@ -919,6 +914,14 @@ def _refresh_due(residual: float, last_residual: float | None, rtol: float) -> b
     if fresh and residual < last_residual:
         fresh = math.log(rtol / residual) < FINISH_ITERATIONS * math.log(residual / last_residual)
     return fresh
+
+
+def _compiled_point(qs, y, my, e, delta, q, force, n, length, gradient, mismatch, loaded, terms) -> "_Point":
+    """The :class:`_Point` a compiled loop reached, as it returns it (``terms``: the total energy, the energy
+    scale, the largest force, the largest residual, the loaded diagonals; :func:`~slewing_model.distribution.kernel._kept_iterations`)."""
+    total, energy_scale, peak_force, peak_residual, n_loaded = terms
+    return _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch, peak_force,
+                  peak_residual, loaded, n_loaded > 0, my)
 
 
 @dataclass
