@@ -18,10 +18,10 @@ called (the method wrapped for the run):
 
 Steps that form, border or invert an operator (their time is that work's: ``bench_operator.py``)
 are counted apart; the table is of the other steps, the usual ones. The compiled calls (the two big
-ones, the solve's and the friction's, and the other loops a step calls from Python: the start's trial point, the ring product, the
-operator's turn, the contacts' results, the life map) are then called again with the arguments they had in those steps,
-each several times in a row ("hot": its data and code in the cache, no Python around it): the sum
-of the hot calls is what a step made of one compiled call would still cost, the floor of issue
+ones, the solve's and the friction's, and the other loops a step calls from Python: the start's
+trial point, the ring product, the operator's turn, the contacts' results, the life map) are then
+called again with the arguments they had in those steps, each several times in a row ("hot": its
+data and code in the cache, no Python around it): the sum of the hot calls is what a step made of one compiled call would still cost, the floor of issue
 31's "one compiled call", against the median of the step as it runs now. The gap between a call in
 the step and the same call hot is what the step's cold caches cost it (the other parts' data and
 code ran in between).

@@ -917,8 +917,9 @@ def _refresh_due(residual: float, last_residual: float | None, rtol: float) -> b
 
 
 def _compiled_point(qs, y, my, e, delta, q, force, n, length, gradient, mismatch, loaded, terms) -> "_Point":
-    """The :class:`_Point` a compiled loop reached, as it returns it (``terms``: the total energy, the energy
-    scale, the largest force, the largest residual, the loaded diagonals; :func:`~slewing_model.distribution.kernel._kept_iterations`)."""
+    """The :class:`_Point` a compiled loop reached, as it returns it (``terms``: the total energy, the
+    energy scale, the largest force, the largest residual, the loaded diagonals;
+    :func:`~slewing_model.distribution.kernel._kept_iterations`)."""
     total, energy_scale, peak_force, peak_residual, n_loaded = terms
     return _Point(qs, y, e, delta, q, force, None, n, length, total, energy_scale, gradient, mismatch, peak_force,
                   peak_residual, loaded, n_loaded > 0, my)

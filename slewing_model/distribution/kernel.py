@@ -122,8 +122,8 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
 
 def _symmetric_times(matrix, vectors):
     """``(M V)^T`` (k, n) for a symmetric ``M`` (n, n; double or single precision) and ``V^T = vectors``
-    (k, n), summed in double column by column, ``sum_j v_j M_j`` with ``M``'s rows for its columns: a loop of vector operations, where
-    a row's dot product is one chain of additions. ``M`` symmetric to round-off (a bordered
+    (k, n), summed in double column by column, ``sum_j v_j M_j`` with ``M``'s rows for its columns: a
+    loop of vector operations, where a row's dot product is one chain of additions. ``M`` symmetric to round-off (a bordered
     ``W^-1``) gives ``M^T V``, which differs from ``M V`` by round-off."""
     k, n = vectors.shape
     out = np.zeros((k, n))
@@ -805,7 +805,9 @@ def _warm_solve(separation, jacobian_rows, natural_length, stiffness, f_scaled, 
         for i in range(rows.size):
             for c in range(5):
                 same = same and op_jacobian[i, c] == jacobian_rows[rows[i], c]
-        if not same:
+        if op_jacobian.shape[0] != rows.size:                    # (as numpy's turn: formed anew)
+            status = WARM_NOT_TURNED
+        elif not same:
             new = np.empty((rows.size, 5))
             for i in range(rows.size):
                 new[i] = jacobian_rows[rows[i]]
