@@ -176,7 +176,6 @@ def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
 OPERATOR_PRECISION = np.float32
 
 
-
 def kept_precision(inverse: np.ndarray) -> np.ndarray:
     """``inverse`` as a :class:`ReducedOperator` keeps it: in single precision where it was computed
     so (an inverse by halves in :data:`OPERATOR_PRECISION`, which passed the check), else in double.
@@ -184,11 +183,11 @@ def kept_precision(inverse: np.ndarray) -> np.ndarray:
     The Newton iterations with a kept operator multiply by it 4-5 times a step, and the product
     reads all of it (the pitch bearing's 368 rows: 1.08 MB in double, from beyond the core's cache
     at a step's first iteration): kept in single precision it reads half, in products that still
-    sum in double (the pitch bearing's complete steps 0.93 of the time, docs/speed.md, "Issue 31,
+    sum in double (the pitch bearing's complete steps 0.93-0.95 of the time, docs/speed.md, "Issue 31,
     fourteenth turn"). An inverse computed in single precision loses nothing so kept; one bordered
     in double from it (:func:`update_operator`) is rounded back, an error of ``6e-8`` relative per
-    entry against the ``1e-7 cond(W)`` it already had. An inverse made in double (:func:`checked_inverse`:
-    ``W`` too ill-conditioned for single precision) stays double."""
+    entry against the ``1e-7 cond(W)`` it already had. An inverse made in double
+    (:func:`checked_inverse`: ``W`` too ill-conditioned for single precision) stays double."""
     return inverse if inverse.dtype == np.float32 else inverse.astype(np.float64, copy=False)
 
 
@@ -512,10 +511,10 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     with its coupling to the Jacobian (4B, 5) of now (``jacobian`` None: the pending operator,
     inverted). A ``W`` of :data:`LEAF` rows or fewer is inverted in one stage. The stages run in
     :func:`method_precision`; the inverse, once done, is checked (:func:`checked_inverse`) and
-    kept as :func:`kept_precision` keeps it. An inverse that misses the check is made again through the Cholesky factor:
-    with ``again``, as a pending operator of the next method at stage 0 (by halves: 1, in single
-    precision; 1: 2, in double), whose stages the next calls run (a solve that can go on without it,
-    or a bounded one: spread over steps as any new operator); else at once. A ``W`` singular in
+    kept as :func:`kept_precision` keeps it. An inverse that misses the check is made again through
+    the Cholesky factor: with ``again``, as a pending operator of the next method at stage 0 (by
+    halves: 1, in single precision; 1: 2, in double), whose stages the next calls run (a solve that
+    can go on without it, or a bounded one: spread over steps as any new operator); else at once. A ``W`` singular in
     single precision (the preload's alone, condition 4e13 on the yaw bearing) is made again so in
     double (method 2): with ``again`` spread, else at once (:func:`checked_inverse`)."""
     if until is None:
@@ -539,7 +538,7 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             pending = replace(pending, stage=len(STAGES), parts=(None,))     # else at once
         if pending.stage == len(STAGES):
             inverse = pending.parts[0]
-            if inverse is not None:          # kept as made (W^-1 = S (S W S)^-1 S in double for the factor's), checked
+            if inverse is not None:          # as made (W^-1 = S (S W S)^-1 S in double for the factor's), checked
                 inverse = _unscaled(inverse, pending.scaled[1]) if pending.method else kept_precision(inverse)
                 if not passes_check(pending.matrix, inverse):
                     if again and method_precision(pending.method) != np.float64:
