@@ -130,7 +130,9 @@ HELD_WORK = 5e7
 #: a bounded solve's Newton iterations count against BOUNDED_WORK too, each (BimeSolver._iteration_work)
 #: its product with the operator's inverse, ``2 n^2`` for ``n`` rows, times the first, and its trial point and
 #: ring products, the second times the balls: 2.9e6 for the pitch bearing's kept operator (368 rows, 150
-#: balls), whose iterations took 55 us each in a step (``benchmarks/bench_step_parts.py``: 254 us for 4.6)
+#: balls), whose iterations took 55 us each in a step (``benchmarks/bench_step_parts.py``: 254 us for 4.6).
+#: With the kept inverse in single precision (fourteenth turn) they take 44.8 us; a product factor of 2.9
+#: made no clear difference side by side (docs/speed.md), so it stays
 ITERATION_WEIGHT = (5.0, 1.1e4)
 STEP_WORK = ("complete", "bounded")
 #: a warm solve with a kept operator and no stage of a new one due (a co-simulation's usual step) runs its
@@ -183,8 +185,8 @@ class BimeSolver:
         and ring operator inversions that takes (the pitch bearing's moment reversed in one step:
         9 and 5, from the held-rings start of :meth:`_held_rings_start`). "bounded" (real time): at
         most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of work, the operator's
-        and the iterations' (a new operator's inverse spread over as many solves as that takes); a solve that would
-        need more returns its last iterate with ``converged=False`` and its ``residual``, keeps its operator
+        and the iterations' (a new operator's inverse spread over as many solves as that takes); a
+        solve that would need more returns its last iterate with ``converged=False`` and its ``residual``, keeps its operator
         (and one being inverted), and the next warm solve goes on from there. A cold solve
         (no ``initial``) is always complete.
     """
@@ -610,15 +612,12 @@ class BimeSolver:
         (:func:`slewing_model.distribution.kernel._kept_iterations`: the steps of :meth:`solve`, up
         to the first that needs more than the operator's product): the iterations done, the point
         reached and the last residual."""
-        a, op = self.assembly, self._reduced
         dw = self.bearing.ball_diameter
         rules = np.array([self.rtol, load_scale, trust, dw * dw, REFRESH, FINISH_ITERATIONS, last_residual])
         terms = np.array([p.total, p.energy_scale, p.peak_force, p.peak_residual, float(p.any_loaded)])
         done, last_residual, *reached = compiled_kept_iterations()(
-            self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
-            *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
-            op.schur_inverse, op.active, *self._product_operands, p.qs, p.y, p.ring_motion, p.e, p.delta, p.q,
-            p.force, p.n, p.length, p.gradient, p.mismatch, p.loaded, terms, rules, iterations, limit)
+            *self._kept_operands(f_scaled), p.qs, p.y, p.ring_motion, p.e, p.delta, p.q, p.force, p.n, p.length,
+            p.gradient, p.mismatch, p.loaded, terms, rules, iterations, limit)
         if not done:
             return 0, p, last_residual
         return done, _compiled_point(*reached), last_residual
@@ -630,17 +629,15 @@ class BimeSolver:
         start's test, the operator turned with the ring, its iterations and, at an equilibrium, the
         contacts' results. Returns the point reached, the iterations done, the last residual, whether
         the kept loop stopped before the next iteration, whether the held-rings start is still to be
-        tried (a start far off), and the contacts' results (:func:`~slewing_model.distribution.kernel._contact_results`)
-        where the point is the equilibrium, else None: there :meth:`solve` goes on."""
-        a, op, b = self.assembly, self._reduced, self.bearing
-        dw = b.ball_diameter
+        tried (a start far off), and the contacts' results
+        (:func:`~slewing_model.distribution.kernel._contact_results`) where the point is the
+        equilibrium, else None: there :meth:`solve` goes on."""
+        op, dw = self._reduced, self.bearing.ball_diameter
         rules = np.array([self.rtol, load_scale, trust, dw * dw, REFRESH, FINISH_ITERATIONS, HELD_START, mu,
                           self._turn_tolerance])
         status, done, last_residual, turned, changed, *found = compiled_warm_solve()(
-            self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
-            *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
-            op.schur_inverse, op.active, *self._product_operands, qs, y, rules, limit,
-            self._reduced_jacobian is not self._jacobian_rows, *self._contact_arguments())
+            *self._kept_operands(f_scaled), qs, y, rules, limit, self._reduced_jacobian is not self._jacobian_rows,
+            *self._contact_arguments())
         reached, (coupling, schur_inverse, jacobian), contacts = found[:13], found[13:16], found[16:]
         if turned:
             if changed:
@@ -652,6 +649,14 @@ class BimeSolver:
             self._work_left -= done * self._iteration_work(point)
         return (point, done, last_residual, status == WARM_STOPPED, status == WARM_FAR,
                 contacts if status == WARM_CONVERGED else None)
+
+    def _kept_operands(self, f_scaled: np.ndarray) -> tuple:
+        """What the compiled loops of the kept operator's iterations take first (``kernel._KEPT_OPERAND_TYPES``):
+        the springs, the loads, the loaded threshold, the kept operator and the ring product's tables."""
+        a, op = self.assembly, self._reduced
+        return (self._separation, self._jacobian_rows, a.natural_length, a.stiffness, f_scaled, self._loaded_from,
+                *product_inverses(op.inverse), op.contact_compliance, op.rows, op.jacobian, op.coupling,
+                op.schur_inverse, op.active, *self._product_operands)
 
     def _contact_arguments(self) -> tuple:
         """What the compiled contacts' results take of the bearing beside the springs

@@ -485,8 +485,12 @@ def _interp(x, xp, fp, left, right, guess):
     return slope * (x - xp[j]) + fp[j], j
 
 
+#: the types of what :func:`_contact_results` takes of the bearing beside the springs' loads and vectors
+#: (``BimeSolver._contact_arguments``): contact stiffness, ball diameters, groove radii, pitch diameter,
+#: which contacts are inner, the modulus, the Hertz tables, the groove edges
+_BEARING_CONTACT_TYPES = "f8[:, :], f8[:], f8[:, :], f8, b1[:], f8, f8[:], f8[:], f8[:], f8[:]"
 _RESULTS_SIGNATURE = ("Tuple((f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], b1[:, :], i8))("
-                      "f8[:, :], f8[:, :, :], f8[:, :], f8[:], f8[:, :], f8, b1[:], f8, f8[:], f8[:], f8[:], f8[:])")
+                      f"f8[:, :], f8[:, :, :], {_BEARING_CONTACT_TYPES})")
 
 
 def _hertz_contact(q, dw, groove_radius, contact_angle, pitch_diameter, inner, modulus, f_table, log_kappa_table,
@@ -651,12 +655,16 @@ def _ring_times(cos_table, sin_table, cos_by_ball, sin_by_ball, harmonic_real, h
     return out
 
 
+#: the types of what the loops of the kept operator's iterations take first (``BimeSolver._kept_operands``):
+#: the springs (separation, Jacobian rows, natural lengths, stiffness), the loads, the loaded threshold; the
+#: operator (its inverse in double or single, compliance, rows, Jacobian, coupling, Schur complement's
+#: inverse, diagonals); the ring product's tables (:func:`_ring_times`)
+_KEPT_OPERAND_TYPES = ("f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
+                       "f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
+                       "f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1]")
 _KEPT_SIGNATURE = (
     "Tuple((i8, f8, f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
-    "f8[:, ::1], f8[::1], f8[::1], b1[::1], f8[::1]))("
-    "f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
-    "f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
-    "f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
+    f"f8[:, ::1], f8[::1], f8[::1], b1[::1], f8[::1]))({_KEPT_OPERAND_TYPES}, "
     "f8[::1], f8[::1], f8[::1], f8[:, :, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], f8[:, ::1], "
     "f8[::1], f8[::1], b1[::1], f8[:], f8[:], i8, i8)")
 
@@ -755,11 +763,8 @@ WARM_CONVERGED, WARM_STOPPED, WARM_FAR, WARM_NOT_TURNED = 0, 1, 2, 3
 _WARM_SIGNATURE = (
     "Tuple((i8, i8, f8, b1, b1, f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
     "f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], f8[:, :], "
-    "f8[:, :], f8[:, :], b1[:, :], i8))("
-    "f8[:, :, :], f8[:, :], f8[:, :], f8[:, :], f8[:], f8, "
-    "f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], f8[:, :], b1[:], "
-    "f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, ::1], f8[:, :, ::1], f8[:, :, ::1], "
-    "f8[::1], f8[::1], f8[:], i8, b1, f8[:, :], f8[:], f8[:, :], f8, b1[:], f8, f8[:], f8[:], f8[:], f8[:])")
+    f"f8[:, :], f8[:, :], b1[:, :], i8))({_KEPT_OPERAND_TYPES}, f8[::1], f8[::1], f8[:], i8, b1, "
+    f"{_BEARING_CONTACT_TYPES})")
 
 
 def _warm_solve(separation, jacobian_rows, natural_length, stiffness, f_scaled, loaded_from,
@@ -801,16 +806,12 @@ def _warm_solve(separation, jacobian_rows, natural_length, stiffness, f_scaled, 
     converged = status == WARM_STOPPED and (peak_residual / scale <= rtol or scale == 1e-300)
     turned = changed = False
     if status == WARM_STOPPED and not converged and turn:          # the kept operator follows the ring
-        same = op_jacobian.shape[0] == rows.size
+        new = np.empty((rows.size, 5))
         for i in range(rows.size):
-            for c in range(5):
-                same = same and op_jacobian[i, c] == jacobian_rows[rows[i], c]
+            new[i] = jacobian_rows[rows[i]]
         if op_jacobian.shape[0] != rows.size:                    # (as numpy's turn: formed anew)
             status = WARM_NOT_TURNED
-        elif not same:
-            new = np.empty((rows.size, 5))
-            for i in range(rows.size):
-                new[i] = jacobian_rows[rows[i]]
+        elif not (op_jacobian == new).all():
             found, new_coupling, new_schur, new_jacobian = _column_turn(op_jacobian, new, coupling, mu,
                                                                        turn_tolerance)
             if not found:

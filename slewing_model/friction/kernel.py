@@ -129,8 +129,8 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
 
 def _solve3(a, rhs, out, m):
     """``out = a^-1 rhs`` for a symmetric (3, 3) ``a``, eliminated in ``m`` (3, 4), the caller's (an
-    array made per call cost 37 of its 53 ns, measured; 300-450 calls a step): Gaussian elimination with partial
-    pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same; the contacts'
+    array made per call cost 37 of its 53 ns, measured; 300-450 calls a step): Gaussian elimination
+    with partial pivoting (LAPACK's ``gesv``, which ``solve_per_ball`` calls, does the same; the contacts'
     general ``_solve_small`` is the same elimination, slower here by its sizes known late). A
     singular ``a`` (not met) is regularised as ``solve_per_ball`` does: ``a + 1e-13 mean(diag) I``;
     still singular, it raises ValueError (numpy's LinAlgError is one)."""
@@ -198,9 +198,9 @@ def _quadratic(g, h, du):
 def _damped_step(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta, has_extra, f, g, h, extra,
                  minus_g, damped, du, work):
     """The damped step ``du = -(H + theta (M - H))^-1 g`` of one ball at ``x`` into ``du``,
-    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra`` (``damped`` and
-    ``work`` the caller's scratch arrays); returns the power at ``x``, the slope ``g . du`` and the decrease the quadratic model
-    predicts, ``-(g . du + du . H du / 2)``."""
+    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra`` (``damped``
+    and ``work`` the caller's scratch arrays); returns the power at ``x``, the slope ``g . du`` and
+    the decrease the quadratic model predicts, ``-(g . du + du . H du / 2)``."""
     if not has_extra:
         f = _ball_evaluate(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, extra)
     damped[:, :] = h + theta * extra

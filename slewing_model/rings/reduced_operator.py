@@ -183,8 +183,8 @@ def kept_precision(inverse: np.ndarray) -> np.ndarray:
     The Newton iterations with a kept operator multiply by it 4-5 times a step, and the product
     reads all of it (the pitch bearing's 368 rows: 1.08 MB in double, from beyond the core's cache
     at a step's first iteration): kept in single precision it reads half, in products that still
-    sum in double (the pitch bearing's complete steps 0.93-0.95 of the time, docs/speed.md, "Issue 31,
-    fourteenth turn"). An inverse computed in single precision loses nothing so kept; one bordered
+    sum in double (the pitch bearing's complete steps 0.93-0.95 of the time, docs/speed.md, "Issue
+    31, fourteenth turn"). An inverse computed in single precision loses nothing so kept; one bordered
     in double from it (:func:`update_operator`) is rounded back, an error of ``6e-8`` relative per
     entry against the ``1e-7 cond(W)`` it already had. An inverse made in double
     (:func:`checked_inverse`: ``W`` too ill-conditioned for single precision) stays double."""
@@ -514,9 +514,9 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
     kept as :func:`kept_precision` keeps it. An inverse that misses the check is made again through
     the Cholesky factor: with ``again``, as a pending operator of the next method at stage 0 (by
     halves: 1, in single precision; 1: 2, in double), whose stages the next calls run (a solve that
-    can go on without it, or a bounded one: spread over steps as any new operator); else at once. A ``W`` singular in
-    single precision (the preload's alone, condition 4e13 on the yaw bearing) is made again so in
-    double (method 2): with ``again`` spread, else at once (:func:`checked_inverse`)."""
+    can go on without it, or a bounded one: spread over steps as any new operator); else at once. A
+    ``W`` singular in single precision (the preload's alone, condition 4e13 on the yaw bearing) is
+    made again so in double (method 2): with ``again`` spread, else at once (:func:`checked_inverse`)."""
     if until is None:
         until = step_end(pending)
     if pending.stage < until:
