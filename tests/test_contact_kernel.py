@@ -177,6 +177,16 @@ def test_compiled_newton_step_equals_the_numpy_step(pitch, precision, monkeypatc
     ja = solver.jacobian.reshape(-1, 5)[bordered.rows]
     for want, got in zip(operator_coupling(bordered.inverse, ja, mu), compiled_coupling(bordered.inverse, ja, mu)):
         assert np.abs(got - want).max() <= 1e-11 * np.abs(want).max()
+    # the products with W^-1 (the coupling's, the inverse's check) read it as kept and sum in double: they are
+    # BLAS's product with it converted, to double round-off (summed in single precision they would be 1e-7 off)
+    from slewing_model.distribution.kernel import inverse_product as compiled_product
+    from slewing_model.rings.reduced_operator import inverse_product
+
+    vectors = np.vstack([ja.T, 1.0 + 0.125 * (np.arange(bordered.rows.size) % 7)])
+    exact = bordered.inverse.astype(np.float64) @ vectors.T
+    for product in (inverse_product, compiled_product):
+        got = product(bordered.inverse, vectors).T
+        assert np.abs(got - exact).max() <= 1e-13 * np.abs(exact).max()
     for op in (assemble_operator(*args, solver.jacobian, masks[0], mu), bordered):
         (dq, y), (dq_c, y_c) = newton_step(op, off, f_scaled), compiled_step(op, off, f_scaled)
         assert np.abs(dq_c - dq).max() <= 1e-11 * np.abs(dq).max()

@@ -808,8 +808,9 @@ class BimeSolver:
         n, stage = pending.matrix.shape[0], pending.stage
         while stage < until and self._take(stage_work(n, stage, pending.method)):
             stage += 1
-        if stage > pending.stage:    # an inverse that misses the check: made again, spread where the solve can
-            pending = advance_operator(pending, None, None, until=stage,  # wait or its work is bounded
+        if stage > pending.stage:
+            # an inverse that misses the check: made again, spread where the solve can wait or its work is bounded
+            pending = advance_operator(pending, None, None, self._arithmetic, until=stage,
                                        again=not required or math.isfinite(self._work_left))
         if pending.stage >= len(STAGES) and until >= len(STAGES):
             return advance_operator(pending, self.jacobian, mu, self._arithmetic)

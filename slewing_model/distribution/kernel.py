@@ -429,14 +429,26 @@ def _operator_matrix(blocks, rows, normal, delta, length, load, stiffness):
     return a_inv, w
 
 
-_COUPLING_SIGNATURE = "Tuple((f8[:, :], f8[:, :]))(f8[:, ::1], f8[:, :], f8)"
+_PRODUCT_SIGNATURE = "f8[:, :](f8[:, ::1], f4[:, ::1], f8[:, :])"
 
 
-def _operator_coupling(inverse, ja, mu):
+def _inverse_product(inverse, single_inverse, vectors):
+    """``(W^-1 V)^T`` (k, n) for ``V^T = vectors`` (k, n), summed in double column by column
+    (:func:`_symmetric_times`), ``W^-1`` ``inverse`` (double) or, where that is empty,
+    ``single_inverse`` (:func:`_newton_step`): read in the precision it is kept in, not converted."""
+    if inverse.shape[0] == vectors.shape[1]:
+        return _symmetric_times(inverse, vectors)
+    return _symmetric_times(single_inverse, vectors)
+
+
+_COUPLING_SIGNATURE = "Tuple((f8[:, :], f8[:, :]))(f8[:, ::1], f4[:, ::1], f8[:, :], f8)"
+
+
+def _operator_coupling(inverse, single_inverse, ja, mu):
     """:func:`slewing_model.rings.reduced_operator.operator_coupling` as one compiled loop: ``W^-1 J_a``
-    summed column by column (:func:`_symmetric_times`) and
-    ``(J_a^T W^-1 J_a + mu I)^-1``, or an empty inverse where that is singular."""
-    coupling = np.ascontiguousarray(_symmetric_times(inverse, np.ascontiguousarray(ja.T)).T)
+    (:func:`_inverse_product`; ``W^-1`` as there) and ``(J_a^T W^-1 J_a + mu I)^-1``, or an empty inverse
+    where that is singular."""
+    coupling = np.ascontiguousarray(_inverse_product(inverse, single_inverse, np.ascontiguousarray(ja.T)).T)
     found, schur_inverse = _schur_inverse(ja, coupling, mu)
     return coupling, schur_inverse if found else np.empty((0, 0))
 
@@ -944,7 +956,7 @@ def _rigid_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, 
 #: the helpers the load distribution's loops call
 _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_bordered_blocks",
             "_periodic_interp", "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse",
-            "_column_turn", "_kept_iterations", "_contact_results")
+            "_column_turn", "_kept_iterations", "_contact_results", "_inverse_product")
 
 
 #: numpy's floating-point semantics: a division by zero gives inf or NaN as the numpy code does,
@@ -965,6 +977,7 @@ compiled_jacobian = loop_factory(KERNELS, _compile, _jacobian, _JACOBIAN_SIGNATU
 compiled_bordered_inverse = loop_factory(KERNELS, _compile, _bordered_inverse, _BORDER_SIGNATURE)
 compiled_operator_matrix = loop_factory(KERNELS, _compile, _operator_matrix, _MATRIX_SIGNATURE)
 compiled_operator_coupling = loop_factory(KERNELS, _compile, _operator_coupling, _COUPLING_SIGNATURE)
+compiled_inverse_product = loop_factory(KERNELS, _compile, _inverse_product, _PRODUCT_SIGNATURE)
 compiled_contact_results = loop_factory(KERNELS, _compile, _contact_results, _RESULTS_SIGNATURE)
 compiled_add_groove_errors = loop_factory(KERNELS, _compile, _add_groove_errors, _GROOVE_ERRORS_SIGNATURE)
 compiled_ring_times = loop_factory(KERNELS, _compile, _ring_times, _RING_TIMES_SIGNATURE)
@@ -1035,10 +1048,15 @@ def operator_matrix(point, compliance, stiffness, active):
 def operator_coupling(inverse, ja, mu):
     """:func:`slewing_model.rings.reduced_operator.operator_coupling` by the compiled loop (a singular
     complement, not met, raises numpy's LinAlgError as the numpy one does)."""
-    coupling, schur_inverse = compiled_operator_coupling()(np.ascontiguousarray(inverse, dtype=np.float64), ja, mu)
+    coupling, schur_inverse = compiled_operator_coupling()(*product_inverses(inverse), ja, mu)
     if schur_inverse.size == 0:
         raise np.linalg.LinAlgError("singular matrix: the Schur complement of the reduced operator")
     return coupling, schur_inverse
+
+
+def inverse_product(inverse, vectors):
+    """:func:`slewing_model.rings.reduced_operator.inverse_product` by the compiled loop."""
+    return compiled_inverse_product()(*product_inverses(inverse), np.ascontiguousarray(vectors, dtype=np.float64))
 
 
 def add_groove_errors(centre, theta, error_map, contacts):
@@ -1058,4 +1076,5 @@ def contact_tables(youngs_modulus, poisson_ratio) -> tuple:
 
 
 #: the reduced operator's arithmetic as compiled loops (:class:`slewing_model.rings.reduced_operator.OperatorArithmetic`)
-COMPILED_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
+COMPILED_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step,
+                                         inverse_product)

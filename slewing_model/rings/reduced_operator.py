@@ -98,8 +98,16 @@ def reduced_operator(rows, active, contact_compliance, inverse, jacobian: np.nda
 
 def operator_coupling(inverse: np.ndarray, ja: np.ndarray, mu: float):
     """``W^-1 J_a`` and ``(J_a^T W^-1 J_a + mu I)^-1``."""
-    coupling = inverse @ ja
+    coupling = inverse_product(inverse, ja.T).T
     return coupling, np.linalg.inv(ja.T @ coupling + mu * np.eye(5))
+
+
+def inverse_product(inverse: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """``(W^-1 V)^T`` (k, n) for ``V^T = vectors`` (k, n) and a symmetric ``W^-1 = inverse``, summed in
+    double. An inverse kept in single precision (:func:`kept_precision`) is converted first: numpy's
+    product of the two precisions as they are runs without BLAS (in a bounded step after a moment
+    reversal, 74-628 us for one vector, docs/speed.md, "Issue 31, fifteenth turn")."""
+    return vectors @ inverse.astype(np.float64, copy=False)
 
 
 #: how far a turned Jacobian may be off the ring's own where errors move the grooves with it
@@ -490,7 +498,7 @@ def start_operator(point, compliance, stiffness, active, arithmetic: "OperatorAr
     """Form ``W = (A^-1 + M)_aa`` on the ``active`` diagonals at an iterate (:func:`operator_matrix`)
     and run the stages of its inverse up to ``until`` (default: the first step's, :func:`advance_operator`)."""
     rows, a_inv, w_mat = _arithmetic(arithmetic).form(point, compliance, stiffness, active)
-    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None, until=until)
+    return advance_operator(PendingOperator(rows, active, a_inv, w_mat, 0, ()), None, None, arithmetic, until=until)
 
 
 def operator_matrix(point, compliance, stiffness, active):
@@ -540,12 +548,12 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
             inverse = pending.parts[0]
             if inverse is not None:          # as made (W^-1 = S (S W S)^-1 S in double for the factor's), checked
                 inverse = _unscaled(inverse, pending.scaled[1]) if pending.method else kept_precision(inverse)
-                if not passes_check(pending.matrix, inverse):
+                if not passes_check(pending.matrix, inverse, arithmetic):
                     if again and method_precision(pending.method) != np.float64:
                         return replace(pending, stage=0, parts=(), method=pending.method + 1, scaled=())
                     inverse = None
             if inverse is None:
-                inverse = checked_inverse(pending.matrix, pending.method)
+                inverse = checked_inverse(pending.matrix, pending.method, arithmetic)
             pending = replace(pending, parts=(inverse,), scaled=())
     if pending.stage < len(STAGES) or jacobian is None:
         return pending
@@ -562,7 +570,8 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
 INVERSE_CHECK = 0.1
 
 
-def checked_inverse(w_mat: np.ndarray, method: int = 0) -> np.ndarray:
+def checked_inverse(w_mat: np.ndarray, method: int = 0, arithmetic: "OperatorArithmetic | None" = None
+                    ) -> np.ndarray:
     """The inverse of ``W`` (``w_mat``, double) in double precision, made again where the one
     :class:`PendingOperator`'s ``method`` made (by :func:`spd_inverse` in :data:`OPERATOR_PRECISION`, or
     through the Cholesky factor) missed the check (:func:`passes_check`) or ``W`` was singular in its
@@ -585,16 +594,18 @@ def checked_inverse(w_mat: np.ndarray, method: int = 0) -> np.ndarray:
             inverse = cholesky_inverse(w_mat, precision)
         except np.linalg.LinAlgError:       # not positive definite in this precision
             continue
-        if passes_check(w_mat, inverse):
+        if passes_check(w_mat, inverse, arithmetic):
             return inverse
     return _lapack_inverse(w_mat)
 
 
-def passes_check(w_mat: np.ndarray, inverse: np.ndarray) -> bool:
+def passes_check(w_mat: np.ndarray, inverse: np.ndarray, arithmetic: "OperatorArithmetic | None" = None) -> bool:
     """Whether ``W inverse v`` is within :data:`INVERSE_CHECK` of ``v`` for the probe
-    ``v = (1, 1.125, ..., 1.75, 1, ...)`` (relative to its largest entry)."""
+    ``v = (1, 1.125, ..., 1.75, 1, ...)`` (relative to its largest entry); ``inverse v`` summed in double
+    (``arithmetic.product``, :func:`inverse_product`)."""
     probe = 1.0 + 0.125 * (np.arange(w_mat.shape[0]) % 7)
-    return float(np.abs(w_mat @ (inverse @ probe) - probe).max()) <= INVERSE_CHECK * float(probe.max())
+    product = _arithmetic(arithmetic).product(inverse, probe[None, :])[0]
+    return float(np.abs(w_mat @ product - probe).max()) <= INVERSE_CHECK * float(probe.max())
 
 
 def _lapack_inverse(w_mat: np.ndarray) -> np.ndarray:
@@ -756,10 +767,12 @@ class OperatorArithmetic:
     turn: object        # column_turn
     border: object      # bordered_inverse
     step: object        # newton_step
+    product: object     # inverse_product
 
 
 #: this module's numpy functions
-NUMPY_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step)
+NUMPY_ARITHMETIC = OperatorArithmetic(operator_matrix, operator_coupling, column_turn, bordered_inverse, newton_step,
+                                      inverse_product)
 
 
 def _arithmetic(arithmetic: OperatorArithmetic | None) -> OperatorArithmetic:
