@@ -93,14 +93,16 @@ SPREAD_ITERATIONS = 8
 #: :func:`~slewing_model.rings.reduced_operator.stage_work`; forming ``W``:
 #: :func:`~slewing_model.rings.reduced_operator.forming_work`;
 #: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
-#: step's answer does not depend on the machine. 1.1e8, about 2 ms, chosen by the pitch bearing's
+#: step's answer does not depend on the machine. 1e8, about 1.8 ms, chosen by the pitch bearing's
 #: scenarios of ``benchmarks/bench_realtime.py`` with ``benchmarks/bench_bound.py`` (library, caps side
-#: by side in one run; docs/speed.md, "Issue 31, thirteenth turn"): 9e7 flagged NREL's 183 steps of
-#: 6000, 1e8 55, 1.1e8 37, 1.2e8 28, and the slowest steps grew with the cap from 1e8 (3.0-4.7 NREL
-#: medians, 3.8-4.0 at 1.1e8, 4.0-4.3 at 1.2e8). Before, 8e7 of operator work alone, with the iterations
-#: free and the stages counted at 0.75 of their time (the eleventh turn's choice: against 1e8 the
-#: steps slower than 4 NREL medians 0-4 instead of 2-15 a scenario; 7e7 flagged NREL's 87). ...
-BOUNDED_WORK = 1.1e8
+#: by side in one run; docs/speed.md, "Issue 31, fifteenth turn"), once a new operator's check and
+#: coupling no longer took 0.4-0.5 ms outside the count: against 1.1e8 (the thirteenth turn's choice),
+#: two runs, the slowest steps of the reversal, the jump, the feather and the turbulence 3.3-3.6 NREL
+#: medians instead of 3.6-4.7, none of them over 4 instead of 0-7 a scenario; NREL's flagged steps 61 of
+#: 6000 instead of 36, the reversal's 51 of 2000 instead of 44 (9e7: 198 and 65). Before, 8e7 of operator
+#: work alone, with the iterations free and the stages counted at 0.75 of their time (the eleventh turn).
+#: ...
+BOUNDED_WORK = 1e8
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
 BOUNDED_ITERATIONS = 12

@@ -91,7 +91,7 @@ class SimulatorSettings:
         How much a step may do (``step_work`` of :class:`slewing_model.distribution.bime.BimeSolver`):
         "complete" solves every step to ``tolerance``, however long a sudden change of the loads
         makes it (a moment reversed in one step: tens of ms); "bounded" (real time) caps a step's
-        work, its Newton iterations and ring operator work together, at about 2 ms (``BOUNDED_WORK``;
+        work, its Newton iterations and ring operator work together, at about 1.8 ms (``BOUNDED_WORK``;
         a new operator's inverse spread over steps), and a step that
         would need more answers with its last iterate, ``distribution.converged`` False and its
         ``distribution.residual``, and carries the rest over to the next steps; the friction
