@@ -23,7 +23,7 @@ million a millisecond. A part whose time is far above its share of that count is
 not see.
 
 Run: .venv/bin/python benchmarks/bench_slowest.py [--scenarios nrel reversal ...] [--top 5]
-     [--step-work bounded|complete]   (about 1 minute for the five scenarios)
+     [--step-work bounded|complete]   (about 20 s for the five scenarios)
 """
 from __future__ import annotations
 
