@@ -148,7 +148,7 @@ def _newton_step(inverse, single_inverse, contact_compliance, rows, jacobian, co
 
     ``W^-1`` is ``inverse`` (double) or, where that is empty, ``single_inverse``
     (:func:`slewing_model.rings.reduced_operator.kept_precision`; :func:`product_inverses`);
-    ``W^-1 rhs`` is summed in double, column by column (:func:`_symmetric_times`)."""
+    ``W^-1 rhs`` is summed in double, column by column (:func:`_inverse_product`)."""
     n = rows.size
     rhs = np.empty(n)
     for k in range(n // 2):                 # A^-1 (f - y) of each diagonal, + (M y_off) on its rows
@@ -158,10 +158,7 @@ def _newton_step(inverse, single_inverse, contact_compliance, rows, jacobian, co
         for c in range(2):
             rhs[2 * k + c] = (contact_compliance[k, c, 0] * m0 + contact_compliance[k, c, 1] * m1
                               + off_motion[rows[2 * k + c]])
-    if inverse.shape[0] == n:
-        w = _symmetric_times(inverse, rhs.reshape(1, n))[0]
-    else:
-        w = _symmetric_times(single_inverse, rhs.reshape(1, n))[0]
+    w = _inverse_product(inverse, single_inverse, rhs.reshape(1, n))[0]
     for i in range(n):
         w[i] += y[rows[i]]
     t = f_scaled.copy()                     # F - J_a^T w
@@ -302,7 +299,7 @@ _BORDER_SIGNATURE = ("Tuple((b1, f8[:, :], f8[:, :]))(f8[:, ::1], f4[:, ::1], f8
 def _bordered_inverse(inverse, single_inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu, bordered,
                       single_bordered):
     """:func:`slewing_model.rings.reduced_operator.bordered_inverse` as one compiled loop: the same blocks,
-    with ``W^-1 B`` summed column by column (:func:`_symmetric_times`) and ``W^-1 + X S X^T``
+    with ``W^-1 B`` summed column by column (:func:`_inverse_product`) and ``W^-1 + X S X^T``
     written in one pass over ``W^-1`` (numpy's product and sum take three, with a temporary the
     size of ``W^-1``).
 
@@ -312,10 +309,7 @@ def _bordered_inverse(inverse, single_inverse, b_mat, c_mat, jacobian, coupling,
     the new coupling and the new Schur complement's inverse."""
     n, r = b_mat.shape
     b_t = np.ascontiguousarray(b_mat.T)
-    if inverse.shape[0] == n:
-        x_t = _symmetric_times(inverse, b_t)                            # X^T = (W^-1 B)^T
-    else:
-        x_t = _symmetric_times(single_inverse, b_t)
+    x_t = _inverse_product(inverse, single_inverse, b_t)                 # X^T = (W^-1 B)^T
     reduced = np.empty((r, r))                     # C - B^T X
     for k in range(r):
         for m in range(r):
@@ -435,7 +429,8 @@ _PRODUCT_SIGNATURE = "f8[:, :](f8[:, ::1], f4[:, ::1], f8[:, :])"
 def _inverse_product(inverse, single_inverse, vectors):
     """``(W^-1 V)^T`` (k, n) for ``V^T = vectors`` (k, n), summed in double column by column
     (:func:`_symmetric_times`), ``W^-1`` ``inverse`` (double) or, where that is empty,
-    ``single_inverse`` (:func:`_newton_step`): read in the precision it is kept in, not converted."""
+    ``single_inverse`` (:func:`product_inverses`): read in the precision it is kept in, not converted.
+    The product of every loop with a kept operator's inverse (the Newton step, bordering, coupling)."""
     if inverse.shape[0] == vectors.shape[1]:
         return _symmetric_times(inverse, vectors)
     return _symmetric_times(single_inverse, vectors)

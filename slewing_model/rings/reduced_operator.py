@@ -739,7 +739,7 @@ def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray, off_motion: np
     rhs = (op.contact_compliance @ mismatch[..., None]).ravel()
     if off_motion is not None:
         rhs = rhs + off_motion[op.rows]
-    w_vec = point.y[op.rows] + op.inverse @ rhs
+    w_vec = point.y[op.rows] + inverse_product(op.inverse, rhs[None, :])[0]
     dq = op.schur_inverse @ (f_scaled - op.jacobian.T @ w_vec)
     y_new = np.zeros_like(point.y)
     y_new[op.rows] = w_vec + op.coupling @ dq
