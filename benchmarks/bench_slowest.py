@@ -37,7 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_realtime import SCENARIOS, scenario  # noqa: E402
-from bench_step_parts import patched  # noqa: E402
+from bench_step_parts import patched, timer  # noqa: E402
 from timing import print_table  # noqa: E402
 
 from slewing_model import Loads, load_bearing  # noqa: E402
@@ -65,22 +65,6 @@ PARTS = (
 WORK_RATE = 55e6
 
 
-def timer(label, spent, depth):
-    """A wrapper timing the outermost calls of a part (``_run_stages`` recurses) into ``spent[label]``."""
-    def wrap(original):
-        def timed(*args, **kwargs):
-            depth[label] = depth.get(label, 0) + 1
-            start = time.perf_counter()
-            try:
-                return original(*args, **kwargs)
-            finally:
-                depth[label] -= 1
-                if depth[label] == 0:
-                    spent[label] = spent.get(label, 0.0) + time.perf_counter() - start
-        return timed
-    return wrap
-
-
 def run(name: str, step_work: str) -> list[dict]:
     """Every step of the scenario ``name``: its time, flag, work charged and parts (ms)."""
     case = scenario(name)
@@ -89,10 +73,10 @@ def run(name: str, step_work: str) -> list[dict]:
     sim = simulator.BearingSimulator(bearing, superelement, simulator.SimulatorSettings(
         ring_model="flexible", load_frame="rotating", life=True, step_work=step_work, contact_kernel="auto"))
     sim.step(Loads(), 0.0, 0.0)                     # the start values, solved leaving initialization
-    steps, spent, depth = [], {}, {}
+    steps, spent = [], {}
     with ExitStack() as stack:
         for label, owner, attribute in PARTS:
-            stack.enter_context(patched(owner, attribute, timer(label, spent, depth)))
+            stack.enter_context(patched(owner, attribute, timer(label, spent)))
         for k in range(case.steps):
             spent.clear()
             start = time.perf_counter()

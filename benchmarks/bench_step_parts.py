@@ -88,14 +88,21 @@ def patched(owner, name, wrapper):
         setattr(owner, name, original)
 
 
-def timer(label, spent):
+def timer(label, spent, depth=None):
+    """A wrapper adding the time of the outermost calls of a part to ``spent[label]`` (a call within a call of
+    the same label, ``_run_stages``' recursion, is not counted twice; ``depth``: the calls open per label)."""
+    depth = {} if depth is None else depth
+
     def wrap(original):
         def timed(*args, **kwargs):
+            depth[label] = depth.get(label, 0) + 1
             start = time.perf_counter()
             try:
                 return original(*args, **kwargs)
             finally:
-                spent[label] = spent.get(label, 0.0) + time.perf_counter() - start
+                depth[label] -= 1
+                if depth[label] == 0:
+                    spent[label] = spent.get(label, 0.0) + time.perf_counter() - start
         return timed
     return wrap
 
