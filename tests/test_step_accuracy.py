@@ -118,6 +118,38 @@ def test_state_taken_while_a_new_operator_is_pending_repeats_the_steps():
             assert np.array_equal(q1, q2) and np.array_equal(d1, d2) and t1 == t2
 
 
+def test_a_refused_step_leaves_the_simulator_as_it_was():
+    """A step whose loads the bearing cannot carry raises, and the simulator restores itself
+    (``BearingSimulator._checkpoint``): taken while a new operator is pending, with the life
+    accumulator on, the steps after it equal to the last bit those of a twin that never saw it, the
+    life outputs too."""
+    from slewing_model import NoEquilibriumError
+
+    case = CASES["pitch"](STEPS)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    sims = [BearingSimulator(bearing, superelement, _settings(case, life=True)) for _ in range(2)]
+
+    def step(sim, k):
+        r = sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k])
+        return (r.distribution.contact_load, r.distribution.displacement, r.friction_torque,
+                sim.life.track_damage, sim.life.last_ratio)
+
+    k = 0
+    while sims[0].solver.pending_operator is None:
+        for sim in sims:
+            step(sim, k)
+        k += 1
+        assert k < STEPS - 5, "no new operator was pending within the case"
+    with pytest.raises(NoEquilibriumError, match="beyond what the bearing can carry"):
+        sims[0].step(Loads(*(50.0 * case.loads[k])), case.psi[k] + 0.3, case.omega[k])
+    assert sims[0].solver.pending_operator is not None
+    for j in range(k, k + 5):
+        got, want = step(sims[0], j), step(sims[1], j)
+        for a, b in zip(got, want):
+            assert np.array_equal(a, b, equal_nan=True), (j, a, b)
+
+
 def test_the_friction_start_carried_on_is_nearer_the_balls_motions_of_the_step():
     """The friction torque of a step starts from the last two steps' ball motions carried on as far as
     the loads go on (``simulator.extrapolated_motion``). For the pitch bearing's blade-root series it

@@ -26,6 +26,8 @@ from .dg03 import DG03Life, dg03_life, equivalent_axial_load
 from .oscillation import critical_angle, equivalent_revolutions, rainflow_cycles, span_mean
 from .rating import TRACK_RINGS, LifeInputError, axial_rating, combined_damage, equivalent_load, \
     four_point_capacities
+from ..numerics.compiled import use_compiled
+from .kernel import compiled_widest_contacts
 from .raceway_map import DEFAULT_SLICES, RacewayMap, default_slices, passes_per_revolution, track_damage
 from .wear import rolling_travel, relubrication_gap
 
@@ -154,6 +156,11 @@ class HalfCycles:
     last_swing: float = 0.0         # its swing, rad
     completed: int = 0
 
+    def copy(self) -> "HalfCycles":
+        """A shallow copy (the arrays are replaced, never changed in place)."""
+        return HalfCycles(self.direction, self.turn, self.extreme, self.b_max, self.angle, self.last_ratio,
+                          self.last_swing, self.completed)
+
 
 class LifeAccumulator:
     """Step-by-step life and wear of one bearing (what the FMU carries; plain numpy state).
@@ -176,6 +183,7 @@ class LifeAccumulator:
     def __init__(self, model: LifeModel, record: bool = False, kernel: str = "numpy"):
         self.model = model
         self.map = RacewayMap(model.capacity, model.passes, model.moving_ring, model.slices, kernel=kernel)
+        self._compiled = use_compiled(kernel, "kernel")
         self.half = HalfCycles()
         self.record = record
         self.rows: list = []
@@ -186,16 +194,22 @@ class LifeAccumulator:
         ``record`` only) loads ``(Fx, Fy, Fz, Mx, My)`` (N, N m)."""
         d = distribution
         self.map.update(d.ball_angle, psi, d.contact_load)
-        b = d.semi_axis_b
-        j = np.argmax(b, axis=0)                                   # the widest patch of each track
-        cols = np.arange(4)
-        self._half_cycle(psi, b[j, cols], d.contact_angle[j, cols])
+        widest, widest_angle = self._widest_contacts(d.semi_axis_b, d.contact_angle)
+        self._half_cycle(psi, widest, widest_angle)
         if self.record:
             pea = float(equivalent_axial_load(np.asarray(loads, float)[:5], self.model.bearing.pitch_diameter)[0]) \
                 if loads is not None else math.nan
             self.rows.append((time, psi, self.model.track_equivalent_loads(d.contact_load),
-                              self.model.track_standing_loads(d.contact_load), b[j, cols],
-                              d.contact_angle[j, cols], d.contact_pressure.max(axis=0), pea))
+                              self.model.track_standing_loads(d.contact_load), widest,
+                              widest_angle, d.contact_pressure.max(axis=0), pea))
+
+    def _widest_contacts(self, semi_b, contact_angle):
+        """The widest patch of each track this step (4,) and its contact angle (4,)."""
+        if self._compiled:
+            return compiled_widest_contacts()(np.ascontiguousarray(semi_b, dtype=float),
+                                              np.ascontiguousarray(contact_angle, dtype=float))
+        j, cols = np.argmax(semi_b, axis=0), np.arange(semi_b.shape[1])
+        return semi_b[j, cols], contact_angle[j, cols]
 
     def _half_cycle(self, psi, b, angle) -> None:
         h, tol = self.half, self.model.settings.reversal_tolerance
@@ -256,6 +270,19 @@ class LifeAccumulator:
                          "angle": h.angle, "last_ratio": h.last_ratio, "last_swing": h.last_swing,
                          "completed": h.completed},
                 "rows": len(self.rows)}
+
+    def checkpoint(self) -> tuple:
+        """What :meth:`restore` goes back to (a failed step's): the map's checkpoint
+        (:meth:`RacewayMap.checkpoint`), the half-cycles' state (a shallow copy: their arrays are
+        replaced, never changed in place) and the count of recorded steps. Cheaper than :meth:`get_state`."""
+        return self.map.checkpoint(), self.half.copy(), len(self.rows)
+
+    def restore(self, checkpoint: tuple) -> None:
+        """Back to a :meth:`checkpoint`."""
+        map_checkpoint, half, rows = checkpoint
+        self.map.restore(map_checkpoint)
+        self.half = half.copy()
+        del self.rows[rows:]
 
     def set_state(self, state: dict) -> None:
         self.map.set_state(state["map"])

@@ -11,17 +11,26 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..numerics.compiled import compile_loop, loop_factory
 
-_MAP_UPDATE_SIGNATURE = "void(f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:], f8, f8, f8[:, :], f8[:, :], f8)"
+_MAP_UPDATE_SIGNATURE = "f8[:, :](f8[:, :], f8[:], f8[:], b1[:], f8[:], f8[:], f8, f8, f8[:, :], f8[:, :], f8)"
 
 
-def _map_update(damage_map, power, scale, moving, angle_old, angle_new, psi_old, psi_new, q3_old, q3_new, slope):
+def _map_update(damage_map, power, scale, moving, angle_old, angle_new, psi_old, psi_new, q3_old, contact_load, slope):
     """Add the passes from the last step to this one to ``damage_map`` (4, N) and to each track's
     ``power`` (4,) ``Σ_j d_j^slope``, in place: ball ``b`` passes the slices whose centres lie between
     its old and new place on the track's ring (``angle - psi`` on the moving ring, ``moving`` (4,)),
     half-open, each pass carrying ``scale[k] (q3_old[b, k] + q3_new[b, k]) / 2``
-    (:func:`slewing_model.life.raceway_map.crossed_slices`, ``RacewayMap._add``)."""
+    (:func:`slewing_model.life.raceway_map.crossed_slices`, ``RacewayMap._add``). Returns ``q3_new``, the
+    cubes of this step's ``contact_load`` (B, 4), negatives as zero (``RacewayMap.update``'s); with no
+    last step (``angle_old`` empty) only that."""
+    q3_new = np.empty(contact_load.shape)
+    for b in range(contact_load.shape[0]):
+        for k in range(contact_load.shape[1]):
+            load = max(contact_load[b, k], 0.0)
+            q3_new[b, k] = load ** 3.0             # pow, as numpy's ** 3
     slices = damage_map.shape[1]
     per_radian = slices / (2.0 * math.pi)
     for k in range(damage_map.shape[0]):
@@ -41,6 +50,24 @@ def _map_update(damage_map, power, scale, moving, angle_old, angle_new, psi_old,
                 new = old + mean
                 power[k] += new ** slope - old ** slope
                 damage_map[k, s] = new
+    return q3_new
+
+
+_WIDEST_SIGNATURE = "UniTuple(f8[:], 2)(f8[:, :], f8[:, :])"
+
+
+def _widest_contacts(semi_b, contact_angle):
+    """The widest contact patch of each track this step: the largest ``semi_b`` of each column (4,) and
+    the ``contact_angle`` at it (the first ball of the largest, as ``np.argmax``; ``LifeAccumulator.step``)."""
+    n_balls, n_tracks = semi_b.shape
+    widest, angle = np.empty(n_tracks), np.empty(n_tracks)
+    for k in range(n_tracks):
+        best = 0
+        for b in range(1, n_balls):
+            if semi_b[b, k] > semi_b[best, k]:
+                best = b
+        widest[k], angle[k] = semi_b[best, k], contact_angle[best, k]
+    return widest, angle
 
 
 #: the helpers the loops call
@@ -56,3 +83,4 @@ def _compile(function, signature):
 #: (factory, Python function) of each compiled loop of the life model
 KERNELS: list = []
 compiled_map_update = loop_factory(KERNELS, _compile, _map_update, _MAP_UPDATE_SIGNATURE)
+compiled_widest_contacts = loop_factory(KERNELS, _compile, _widest_contacts, _WIDEST_SIGNATURE)

@@ -133,19 +133,20 @@ class RacewayMap:
     def update(self, ball_angle, psi: float, contact_load) -> None:
         """Add the passes from the last step to this one (the first call only records). Only the
         slices a ball crossed change, and each track's ``Σ d_j^(10/9)`` follows them."""
-        q3 = np.maximum(contact_load, 0.0) ** 3
-        if self._angle is not None and self._compiled:
+        if self._angle is not None and self._compiled:     # Q^3 and the passes in one compiled loop
             self._own_map()
-            compiled_map_update()(self.damage_map, self._power, self.scale, self.moving, self._angle,
-                                  np.ascontiguousarray(ball_angle, dtype=float), self._psi, float(psi), self._q3,
-                                  np.ascontiguousarray(q3), WEIBULL_SLOPE)
-        elif self._angle is not None:
-            mean = 0.5 * (q3 + self._q3) * self.scale
-            for ring_moving, tracks in self._tracks.items():
-                shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)
-                ball, where = crossed_slices(self._angle - shift_old, ball_angle - shift_new, self.slices)
-                if ball.size and tracks.size:
-                    self._add(tracks, ball, where, mean)
+            q3 = compiled_map_update()(self.damage_map, self._power, self.scale, self.moving, self._angle,
+                                       np.ascontiguousarray(ball_angle, dtype=float), self._psi, float(psi),
+                                       self._q3, np.ascontiguousarray(contact_load, dtype=float), WEIBULL_SLOPE)
+        else:
+            q3 = np.maximum(contact_load, 0.0) ** 3
+            if self._angle is not None:
+                mean = 0.5 * (q3 + self._q3) * self.scale
+                for ring_moving, tracks in self._tracks.items():
+                    shift_old, shift_new = (self._psi, psi) if ring_moving else (0.0, 0.0)
+                    ball, where = crossed_slices(self._angle - shift_old, ball_angle - shift_new, self.slices)
+                    if ball.size and tracks.size:
+                        self._add(tracks, ball, where, mean)
         self._angle = np.array(ball_angle, dtype=float)
         self._psi = float(psi)
         self._q3 = q3
@@ -171,11 +172,21 @@ class RacewayMap:
         step (:func:`track_damage` sums the whole map again; they agree to round-off)."""
         return (np.maximum(self._power, 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
 
-    def get_state(self) -> dict:
-        """The map's state (the map is not copied: the next update copies it before a change)."""
+    def checkpoint(self) -> tuple:
+        """The map, its sums, the last ball angles, ring angle and ``Q^3`` (the map is not copied: the next
+        update copies it before a change; the others are replaced, not changed, by an update)."""
         self._shared = True
-        return {"map": self.damage_map, "power": self._power.copy(), "angle": self._angle, "psi": self._psi,
-                "q3": self._q3}
+        return self.damage_map, self._power.copy(), self._angle, self._psi, self._q3
+
+    def restore(self, checkpoint: tuple) -> None:
+        """Back to a :meth:`checkpoint`."""
+        self.damage_map, power, self._angle, self._psi, self._q3 = checkpoint
+        self._power = power.copy()
+        self._shared = True
+
+    def get_state(self) -> dict:
+        """The map's state (:meth:`checkpoint`'s, by name)."""
+        return dict(zip(("map", "power", "angle", "psi", "q3"), self.checkpoint()))
 
     def set_state(self, state: dict) -> None:
         self.damage_map = np.array(state["map"], dtype=float).reshape(4, self.slices)
