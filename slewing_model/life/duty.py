@@ -22,12 +22,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..numerics.compiled import use_compiled
 from .dg03 import DG03Life, dg03_life, equivalent_axial_load
+from .kernel import compiled_widest_contacts
 from .oscillation import critical_angle, equivalent_revolutions, rainflow_cycles, span_mean
 from .rating import TRACK_RINGS, LifeInputError, axial_rating, combined_damage, equivalent_load, \
     four_point_capacities
-from ..numerics.compiled import use_compiled
-from .kernel import compiled_widest_contacts
 from .raceway_map import DEFAULT_SLICES, RacewayMap, default_slices, passes_per_revolution, track_damage
 from .wear import rolling_travel, relubrication_gap
 
