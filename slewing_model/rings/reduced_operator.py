@@ -470,8 +470,10 @@ class PendingOperator:
     done, of :data:`STAGES` (``method`` 0: by halves) or of :data:`FACTOR_STAGES` (``method`` 1:
     through the Cholesky factor, ``W`` scaled: an inverse by halves that missed the check, made
     again; ``method`` 2: the same in double, where that missed it too), ``parts`` the last one's
-    results (in :func:`method_precision`); ``scaled``: :func:`scaled_matrix` of ``matrix`` for
-    methods 1 and 2 (not part of the state: it follows from ``matrix``)."""
+    results (in :func:`method_precision`); ``scaled``: the matrix the stages take, ``matrix`` in
+    :data:`OPERATOR_PRECISION` for method 0 (converted once, not at each step of stages: 0.1 ms an
+    operator of the pitch bearing in a step, docs/speed.md, "Issue 31, sixteenth turn"), its
+    :func:`scaled_matrix` for methods 1 and 2 (not part of the state: it follows from ``matrix``)."""
 
     rows: np.ndarray
     active: np.ndarray
@@ -529,12 +531,10 @@ def advance_operator(pending: PendingOperator, jacobian, mu, arithmetic: "Operat
         until = step_end(pending)
     if pending.stage < until:
         try:
-            if pending.method:
-                if not pending.scaled:
-                    pending = replace(pending, scaled=scaled_matrix(pending.matrix, method_precision(pending.method)))
-                w_mat = pending.scaled[0]
-            else:
-                w_mat = pending.matrix.astype(OPERATOR_PRECISION, copy=False)
+            if not pending.scaled:           # the matrix the stages take, made on the first of them
+                pending = replace(pending, scaled=scaled_matrix(pending.matrix, method_precision(pending.method))
+                                  if pending.method else (pending.matrix.astype(OPERATOR_PRECISION, copy=False),))
+            w_mat = pending.scaled[0]
             if pending.matrix.shape[0] <= LEAF:
                 pending = replace(pending, stage=len(STAGES), parts=(spd_inverse(w_mat),))
             else:
