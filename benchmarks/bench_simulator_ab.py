@@ -3,8 +3,9 @@ off: where a step's time went between two versions (the FMU layer left out).
 
 Each version runs in a worker process of its own, importing ``slewing_model`` from its own tree
 (a git worktree for the revision; before the package was regrouped the simulator was
-``slewing_model.simulator``); both step the same case of ``benchmarks/cases.py`` (fine
-superelement, free rings), in alternating blocks, so that both see the same machine load.
+``slewing_model.simulator``), its numba loops loaded from its tree's cache (a first process
+compiles them there); both step the same case of ``benchmarks/cases.py`` (fine superelement, free
+rings), in alternating blocks, so that both see the same machine load.
 
 Run: .venv/bin/python benchmarks/bench_simulator_ab.py [--baseline REV] [--cases pitch table3_heavy]
      [--steps 300] [--runs 3] [--life off|on|both]
@@ -100,6 +101,11 @@ def main() -> None:
             rows = []
             for case in args.cases:
                 total = WARM + args.steps * args.runs
+                # a first process of each version compiles its loops into its tree's numba cache, and the timed
+                # ones load them from there: a process that compiled them itself ran 3 % slower at the median
+                # and up to 30 % at the slowest steps (docs/speed.md, "Issue 31, sixteenth turn")
+                for v, (t, life) in versions.items():
+                    Worker(t, case, total, life).close()
                 workers = {v: Worker(t, case, total, life) for v, (t, life) in versions.items()}
                 for w in workers.values():
                     w.run(0, WARM)
