@@ -4,8 +4,10 @@
 steps to the slices they crossed: with numpy some thirty array operations a step (the crossed
 slices of each ring, ``np.unique``, a ``bincount`` per track), each a few microseconds of call
 overhead for a few dozen passes. :func:`_map_update` is the same sum as one loop over tracks,
-balls and the slices each ball crossed, in place. It adds the passes one by one where numpy sums a
-slice's passes first: the map and its sums agree to round-off (``tests/test_life.py``).
+balls and the slices each ball crossed, in place, with the step's ``Q^3``. It adds the passes one by
+one where numpy sums a slice's passes first: the map and its sums agree to round-off
+(``tests/test_life.py``). :func:`_widest_contacts` finds each track's widest contact patch, which
+``LifeAccumulator.step`` took with numpy's ``argmax`` and fancy indexing (16 us of a step).
 """
 from __future__ import annotations
 

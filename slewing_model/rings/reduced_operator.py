@@ -471,8 +471,8 @@ class PendingOperator:
     through the Cholesky factor, ``W`` scaled: an inverse by halves that missed the check, made
     again; ``method`` 2: the same in double, where that missed it too), ``parts`` the last one's
     results (in :func:`method_precision`); ``scaled``: the matrix the stages take, ``matrix`` in
-    :data:`OPERATOR_PRECISION` for method 0 (converted once, not at each step of stages: 0.1 ms an
-    operator of the pitch bearing in a step, docs/speed.md, "Issue 31, sixteenth turn"), its
+    :data:`OPERATOR_PRECISION` for method 0 (converted once, not at each step of stages: 0.1 ms a step
+    of stages of the pitch bearing's operators, docs/speed.md, "Issue 31, sixteenth turn"), its
     :func:`scaled_matrix` for methods 1 and 2 (not part of the state: it follows from ``matrix``)."""
 
     rows: np.ndarray

@@ -288,8 +288,8 @@ class BearingSimulator:
     def _checkpoint(self) -> tuple:
         """What a failed :meth:`step` restores (:meth:`_restore`): :meth:`get_state`'s entries as they are
         (none is changed in place) and the life accumulator's :meth:`~slewing_model.life.LifeAccumulator.checkpoint`,
-        with no dictionary built (:meth:`get_state`'s took 14 us of the pitch bearing's steps; docs/speed.md,
-        "Issue 31, sixteenth turn")."""
+        with no dictionary built (:meth:`get_state` took 17-22 us of the pitch bearing's NREL steps;
+        docs/speed.md, "Issue 31, sixteenth turn")."""
         return (self._warm, self._previous, self._loads, self._warm_converged, self._psi, self.solver.operator,
                 self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged,
                 None if self.life is None else self.life.checkpoint())
