@@ -99,13 +99,13 @@ def main() -> None:
             for life in (("off", "on") if args.life == "both" else (args.life,)):
                 versions[f"this tree, life {life}"] = (ROOT, life)
             rows = []
+            total = WARM + args.steps * args.runs
+            # a first process of each version compiles its loops into its tree's numba cache, and the timed ones
+            # load them from there: a process that compiled them itself ran 3 % slower at the median and up to
+            # 30 % at the slowest steps (docs/speed.md, "Issue 31, sixteenth turn")
+            for t, life in versions.values():
+                Worker(t, args.cases[0], total, life).close()
             for case in args.cases:
-                total = WARM + args.steps * args.runs
-                # a first process of each version compiles its loops into its tree's numba cache, and the timed
-                # ones load them from there: a process that compiled them itself ran 3 % slower at the median
-                # and up to 30 % at the slowest steps (docs/speed.md, "Issue 31, sixteenth turn")
-                for v, (t, life) in versions.items():
-                    Worker(t, case, total, life).close()
                 workers = {v: Worker(t, case, total, life) for v, (t, life) in versions.items()}
                 for w in workers.values():
                     w.run(0, WARM)
