@@ -336,6 +336,45 @@ def test_a_bounded_run_gets_on_where_the_held_start_leaves_less_than_a_stage(tab
     assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
 
 
+def test_a_bordering_larger_than_the_work_left_borders_the_most_stretched_contacts_first(table1, rings,
+                                                                                        monkeypatch):
+    """Contacts that closed are bordered in as the bounded solve's work allows (``_bordering_that_fits``):
+    the most stretched first, the rest in the next solves. Before, a bordering was one piece whatever its
+    size: on the pitch bearing 70-100 rows at once, three times the bound (NREL's slowest step). Here the
+    bound and the first piece are made too small for the reversal's borderings: a solve borders only part
+    of what closed, its work stays within the bound or the first piece (or one stage), and the run arrives
+    at the cold solution."""
+    piece = bordering_work(8, 3 * table1.ball_count)    # four diagonals onto more rows than the operator's
+    monkeypatch.setattr(bime, "BOUNDED_WORK", piece)
+    monkeypatch.setattr(bime, "BORDER_PIECE", piece)
+    monkeypatch.setattr(bime, "HELD_START", np.inf)     # no held-rings start: the contacts close as they iterate
+    borderings = []
+    original = bime.update_operator
+
+    def spied(op, point, compliance, stiffness, jacobian, active, *rest):
+        entering, closed = active & ~op.active, point.loaded & ~op.active
+        stretch = point.delta.ravel()
+        if entering.any():
+            borderings.append((int(np.count_nonzero(entering)), int(np.count_nonzero(closed)),
+                               stretch[entering].min() >= stretch[closed & ~entering].max(initial=0.0),
+                               bordering_work(2 * int(np.count_nonzero(entering)), op.rows.size)))
+        return original(op, point, compliance, stiffness, jacobian, active, *rest)
+
+    monkeypatch.setattr(bime, "update_operator", spied)
+    work = OperatorWork(monkeypatch)
+    results, spent = reversal(table1, rings, "bounded", work, steps=80)
+    assert sum(entered < closed for entered, closed, _, _ in borderings) >= 2   # the case discriminates
+    assert all(most_stretched for _, _, most_stretched, _ in borderings)
+    # each bordering within the piece, or of one diagonal (that the run gets on)
+    assert all(cost <= piece * (1 + 1e-12) for _, _, _, cost in borderings)
+    for (operator_work, largest), pieces in zip(spent, work.pieces_taken[-len(spent):]):
+        assert operator_work <= max(piece, largest) * (1 + 1e-12) or pieces == 1   # or its one piece
+    first = next(k for k, r in enumerate(results) if r.converged)
+    assert all(r.converged for r in results[first:])
+    reference = BimeSolver(table1, rings, rtol=1e-11).solve(REVERSED)
+    assert results[-1].max_ball_load == pytest.approx(reference.max_ball_load, rel=2e-6)
+
+
 def test_the_yaw_bearing_bounded_from_zero_loads_arrives():
     """The 180-ball yaw bearing started at zero loads (an FMU's start values), then its tower-top loads
     held, bounded: the run arrives at the complete step's equilibrium and stays there. Its preload's

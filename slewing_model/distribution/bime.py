@@ -103,6 +103,10 @@ SPREAD_ITERATIONS = 8
 #: work alone, with the iterations free and the stages counted at 0.75 of their time (the eleventh turn).
 #: ...
 BOUNDED_WORK = 1e8
+#: a bounded solve's one piece of operator work (:meth:`BimeSolver._take`), where it is a bordering, borders
+#: the contacts that closed whose work is at most this, or the work left if more (that a run of bounded solves
+#: gets on; :meth:`BimeSolver._bordering_that_fits`): what a step has after a held-rings start (HELD_WORK)
+BORDER_PIECE = 5e7
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
 #: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
 BOUNDED_ITERATIONS = 12
@@ -778,9 +782,12 @@ class BimeSolver:
             rows = closing_rows(op, active)
             if rows == 0:
                 return op
+            entering = active
             if borders(op, rows):              # else update_operator declines: no work
-                self._spend(bordering_work(rows, op.rows.size))
-            return update_operator(op, p, self.compliance, self.assembly.stiffness, self.jacobian, active, mu,
+                entering = self._bordering_that_fits(op, p, active & ~op.active)
+                self._spend(bordering_work(2 * int(np.count_nonzero(entering)), op.rows.size))
+                entering = entering | op.active
+            return update_operator(op, p, self.compliance, self.assembly.stiffness, self.jacobian, entering, mu,
                                    self._arithmetic)
 
         if not fresh and op is not None:
@@ -820,6 +827,30 @@ class BimeSolver:
             self.pending_operator = pending
             raise _WorkSpent
         return pending
+
+    def _bordering_that_fits(self, op: ReducedOperator, p: "_Point", closed: np.ndarray) -> np.ndarray:
+        """The diagonals that ``closed`` since ``op`` was formed and are bordered in now: all of them
+        where the solve's work allows it (a complete solve: always), else the most stretched (largest
+        ``delta``) whose bordering the work left allows
+        (:func:`~slewing_model.rings.reduced_operator.bordering_work`); where the solve did no operator
+        work yet (its one piece, :meth:`_take`), what :data:`BORDER_PIECE` allows if more. The others
+        carry no force in this solve's Newton steps (as a fresh operator's rows left out,
+        :func:`~slewing_model.rings.reduced_operator.off_rows`) and enter in the next solves: one
+        bordering of 70-100 rows onto the pitch bearing's 380-460 took 2.75 ms of work in a step of
+        three times the bound (docs/speed.md, "Issue 31, seventeenth turn")."""
+        n, count = op.rows.size, int(np.count_nonzero(closed))
+        allowed = self._work_left if self._operator_work_done else max(self._work_left, BORDER_PIECE)
+        if bordering_work(2 * count, n) <= allowed:
+            return closed
+        fit = 0
+        while fit < count and bordering_work(2 * (fit + 1), n) <= allowed:
+            fit += 1
+        if fit == 0:                        # not even one: _spend refuses it (or it is the one piece)
+            fit = 1
+        candidates = np.flatnonzero(closed)
+        entering = np.zeros_like(closed)
+        entering[candidates[np.argsort(-p.delta.ravel()[candidates], kind="stable")[:fit]]] = True
+        return entering
 
     def _iteration_work(self, p: "_Point") -> float:
         """The work of a Newton iteration from ``p`` (:data:`BOUNDED_WORK`, as the operator's work is
