@@ -14,7 +14,7 @@ from slewing_model.distribution.bime import BOUNDED_ITERATIONS, BOUNDED_WORK
 from slewing_model.distribution.kernel import BORDER_BLAS_ROWS, bordered_inverse as compiled_bordered_inverse
 from slewing_model.numerics.compiled import AVAILABLE
 from slewing_model.rings.reduced_operator import (
-    LEAF, STAGES, bordered_inverse, bordering_work, stage_work,
+    BORDER_BLOCK, LEAF, STAGES, bordered_inverse, bordering_work, stage_work,
 )
 from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 from statics import load_on_moving_ring
@@ -249,9 +249,10 @@ def test_unknown_step_work_is_refused_with_its_name(table1):
 @pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
 @pytest.mark.parametrize("new_rows", [2, BORDER_BLAS_ROWS + 8])
 def test_bordered_inverse_is_the_inverse_of_the_bordered_matrix(new_rows):
-    """Compiled (few new rows) or by BLAS (many): against LAPACK's inverse of the whole matrix."""
+    """Compiled (few new rows) or by BLAS (many; ``W^-1`` read by blocks of BORDER_BLOCK rows, the last one
+    short here): against LAPACK's inverse of the whole matrix."""
     rng = np.random.default_rng(new_rows)
-    n = 3 * LEAF
+    n = 3 * BORDER_BLOCK + 5
     a = rng.standard_normal((n + new_rows, n + new_rows))
     w = a @ a.T + (n + new_rows) * np.eye(n + new_rows)
     inverse = np.linalg.inv(w[:n, :n])

@@ -695,22 +695,45 @@ def bordering_work(rows: int, kept_rows: int) -> float:
     return 5.0 * n * n * r + 4.0 * n * r * r + 6.0 * r ** 3 + 120.0 * (n + r) ** 2
 
 
+#: rows of ``W^-1`` :func:`bordered_inverse` converts to double at a time (a buffer of 64 x 400-480 doubles,
+#: 0.2 MB). Inside the pitch bearing's NREL steps 3-6 from the start values (16-30 rows onto 402-476), a
+#: bordering by numpy took 1.2-2.4 ms with the whole inverse converted and the product added whole, 1.1-1.3
+#: ms by blocks (docs/speed.md, "Issue 31, seventeenth turn"; 128 rows: no faster than whole)
+BORDER_BLOCK = 64
+
+
 def bordered_inverse(inverse, b_mat, c_mat, jacobian, coupling, new_jacobian, mu):
     """``W^-1`` (n, n) bordered by ``r`` rows (:func:`update_operator`): with ``X = W^-1 B`` (``b_mat``
     (n, r)) and ``S = (C - B^T X)^-1`` (``c_mat`` (r, r)), the new inverse
     ``[[W^-1 + X S X^T, -X S], [-S X^T, S]]``, its coupling ``[W^-1 J - X S d, S d]`` with
     ``d = J_r - X^T J`` (``coupling = W^-1 J`` (n, 5), ``jacobian = J``, ``new_jacobian = J_r``
     (r, 5)) and the new Schur complement's inverse ``(J_new^T W_new^-1 J_new + mu I)^-1``. The blocks
-    are summed in double, the new inverse stored in ``W^-1``'s precision (:func:`kept_precision`)."""
+    are summed in double, the new inverse stored in ``W^-1``'s precision (:func:`kept_precision`).
+
+    ``W^-1`` is read by blocks of :data:`BORDER_BLOCK` rows, each converted to double in one buffer, for
+    ``X`` and again for ``W^-1 + X S X^T``: two reads of it and one write of the new inverse, where
+    converting it whole and adding the product whole made several passes over newly allocated matrices
+    of its size."""
     stored = inverse.dtype
-    inverse = inverse.astype(np.float64, copy=False)
-    x_mat = inverse @ b_mat
+    n, r = b_mat.shape
+    x_mat = np.empty((n, r))
+    buffer = np.empty((min(BORDER_BLOCK, n), n))
+    for start in range(0, n, BORDER_BLOCK):
+        rows = slice(start, min(start + BORDER_BLOCK, n))
+        part = buffer[:rows.stop - start]
+        part[...] = inverse[rows]
+        np.matmul(part, b_mat, out=x_mat[rows])             # X = W^-1 B, by rows
     schur = np.linalg.inv(c_mat - b_mat.T @ x_mat)
     schur = 0.5 * (schur + schur.T)
     xs = x_mat @ schur
-    n, r = b_mat.shape
     bordered = np.empty((n + r, n + r), dtype=stored)
-    np.add(inverse, xs @ x_mat.T, out=bordered[:n, :n])
+    x_t = np.ascontiguousarray(x_mat.T)
+    for start in range(0, n, BORDER_BLOCK):
+        rows = slice(start, min(start + BORDER_BLOCK, n))
+        part = buffer[:rows.stop - start]
+        np.matmul(xs[rows], x_t, out=part)
+        part += inverse[rows]                                # W^-1 + X S X^T, summed in double
+        bordered[rows, :n] = part
     bordered[:n, n:] = -xs
     bordered[n:, :n] = -xs.T
     bordered[n:, n:] = schur
