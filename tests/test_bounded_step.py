@@ -341,7 +341,8 @@ def test_a_bordering_larger_than_the_work_left_borders_the_most_stretched_contac
                                                                                         monkeypatch):
     """Contacts that closed are bordered in as the bounded solve's work allows (``_bordering_that_fits``):
     the most stretched first, the rest in the next solves. Before, a bordering was one piece whatever its
-    size: on the pitch bearing 70-100 rows at once, three times the bound (NREL's slowest step). Here the
+    size: on the pitch bearing 74 rows at once after its start values, the whole bound where the held-rings
+    start had left half (NREL's slowest step). Here the
     bound and the first piece are made too small for the reversal's borderings: a solve borders only part
     of what closed, its work stays within the bound or the first piece (or one stage), and the run arrives
     at the cold solution."""
@@ -366,7 +367,7 @@ def test_a_bordering_larger_than_the_work_left_borders_the_most_stretched_contac
     results, spent = reversal(table1, rings, "bounded", work, steps=80)
     assert sum(entered < closed for entered, closed, _, _ in borderings) >= 2   # the case discriminates
     assert all(most_stretched for _, _, most_stretched, _ in borderings)
-    # each bordering within the piece, or of one diagonal (that the run gets on)
+    # each bordering within the piece
     assert all(cost <= piece * (1 + 1e-12) for _, _, _, cost in borderings)
     for (operator_work, largest), pieces in zip(spent, work.pieces_taken[-len(spent):]):
         assert operator_work <= max(piece, largest) * (1 + 1e-12) or pieces == 1   # or its one piece

@@ -835,9 +835,10 @@ class BimeSolver:
         (:func:`~slewing_model.rings.reduced_operator.bordering_work`); where the solve did no operator
         work yet (its one piece, :meth:`_take`), what :data:`BORDER_PIECE` allows if more. The others
         carry no force in this solve's Newton steps (as a fresh operator's rows left out,
-        :func:`~slewing_model.rings.reduced_operator.off_rows`) and enter in the next solves: one
-        bordering of 70-100 rows onto the pitch bearing's 380-460 took 2.75 ms of work in a step of
-        three times the bound (docs/speed.md, "Issue 31, seventeenth turn")."""
+        :func:`~slewing_model.rings.reduced_operator.off_rows`) and enter in the next solves. Before, the
+        pitch bearing's NREL step 3 from its start values bordered 74 rows onto 402 at once: 1.8 ms of work
+        by its count where the held-rings start had left 0.9 ms (3.4 ms measured), the scenario's slowest
+        step (docs/speed.md, "Issue 31, seventeenth turn")."""
         n, count = op.rows.size, int(np.count_nonzero(closed))
         allowed = self._work_left if self._operator_work_done else max(self._work_left, BORDER_PIECE)
         if bordering_work(2 * count, n) <= allowed:
