@@ -342,10 +342,9 @@ def test_a_bordering_larger_than_the_work_left_borders_the_most_stretched_contac
     """Contacts that closed are bordered in as the bounded solve's work allows (``_bordering_that_fits``):
     the most stretched first, the rest in the next solves. Before, a bordering was one piece whatever its
     size: on the pitch bearing 74 rows at once after its start values, the whole bound where the held-rings
-    start had left half (NREL's slowest step). Here the
-    bound and the first piece are made too small for the reversal's borderings: a solve borders only part
-    of what closed, its work stays within the bound or the first piece (or one stage), and the run arrives
-    at the cold solution."""
+    start had left half (NREL's slowest step). Here the bound and the first piece are made too small for
+    the reversal's borderings: a solve borders only part of what closed, its work stays within the bound or
+    the first piece (or one stage), and the run arrives at the cold solution."""
     piece = bordering_work(8, 3 * table1.ball_count)    # four diagonals onto more rows than the operator's
     monkeypatch.setattr(bime, "BOUNDED_WORK", piece)
     monkeypatch.setattr(bime, "BORDER_PIECE", piece)

@@ -66,7 +66,7 @@ from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
     APPROXIMATE_TURN, NUMPY_ARITHMETIC, SPREAD_STAGES, STAGES, PendingOperator, ReducedOperator, advance_operator,
-    bordering_work, borders, closing_rows, forming_work, off_rows, stage_work, start_operator, step_end,
+    bordering_work, borders, forming_work, off_rows, stage_work, start_operator, step_end,
     turned_operator, update_operator,
 )
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
@@ -779,12 +779,12 @@ class BimeSolver:
         self.pending_operator = pending
 
         def bordered(op):                      # contacts closed: bordered in (those that opened stay)
-            rows = closing_rows(op, active)
-            if rows == 0:
+            closed = active & ~op.active
+            if not closed.any():
                 return op
             entering = active
-            if borders(op, rows):              # else update_operator declines: no work
-                entering = self._bordering_that_fits(op, p, active & ~op.active)
+            if borders(op, 2 * int(np.count_nonzero(closed))):        # else update_operator declines: no work
+                entering = self._bordering_that_fits(op, p, closed)
                 self._spend(bordering_work(2 * int(np.count_nonzero(entering)), op.rows.size))
                 entering = entering | op.active
             return update_operator(op, p, self.compliance, self.assembly.stiffness, self.jacobian, entering, mu,

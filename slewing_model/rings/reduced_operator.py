@@ -675,11 +675,6 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
 BORDER_SHARE = 0.25
 
 
-def closing_rows(op: ReducedOperator, active: np.ndarray) -> int:
-    """Rows the contacts that closed since ``op`` was formed would add (:func:`update_operator`)."""
-    return 2 * int(np.count_nonzero(active & ~op.active))
-
-
 def borders(op: ReducedOperator, rows: int) -> bool:
     """Whether :func:`update_operator` borders ``rows`` new rows onto ``op`` (else it declines)."""
     return rows <= BORDER_SHARE * op.rows.size
