@@ -284,12 +284,16 @@ def test_a_flagged_step_caps_its_friction_and_the_steps_after_arrive_at_the_comp
     from slewing_model.simulation import simulator
 
     solved = []
-    original = simulator.friction_torque
 
-    def recorded(*args, **kwargs):
-        solved.append((kwargs.get("max_iterations"), original(*args, **kwargs)))
-        return solved[-1][1]
-    monkeypatch.setattr(simulator, "friction_torque", recorded)
+    def recorded(original):                 # the step's one compiled call (warm_torque), or the general path
+        def call(*args, **kwargs):
+            found = original(*args, **kwargs)
+            if found is not None:
+                solved.append((kwargs.get("max_iterations"), found))
+            return found
+        return call
+    monkeypatch.setattr(simulator, "friction_torque", recorded(simulator.friction_torque))
+    monkeypatch.setattr(simulator, "warm_torque", recorded(simulator.warm_torque))
     steps = {}
     for work in ("complete", "bounded"):
         sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, step_work=work))

@@ -222,6 +222,32 @@ def test_warm_torque_in_one_call_equals_the_loops_one_by_one(case, solve_quadrat
 
 @needs_numba
 @pytest.mark.parametrize("case", range(3))
+def test_a_prepared_warm_torque_is_friction_torques_bit_for_bit(case):
+    """What a co-simulation step takes of the friction torque (its magnitude with the seal torque,
+    convergence, state and iterations), by the one compiled call with its operands prepared once
+    (``warm_torque``), is ``friction_torque``'s bit for bit, also with another coefficient, a seal torque
+    and the iterations capped; where ``friction_torque`` would take its general path (no warm start of
+    the bearing's shape, no loaded contact) there is no answer."""
+    from slewing_model.friction.torque import prepare_warm_torque, seal_torque_of, warm_torque
+
+    bearing, distribution = _distributions()[case]
+    start = friction_torque(bearing, distribution).state * 1.01
+    for mu, seal, cap in ((0.1, 0.0, 60), (0.15, 12.5, 2)):
+        step = prepare_warm_torque(bearing, mu=mu, omega=1.0, tol=1e-5)
+        found = warm_torque(step, distribution, start, seal_torque_of(bearing, seal), max_iterations=cap)
+        full = friction_torque(bearing, distribution, mu=mu, omega=1.0, seal_torque=seal, initial=start, tol=1e-5,
+                               max_iterations=cap)
+        assert found.magnitude == full.magnitude and found.magnitude > seal
+        assert (found.converged, found.iterations) == (full.converged, full.iterations)
+        assert np.array_equal(found.state, full.state)
+    assert warm_torque(step, distribution, None, 0.0) is None
+    assert warm_torque(step, distribution, start[:-1], 0.0) is None
+    idle = replace(distribution, contact_load=np.zeros_like(distribution.contact_load))
+    assert warm_torque(step, idle, start, 0.0) is None
+
+
+@needs_numba
+@pytest.mark.parametrize("case", range(3))
 def test_both_paths_count_iterations_alike_when_they_run_out(case):
     # a few iterations allowed from a perturbed start: some balls converge, others run out;
     # both report max_iterations then (found by a review: the compiled loop reported one more)

@@ -150,6 +150,29 @@ def test_a_refused_step_leaves_the_simulator_as_it_was():
             assert np.array_equal(a, b, equal_nan=True), (j, a, b)
 
 
+def test_tuned_settings_take_effect_from_the_next_step():
+    """The tunable settings (friction coefficient, seal torque, speed regularisation: the FMU's tunable
+    parameters) changed between steps (``BearingSimulator.tune``) take effect from the next step: the
+    steps after it equal, to the last bit, those of a simulator built with them and given the tuned one's
+    state; and differ from those of the untuned one (the change discriminates)."""
+    case = CASES["pitch"](STEPS)
+    bearing = load_bearing(case.bearing)
+    superelement = build_superelement(bearing, mesh="coarse", bc="free")
+    tuned, kept = (BearingSimulator(bearing, superelement, _settings(case)) for _ in range(2))
+    for k in range(8):
+        for sim in (tuned, kept):
+            sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k])
+    changes = {"friction_coefficient": 0.15, "seal_torque": 40.0, "omega_regularisation": 2e-3}
+    built = BearingSimulator(bearing, superelement, _settings(case, **changes))
+    built.set_state(tuned.get_state())
+    tuned.tune(**changes)
+    for k in range(8, 12):
+        got, want, old = (sim.step(Loads(*case.loads[k]), case.psi[k], case.omega[k]) for sim in (tuned, built, kept))
+        assert (got.friction_torque, got.friction_torque_magnitude) == (want.friction_torque,
+                                                                        want.friction_torque_magnitude), k
+        assert got.friction_torque_magnitude > 1.2 * old.friction_torque_magnitude, k
+
+
 def test_the_friction_start_carried_on_is_nearer_the_balls_motions_of_the_step():
     """The friction torque of a step starts from the last two steps' ball motions carried on as far as
     the loads go on (``simulator.extrapolated_motion``). For the pitch bearing's blade-root series it

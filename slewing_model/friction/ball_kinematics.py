@@ -712,6 +712,46 @@ def ball_results(geometry: ContactSet, u: np.ndarray, contact_power: np.ndarray,
             np.count_nonzero(geo.loaded, axis=1))
 
 
+@dataclass(frozen=True)
+class WarmFrictionStep:
+    """A warm-started friction torque's loops in one compiled call, its operands that stay from step to
+    step prepared once (:func:`warm_friction_step`; a co-simulation keeps one:
+    :class:`slewing_model.simulation.simulator.BearingSimulator`). Calling it with a load distribution
+    for this bearing, the last state ``warm`` (B, 4) and the iterations allowed gives what
+    :func:`warm_friction_step` gives.
+
+    Preparing these operands every step (the bearing's ball radii, the rules' arrays, the distribution's
+    arrays checked and copied) took about 50 us of the pitch bearing's 1 ms NREL step
+    (docs/speed.md, "Issue 31, eighteenth turn")."""
+
+    bearing: Bearing
+    operands: tuple          # the bearing's, before mu
+    rules: tuple             # mu ... the solve rule's arrays and whether it is the torque's
+    tol: float
+    cage_speed: float
+
+    @classmethod
+    def prepare(cls, bearing: Bearing, mu: float, speed: float, sliding_regularisation: float,
+                quad: EllipseQuadrature, solve_quad: EllipseQuadrature, tol: float,
+                cage_speed: float) -> "WarmFrictionStep":
+        """The operands of :func:`warm_friction_step` but the distribution, the warm start and the
+        iterations allowed."""
+        same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
+        operands = (ball_radii(bearing), np.asarray(bearing.groove_radius, dtype=float), _IS_MOVING[bearing.moving_ring],
+                    _NORMAL_SIGN_R, _NORMAL_SIGN_Z)
+        rules = (mu, speed, sliding_regularisation, 0.5 * bearing.ball_diameter, 0.5 * bearing.pitch_diameter,
+                 *quad.writable_arrays, *solve_quad.writable_arrays, same)
+        return cls(bearing, operands, rules, tol, cage_speed)
+
+    def __call__(self, distribution, warm: np.ndarray, max_iterations: int):
+        arrays = distribution_arrays(self.bearing, distribution, writable=True)
+        out = compiled_friction_step()(
+            arrays["contact_load"], arrays["contact_angle"], arrays["semi_axis_a"], arrays["semi_axis_b"],
+            *self.operands, *self.rules, np.array(warm, dtype=float), self.tol, max_iterations, _THETA_DOWN,
+            _THETA_UP, _THETA_MIN_UP, self.cage_speed)
+        return None if out[0] == GENERAL_PATH else out[1:]
+
+
 def warm_friction_step(bearing: Bearing, distribution, mu: float, speed: float, sliding_regularisation: float,
                        quad: EllipseQuadrature, solve_quad: EllipseQuadrature, warm: np.ndarray, tol: float,
                        max_iterations: int, cage_speed: float):
@@ -722,16 +762,9 @@ def warm_friction_step(bearing: Bearing, distribution, mu: float, speed: float, 
     :func:`cold_start` starts it, the same to round-off). ``warm``: the last state (B, 4). None where
     the general path must run (a distribution to refuse, no loaded contact); else the
     iterations, largest residual, whether converged, the contacts' powers and torques (C,) and
-    :func:`ball_results`'s arrays."""
-    arrays = distribution_arrays(bearing, distribution, writable=True)
-    same = (solve_quad.n_across, solve_quad.n_along) == (quad.n_across, quad.n_along)
-    out = compiled_friction_step()(
-        arrays["contact_load"], arrays["contact_angle"], arrays["semi_axis_a"], arrays["semi_axis_b"],
-        ball_radii(bearing), np.asarray(bearing.groove_radius, dtype=float), _IS_MOVING[bearing.moving_ring],
-        _NORMAL_SIGN_R, _NORMAL_SIGN_Z, mu, speed, sliding_regularisation, 0.5 * bearing.ball_diameter,
-        0.5 * bearing.pitch_diameter, *quad.writable_arrays, *solve_quad.writable_arrays, same,
-        np.array(warm, dtype=float), tol, max_iterations, _THETA_DOWN, _THETA_UP, _THETA_MIN_UP, cage_speed)
-    return None if out[0] == GENERAL_PATH else out[1:]
+    :func:`ball_results`'s arrays (:class:`WarmFrictionStep`, prepared for this call)."""
+    return WarmFrictionStep.prepare(bearing, mu, speed, sliding_regularisation, quad, solve_quad, tol,
+                                    cage_speed)(distribution, warm, max_iterations)
 
 
 def spin_roll_ratio(geometry: ContactSet, u: np.ndarray, n_balls: int) -> np.ndarray:

@@ -55,7 +55,7 @@ import numpy as np
 
 from ..distribution.assembly import cage_ratio
 from .ball_kinematics import (
-    SOLVED, ContactPoints, ContactSet, ball_results, cold_start, minimise_power, warm_friction_step,
+    SOLVED, ContactPoints, ContactSet, WarmFrictionStep, ball_results, cold_start, minimise_power, warm_friction_step,
 )
 from .catalogue import CATALOGUE_MU, catalogue_torque  # noqa: F401  (part of this module's interface)
 from .contact import (  # noqa: F401
@@ -69,6 +69,8 @@ from ..bearing.geometry import Bearing
 
 #: Default speed scale of the regularised Coulomb law near omega = 0, rad/s
 DEFAULT_OMEGA_REGULARISATION = 1e-4
+#: Default cap on the ball equilibrium's Newton iterations (``max_iterations`` of :func:`friction_torque`)
+DEFAULT_MAX_ITERATIONS = 60
 
 
 @dataclass(frozen=True)
@@ -238,7 +240,8 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
                     omega_regularisation: float = DEFAULT_OMEGA_REGULARISATION, quadrature=DEFAULT_QUADRATURE,
                     solve_quadrature=DEFAULT_SOLVE_QUADRATURE,
                     sliding_regularisation: float = DEFAULT_SLIDING_REGULARISATION, initial=None,
-                    tol: float = 1e-5, max_iterations: int = 60, kernel: str = "auto") -> FrictionTorque:
+                    tol: float = 1e-5, max_iterations: int = DEFAULT_MAX_ITERATIONS, kernel: str = "auto"
+                    ) -> FrictionTorque:
     """Friction torque of the bearing for a load distribution (full sliding, slow speed).
 
     Parameters
@@ -307,10 +310,9 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     sliding_regularisation = check_number("sliding_regularisation", sliding_regularisation, 0.0, strict=True)
     tol = check_number("tol", tol, 0.0, strict=True)
     compiled = use_compiled(kernel)
-    quad = as_quadrature(quadrature)
-    solve_quad = quad if solve_quadrature is None else as_quadrature(solve_quadrature)
+    quad, solve_quad = _rules(quadrature, solve_quadrature)
     seal = seal_torque_of(bearing, seal_torque, seal_torque_per_length, seal_length)
-    speed = omega if omega != 0.0 else 1.0
+    speed = _kinematics_speed(omega)
     n_balls = bearing.ball_count
     cage = cage_ratio(bearing) * speed
     warm = None
@@ -350,7 +352,7 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
             power_c = torque_c = np.zeros(geometry.ball_index.size)     # no loaded contact, or mu = 0
         contact_power, per_ball, omega_ball, orbital, state, spin_roll, contact_count = ball_results(
             geometry, u, power_c, n_balls, cage if geometry.inactive.size else 0.0, compiled)
-    contact_part = float(per_ball.sum())
+    contact_part = _contact_part(per_ball)
     contact_part_moments = -math.copysign(1.0, speed) * float(np.sum(torque_c))
     magnitude = contact_part + seal
 
@@ -362,3 +364,65 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
         contact_count=contact_count, power=float(np.sum(power_c)), mu=mu,
         iterations=iterations, residual=residual, converged=converged, state=state,
     )
+
+
+def _rules(quadrature, solve_quadrature) -> tuple[EllipseQuadrature, EllipseQuadrature]:
+    """The rule the torque is integrated on and the one the balls are solved on (``quadrature`` and
+    ``solve_quadrature`` of :func:`friction_torque`)."""
+    quad = as_quadrature(quadrature)
+    return quad, quad if solve_quadrature is None else as_quadrature(solve_quadrature)
+
+
+def _kinematics_speed(omega: float) -> float:
+    """The speed the balls' kinematics are solved at (``FrictionTorque.kinematics_speed``): ``omega``, or
+    1 rad/s at rest (the torque of full sliding does not depend on it)."""
+    return omega if omega != 0.0 else 1.0
+
+
+def prepare_warm_torque(bearing: Bearing, *, mu: float = DEFAULT_MU, omega: float = 1.0,
+                        quadrature=DEFAULT_QUADRATURE, solve_quadrature=DEFAULT_SOLVE_QUADRATURE,
+                        sliding_regularisation: float = DEFAULT_SLIDING_REGULARISATION,
+                        tol: float = 1e-5) -> WarmFrictionStep:
+    """The operands of :func:`friction_torque`'s one compiled call for these arguments (its own, with
+    the same defaults), prepared once for :func:`warm_torque` step after step."""
+    mu = check_number("mu", mu, 0.0)
+    sliding_regularisation = check_number("sliding_regularisation", sliding_regularisation, 0.0, strict=True)
+    tol = check_number("tol", tol, 0.0, strict=True)
+    quad, solve_quad = _rules(quadrature, solve_quadrature)
+    speed = _kinematics_speed(omega)
+    return WarmFrictionStep.prepare(bearing, mu, speed, sliding_regularisation, quad, solve_quad, tol,
+                                    cage_ratio(bearing) * speed)
+
+
+def _contact_part(per_ball: np.ndarray) -> float:
+    """The contacts' share of the torque magnitude, N m: the balls' (``FrictionTorque.per_ball``)."""
+    return float(per_ball.sum())
+
+
+@dataclass(frozen=True)
+class WarmTorque:
+    """What a co-simulation step takes of a warm-started friction torque (:func:`warm_torque`), as
+    :class:`FrictionTorque` has it."""
+
+    magnitude: float
+    converged: bool
+    state: np.ndarray
+    iterations: int
+
+
+def warm_torque(step: WarmFrictionStep, distribution, initial: np.ndarray, seal_torque: float,
+                max_iterations: int = DEFAULT_MAX_ITERATIONS) -> WarmTorque | None:
+    """:func:`friction_torque`'s magnitude, convergence and state from the warm start ``initial``
+    (its ``state`` (B, 4)) by its one compiled call with operands prepared once (``step``, for the
+    bearing, rules, ``mu``, ``omega``, tolerance and sliding regularisation of that call), bit for bit;
+    ``seal_torque`` N m (``seal_torque_of``'s). None where :func:`friction_torque` must run instead
+    (no warm start of this bearing's shape, a distribution to refuse, no loaded contact). A
+    co-simulation step builds no :class:`FrictionTorque` then (docs/speed.md, "Issue 31, eighteenth
+    turn")."""
+    if initial is None or initial.shape != (step.bearing.ball_count, 4):
+        return None
+    found = step(distribution, initial, max_iterations)
+    if found is None:
+        return None
+    iterations, converged, per_ball, state = found[0], found[2], found[6], found[9]
+    return WarmTorque(_contact_part(per_ball) + seal_torque, converged, state, iterations)

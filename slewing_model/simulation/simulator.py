@@ -18,7 +18,7 @@ import numpy as np
 
 from ..distribution.bime import STEP_WORK, BimeSolver, LoadDistribution, Loads
 from ..numerics.blas import blas_threads
-from ..friction.torque import friction_torque, regularised_torque
+from ..friction.torque import friction_torque, prepare_warm_torque, regularised_torque, seal_torque_of, warm_torque
 from ..friction.kernel import compile_all, use_compiled
 from ..bearing.geometry import Bearing
 from ..rings.reduced_operator import PendingOperator, ReducedOperator
@@ -210,6 +210,8 @@ class BearingSimulator:
         self._friction_previous: np.ndarray | None = None   # ... and of the step before (both equilibria)
         self._friction_converged = True                # _friction_warm an equilibrium (not capped)
         self._psi = 0.0
+        self._warm_friction = None
+        self._prepare_friction()
         self.last: StepResult | None = None
         self.life = None
         if s.life:
@@ -224,6 +226,16 @@ class BearingSimulator:
             if name not in ("friction_coefficient", "seal_torque", "omega_regularisation"):
                 raise ValueError(f"{name} is not tunable: build a new simulator")
         self.settings = replace(self.settings, **changes)
+        self._prepare_friction()
+
+    def _prepare_friction(self) -> None:
+        """The friction torque's one compiled call prepared for the settings (:func:`prepare_warm_torque`),
+        where the friction's loops are compiled and its coefficient is not zero; else None."""
+        s = self.settings
+        self._warm_friction, self._seal_torque = None, seal_torque_of(self.bearing, s.seal_torque)
+        if s.friction_coefficient > 0.0 and use_compiled(s.friction_kernel, "friction_kernel"):
+            self._warm_friction = prepare_warm_torque(self.bearing, mu=s.friction_coefficient, omega=1.0,
+                                                      tol=s.friction_tolerance)
 
     def step(self, loads: Loads, psi: float, omega: float) -> StepResult:
         """Solve the step: load distribution at rotation ``psi`` (warm-started
@@ -259,13 +271,16 @@ class BearingSimulator:
             distribution = self.solver.solve(loads, initial=extrapolated_start(self._warm, self._previous, share))
             magnitude = self.settings.seal_torque
             if self.settings.friction_coefficient > 0.0:
-                friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
-                                           omega=1.0, seal_torque=self.settings.seal_torque,
-                                           initial=extrapolated_motion(self._friction_warm, self._friction_previous,
-                                                                       share),
-                                           tol=self.settings.friction_tolerance, kernel=self.settings.friction_kernel,
-                                           **({} if distribution.converged else
-                                              {"max_iterations": BOUNDED_FRICTION_ITERATIONS}))
+                initial = extrapolated_motion(self._friction_warm, self._friction_previous, share)
+                capped = {} if distribution.converged else {"max_iterations": BOUNDED_FRICTION_ITERATIONS}
+                friction = None
+                if self._warm_friction is not None:          # the usual step: one compiled call, prepared
+                    friction = warm_torque(self._warm_friction, distribution, initial, self._seal_torque, **capped)
+                if friction is None:
+                    friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                               omega=1.0, seal_torque=self.settings.seal_torque, initial=initial,
+                                               tol=self.settings.friction_tolerance,
+                                               kernel=self.settings.friction_kernel, **capped)
                 magnitude = friction.magnitude
                 converged = friction.converged and distribution.converged
                 # a capped torque's motions (a flagged step's) are no point to extrapolate from or to
