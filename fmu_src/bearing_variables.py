@@ -283,7 +283,7 @@ def scalar_outputs(result, simulator=None) -> dict:
     """The scalar outputs (:data:`OUTPUTS` and :data:`COUNT_OUTPUT`) of a step result, by name; the
     life outputs from ``simulator.life`` (0 without it)."""
     d = result.distribution
-    values = dict(zip(("x", "y", "z", "rx", "ry"), map(float, d.displacement)))
+    values = dict(zip(("x", "y", "z", "rx", "ry"), d.displacement.tolist()))
     values.update(friction_torque=result.friction_torque, friction_torque_magnitude=result.friction_torque_magnitude,
                   max_ball_load=d.max_ball_load, max_contact_pressure=d.max_contact_pressure,
                   static_safety_factor=min(d.static_safety_factor, 1e300))

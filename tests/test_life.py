@@ -234,6 +234,8 @@ def test_compiled_map_step_equals_numpy_s(moving_ring):
     assert np.count_nonzero(numpy_map.damage_map) > 1000
     np.testing.assert_allclose(compiled_map.damage_map, numpy_map.damage_map, rtol=1e-12, atol=0.0)
     np.testing.assert_allclose(compiled_map.track_damage(), numpy_map.track_damage(), rtol=1e-12, atol=0.0)
+    for acc in maps.values():               # the worst track's, as the FMU's output takes it: the same number
+        assert acc.worst_damage == acc.track_damage.max() > acc.track_damage[0] > 0.0     # not the first track's
 
 
 def test_half_cycle_travel_ratio():

@@ -66,6 +66,17 @@ def test_preload_alone_gives_preload_interference(table1):
     assert r.balls_in_four_point_contact == table1.ball_count
 
 
+def test_balls_in_four_point_contact_are_those_loaded_on_all_four_contacts(table1):
+    """Under an axial load and a tilting moment some balls carry both diagonals and others one: the
+    count is that of the balls whose four contacts all press (a pressure of at least NO_LOAD_PRESSURE),
+    counted ball by ball here."""
+    from slewing_model.distribution.results import NO_LOAD_PRESSURE
+
+    r = solve(table1, Loads(Fz=1e5, My=3e5))
+    by_ball = sum(all(p >= NO_LOAD_PRESSURE for p in row) for row in r.contact_pressure.tolist())
+    assert 0 < r.balls_in_four_point_contact == by_ball < table1.ball_count
+
+
 def test_load_rotated_by_one_ball_pitch_shifts_loads_by_one_ball(table3):
     loads = Loads(Fx=20e3, Fy=-5e3, Fz=60e3, Mx=15e3, My=-30e3)
     a = solve(table3, loads)

@@ -175,12 +175,14 @@ class LoadDistribution:
         state.pop("ring_displacement", None)
         return state
 
-    @property
+    # the largest load and pressure are taken once (a co-simulation step reads the pressure's three
+    # times: its own output, the safety factor's and the warnings'); the arrays are not changed in place
+    @functools.cached_property
     def max_ball_load(self) -> float:
         """Largest contact load, N."""
         return float(self.contact_load.max())
 
-    @property
+    @functools.cached_property
     def max_contact_pressure(self) -> float:
         """Largest Hertz pressure, Pa."""
         return float(self.contact_pressure.max())
@@ -229,7 +231,9 @@ class LoadDistribution:
         """Number of balls whose both diagonals carry load (a contact pressure of at least
         :data:`NO_LOAD_PRESSURE` on all four contacts: the round-off interference of an unloaded
         bearing is no contact)."""
-        return int(np.count_nonzero(np.all(self.contact_pressure >= NO_LOAD_PRESSURE, axis=1)))
+        p = self.contact_pressure                  # column by column: np.all(axis=1) costs 5 us on (150, 4)
+        least = np.minimum(np.minimum(p[:, 0], p[:, 1]), np.minimum(p[:, 2], p[:, 3]))
+        return int(np.count_nonzero(least >= NO_LOAD_PRESSURE))
 
     def to_dict(self) -> dict:
         """Plain JSON-ready data (the ``slewing solve --json`` object)."""

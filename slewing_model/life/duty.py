@@ -255,7 +255,7 @@ class LifeAccumulator:
     @property
     def worst_damage(self) -> float:
         """Damage of the worst track so far (1: its L10 is used up)."""
-        return float(self.track_damage.max())
+        return self.map.worst_track_damage()
 
     @property
     def last_ratio(self) -> float:

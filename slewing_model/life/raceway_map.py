@@ -172,6 +172,11 @@ class RacewayMap:
         step (:func:`track_damage` sums the whole map again; they agree to round-off)."""
         return (np.maximum(self._power, 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
 
+    def worst_track_damage(self) -> float:
+        """The largest of :meth:`track_damage`, taken from the largest sum (the damage grows with it): the
+        same number, without the arrays (the FMU's ``life_damage`` output, every step)."""
+        return (max(max(self._power.tolist()), 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
+
     def checkpoint(self) -> tuple:
         """The map, its sums, the last ball angles, ring angle and ``Q^3`` (the map is not copied: the next
         update copies it before a change; the others are replaced, not changed, by an update)."""
