@@ -62,6 +62,7 @@ from .kernel import (
 from .results import (  # noqa: F401  (Loads, LoadDistribution and the errors belong to this interface)
     DISPLACEMENT_FIELDS, LOAD_FIELDS, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError,
 )
+from ..numerics.blas import blas_threads
 from ..numerics.compiled import use_compiled
 from ..bearing.geometry import RING_CONTACTS, Bearing
 from ..rings.reduced_operator import (
@@ -195,11 +196,15 @@ class BimeSolver:
         solve that would need more returns its last iterate with ``converged=False`` and its ``residual``, keeps its operator
         (and one being inverted), and the next warm solve goes on from there. A cold solve
         (no ``initial``) is always complete.
+    blas_threads : int or None
+        Threads of numpy's BLAS while the solver iterates beyond the usual step's one compiled call
+        (:func:`slewing_model.numerics.blas.blas_threads`, restored after; the operator's inversions and
+        borderings are its BLAS work); None leaves them as the process has them.
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
                  rtol: float = 1e-10, max_iterations: int = 200, pressure_limit: float = 2.0 * ISO76_PRESSURE_LIMIT,
-                 kernel: str = "numpy", step_work: str = "complete"):
+                 kernel: str = "numpy", step_work: str = "complete", blas_threads: int | None = None):
         if step_work not in STEP_WORK:
             raise ValueError(f"step_work = {step_work!r}: must be one of {', '.join(map(repr, STEP_WORK))}")
         if superelement is not None and superelement.outer.ball_count != bearing.ball_count:
@@ -213,6 +218,7 @@ class BimeSolver:
         self.pressure_limit = pressure_limit
         self.kernel = kernel
         self.step_work = step_work
+        self.blas_threads = blas_threads
         self._work_left = math.inf   # per solve: the work still allowed (BOUNDED_WORK: the operator's, the iterations')
         self._operator_work_done = False   # per solve: a piece of operator work done (_advance, _spend)
         self._compiled = use_compiled(kernel, "kernel")    # the per-contact work as compiled loops
@@ -436,83 +442,87 @@ class BimeSolver:
             if contacts is not None:                      # at the equilibrium
                 residual = point.peak_residual / max(load_scale, point.peak_force, 1e-300)
                 return self._result(loads, point, iterations, residual, contacts=contacts)
-        if point is None:
-            point = self._evaluate(qs, y, f_scaled)
-        if held and point.any_loaded:
-            point = self._held_rings_start(point, loads, f_scaled, load_scale)
-        while True:
-            grad_q, mismatch = point.gradient, point.mismatch
-            scale = max(load_scale, point.peak_force, 1e-300)
-            residual = point.peak_residual / scale
-            if not math.isfinite(residual):
-                raise NoEquilibriumError(f"no equilibrium for loads {loads}: a non-finite force residual "
-                                         f"({residual}) after {iterations} Newton iterations")
-            if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
-                break
-            cost = self._iteration_work(point) if bounded and flexible else 0.0     # an iteration's of the bound
-            if iterations >= limit or self._affordable_iterations(cost) < 1:
-                if bounded:                               # the rest is the next solve's
-                    return self._result(loads, point, iterations, residual, converged=False)
-                raise NoEquilibriumError(
-                    f"no convergence after {iterations} Newton iterations (relative residual {residual:.2e}) "
-                    f"for loads {loads}")
-            if (self._product_operands is not None and not handed_back
-                    and not _refresh_due(residual, last_residual, self.rtol)):
-                if self._reduced is not None:
-                    self._reduced, self._reduced_jacobian = self._turned(self._reduced, mu), self._jacobian_rows
-                if self._kept_operator_serves():
-                    # the iterations that keep the operator, in one compiled loop, as far as they go; the
-                    # one it stopped before is this loop's (handed_back)
-                    done, point, last_residual = self._kept_iterations(
-                        point, f_scaled, load_scale, trust, last_residual, iterations,
-                        int(min(limit, iterations + self._affordable_iterations(cost))))
-                    self._work_left -= done * cost
-                    handed_back = True
-                    if done:
-                        iterations += done
-                        continue
-            handed_back = False
-            iterations += 1
-            self._work_left -= cost
-
-            if flexible:
-                fresh = _refresh_due(residual, last_residual, self.rtol)
-                last_residual = residual
-                try:
-                    dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
-                except _WorkSpent:                        # a bounded solve: the rest is the next solve's
-                    return self._result(loads, point, iterations - 1, residual, converged=False)
-                m_dy = self._ring_times(dy)       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
-                slope = float(grad_q @ dq) - float(mismatch @ m_dy)
-            else:
-                dq, dy = self._rigid_direction(point, grad_q, mu), point.y
-                slope = float(grad_q @ dq)
-            norm = math.sqrt(float(dq @ dq))
-            if norm > trust:  # a step across a clearance is limited, then checked by the energy
-                dq, dy = dq * (trust / norm), dy * (trust / norm)
-                slope *= trust / norm
-                if flexible:
-                    m_dy = m_dy * (trust / norm)
-
-            # backtracking line search on the total energy (convex)
-            t = 1.0
-            for _ in range(60):
-                trial = self._evaluate(point.qs, point.y, f_scaled, point.ring_motion,
-                                       (dq, dy, m_dy) if flexible else (dq, None, None), t)
-                roundoff = 1e-12 * max(point.energy_scale, trial.energy_scale)
-                if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + roundoff:
+        # the iterations beyond the usual step's compiled call: the operator's work runs numpy's BLAS on
+        # blas_threads threads (the usual step uses none: its context's three calls to OpenBLAS cost
+        # about 20 us of it, docs/speed.md, "Issue 31, eighteenth turn")
+        with blas_threads(self.blas_threads):
+            if point is None:
+                point = self._evaluate(qs, y, f_scaled)
+            if held and point.any_loaded:
+                point = self._held_rings_start(point, loads, f_scaled, load_scale)
+            while True:
+                grad_q, mismatch = point.gradient, point.mismatch
+                scale = max(load_scale, point.peak_force, 1e-300)
+                residual = point.peak_residual / scale
+                if not math.isfinite(residual):
+                    raise NoEquilibriumError(f"no equilibrium for loads {loads}: a non-finite force residual "
+                                             f"({residual}) after {iterations} Newton iterations")
+                if residual <= self.rtol or scale == 1e-300:  # converged, or no load and no contact at all
                     break
-                t *= 0.5
-            else:
-                raise NoEquilibriumError(f"line search failed (relative residual {residual:.2e}) for loads {loads}")
-            point = trial
-            if float(point.qs @ point.qs) > dw * dw:
-                raise NoEquilibriumError(
-                    f"no equilibrium for loads {loads}: the moving ring would move "
-                    f"{np.linalg.norm(point.qs) * 1e3:.3g} mm, beyond the ball diameter ({dw * 1e3:g} mm); "
-                    f"no contact resists this load")
+                cost = self._iteration_work(point) if bounded and flexible else 0.0     # an iteration's of the bound
+                if iterations >= limit or self._affordable_iterations(cost) < 1:
+                    if bounded:                               # the rest is the next solve's
+                        return self._result(loads, point, iterations, residual, converged=False)
+                    raise NoEquilibriumError(
+                        f"no convergence after {iterations} Newton iterations (relative residual {residual:.2e}) "
+                        f"for loads {loads}")
+                if (self._product_operands is not None and not handed_back
+                        and not _refresh_due(residual, last_residual, self.rtol)):
+                    if self._reduced is not None:
+                        self._reduced, self._reduced_jacobian = self._turned(self._reduced, mu), self._jacobian_rows
+                    if self._kept_operator_serves():
+                        # the iterations that keep the operator, in one compiled loop, as far as they go; the
+                        # one it stopped before is this loop's (handed_back)
+                        done, point, last_residual = self._kept_iterations(
+                            point, f_scaled, load_scale, trust, last_residual, iterations,
+                            int(min(limit, iterations + self._affordable_iterations(cost))))
+                        self._work_left -= done * cost
+                        handed_back = True
+                        if done:
+                            iterations += done
+                            continue
+                handed_back = False
+                iterations += 1
+                self._work_left -= cost
 
-        return self._result(loads, point, iterations, residual)
+                if flexible:
+                    fresh = _refresh_due(residual, last_residual, self.rtol)
+                    last_residual = residual
+                    try:
+                        dq, dy = self._flexible_direction(point, f_scaled, mu, fresh, iterations)
+                    except _WorkSpent:                        # a bounded solve: the rest is the next solve's
+                        return self._result(loads, point, iterations - 1, residual, converged=False)
+                    m_dy = self._ring_times(dy)       # M is symmetric: (M (f - y)) . dy = (f - y) . M dy
+                    slope = float(grad_q @ dq) - float(mismatch @ m_dy)
+                else:
+                    dq, dy = self._rigid_direction(point, grad_q, mu), point.y
+                    slope = float(grad_q @ dq)
+                norm = math.sqrt(float(dq @ dq))
+                if norm > trust:  # a step across a clearance is limited, then checked by the energy
+                    dq, dy = dq * (trust / norm), dy * (trust / norm)
+                    slope *= trust / norm
+                    if flexible:
+                        m_dy = m_dy * (trust / norm)
+
+                # backtracking line search on the total energy (convex)
+                t = 1.0
+                for _ in range(60):
+                    trial = self._evaluate(point.qs, point.y, f_scaled, point.ring_motion,
+                                           (dq, dy, m_dy) if flexible else (dq, None, None), t)
+                    roundoff = 1e-12 * max(point.energy_scale, trial.energy_scale)
+                    if trial.total <= point.total + 1e-4 * t * min(slope, 0.0) + roundoff:
+                        break
+                    t *= 0.5
+                else:
+                    raise NoEquilibriumError(f"line search failed (relative residual {residual:.2e}) for loads {loads}")
+                point = trial
+                if float(point.qs @ point.qs) > dw * dw:
+                    raise NoEquilibriumError(
+                        f"no equilibrium for loads {loads}: the moving ring would move "
+                        f"{np.linalg.norm(point.qs) * 1e3:.3g} mm, beyond the ball diameter ({dw * 1e3:g} mm); "
+                        f"no contact resists this load")
+
+            return self._result(loads, point, iterations, residual)
 
     def _rigid_solver(self, ring_motion: np.ndarray | None = None) -> "BimeSolver":
         """A rigid-ring solver at this rotation for a starting guess (no capacity checks), its
@@ -526,7 +536,8 @@ class BimeSolver:
         if rigid is None:
             rigid = self._rigid = BimeSolver(self.bearing, None, psi=self.assembly.psi,
                                              cage_angle=self.assembly.cage_angle, rtol=RIGID_START_TOLERANCE,
-                                             max_iterations=self.max_iterations, kernel=self.kernel)
+                                             max_iterations=self.max_iterations, kernel=self.kernel,
+                                             blas_threads=self.blas_threads)
             rigid.edge_angle = np.full(4, np.pi)
             rigid.pressure_limit = math.inf
         for name in ROTATION_ARRAYS:

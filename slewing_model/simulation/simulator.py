@@ -17,7 +17,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..distribution.bime import STEP_WORK, BimeSolver, LoadDistribution, Loads
-from ..numerics.blas import blas_threads
 from ..friction.torque import friction_torque, prepare_warm_torque, regularised_torque, seal_torque_of, warm_torque
 from ..friction.kernel import compile_all, use_compiled
 from ..bearing.geometry import Bearing
@@ -75,9 +74,11 @@ class SimulatorSettings:
         where a four-contact ball stopped on a flat stretch of its power
         (``tests/test_step_accuracy.py``).
     blas_threads : int or None
-        Threads of numpy's BLAS during a step (:func:`slewing_model.numerics.blas.blas_threads`;
-        restored after it); None leaves them as the process has them. Default 1: the
-        step's matrices have a few hundred rows, and a second thread that spins while
+        Threads of numpy's BLAS while a step's load distribution does its BLAS work, the ring
+        operator's inversions and borderings (:func:`slewing_model.numerics.blas.blas_threads`, restored
+        after; ``blas_threads`` of :class:`~slewing_model.distribution.bime.BimeSolver`: the usual step's
+        one compiled call uses no BLAS and leaves them be); None leaves them as the process has them.
+        Default 1: the step's matrices have a few hundred rows, and a second thread that spins while
         other processes share the cores makes steps several times slower.
     friction_kernel : {"auto", "numpy", "compiled"}
         How the friction model runs its loops over points and balls (``kernel`` of
@@ -197,7 +198,8 @@ class BearingSimulator:
             bearing = bearing.with_preload(s.preload)
         self.bearing = bearing
         self.solver = BimeSolver(bearing, self.superelement if s.ring_model == "flexible" else None,
-                                 rtol=s.tolerance, kernel=s.contact_kernel, step_work=s.step_work)
+                                 rtol=s.tolerance, kernel=s.contact_kernel, step_work=s.step_work,
+                                 blas_threads=s.blas_threads)
         friction, contact = use_compiled(s.friction_kernel, "friction_kernel"), use_compiled(s.contact_kernel,
                                                                                              "contact_kernel")
         if friction or contact:
@@ -263,29 +265,28 @@ class BearingSimulator:
             raise
 
     def _step(self, loads: Loads, psi: float, omega: float) -> StepResult:
-        with blas_threads(self.settings.blas_threads):
-            if psi != self._psi or self._warm is None:
-                self.solver.set_rotation(psi)
-            load = self.solver.scaled_load(loads)
-            share = load_share(load, *self._loads)
-            distribution = self.solver.solve(loads, initial=extrapolated_start(self._warm, self._previous, share))
-            magnitude = self.settings.seal_torque
-            if self.settings.friction_coefficient > 0.0:
-                initial = extrapolated_motion(self._friction_warm, self._friction_previous, share)
-                capped = {} if distribution.converged else {"max_iterations": BOUNDED_FRICTION_ITERATIONS}
-                friction = None
-                if self._warm_friction is not None:          # the usual step: one compiled call, prepared
-                    friction = warm_torque(self._warm_friction, distribution, initial, self._seal_torque, **capped)
-                if friction is None:
-                    friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
-                                               omega=1.0, seal_torque=self.settings.seal_torque, initial=initial,
-                                               tol=self.settings.friction_tolerance,
-                                               kernel=self.settings.friction_kernel, **capped)
-                magnitude = friction.magnitude
-                converged = friction.converged and distribution.converged
-                # a capped torque's motions (a flagged step's) are no point to extrapolate from or to
-                self._friction_previous = self._friction_warm if converged and self._friction_converged else None
-                self._friction_warm, self._friction_converged = friction.state, converged
+        if psi != self._psi or self._warm is None:
+            self.solver.set_rotation(psi)
+        load = self.solver.scaled_load(loads)
+        share = load_share(load, *self._loads)
+        distribution = self.solver.solve(loads, initial=extrapolated_start(self._warm, self._previous, share))
+        magnitude = self.settings.seal_torque
+        if self.settings.friction_coefficient > 0.0:
+            initial = extrapolated_motion(self._friction_warm, self._friction_previous, share)
+            capped = {} if distribution.converged else {"max_iterations": BOUNDED_FRICTION_ITERATIONS}
+            friction = None
+            if self._warm_friction is not None:          # the usual step: one compiled call, prepared
+                friction = warm_torque(self._warm_friction, distribution, initial, self._seal_torque, **capped)
+            if friction is None:
+                friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                           omega=1.0, seal_torque=self.settings.seal_torque, initial=initial,
+                                           tol=self.settings.friction_tolerance,
+                                           kernel=self.settings.friction_kernel, **capped)
+            magnitude = friction.magnitude
+            converged = friction.converged and distribution.converged
+            # a capped torque's motions (a flagged step's) are no point to extrapolate from or to
+            self._friction_previous = self._friction_warm if converged and self._friction_converged else None
+            self._friction_warm, self._friction_converged = friction.state, converged
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         if self.life is not None:
             self.life.step(None, psi, distribution)
