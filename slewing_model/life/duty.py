@@ -156,11 +156,6 @@ class HalfCycles:
     last_swing: float = 0.0         # its swing, rad
     completed: int = 0
 
-    def copy(self) -> "HalfCycles":
-        """A shallow copy (the arrays are replaced, never changed in place)."""
-        return HalfCycles(self.direction, self.turn, self.extreme, self.b_max, self.angle, self.last_ratio,
-                          self.last_swing, self.completed)
-
 
 class LifeAccumulator:
     """Step-by-step life and wear of one bearing (what the FMU carries; plain numpy state).
@@ -270,19 +265,6 @@ class LifeAccumulator:
                          "angle": h.angle, "last_ratio": h.last_ratio, "last_swing": h.last_swing,
                          "completed": h.completed},
                 "rows": len(self.rows)}
-
-    def checkpoint(self) -> tuple:
-        """What :meth:`restore` goes back to (a failed step's): the map's checkpoint
-        (:meth:`RacewayMap.checkpoint`), the half-cycles' state (a shallow copy: their arrays are
-        replaced, never changed in place) and the count of recorded steps. Cheaper than :meth:`get_state`."""
-        return self.map.checkpoint(), self.half.copy(), len(self.rows)
-
-    def restore(self, checkpoint: tuple) -> None:
-        """Back to a :meth:`checkpoint`."""
-        map_checkpoint, half, rows = checkpoint
-        self.map.restore(map_checkpoint)
-        self.half = half.copy()
-        del self.rows[rows:]
 
     def set_state(self, state: dict) -> None:
         self.map.set_state(state["map"])

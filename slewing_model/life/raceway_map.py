@@ -177,21 +177,12 @@ class RacewayMap:
         same number, without the arrays (the FMU's ``life_damage`` output, every step)."""
         return (max(max(self._power.tolist()), 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
 
-    def checkpoint(self) -> tuple:
+    def get_state(self) -> dict:
         """The map, its sums, the last ball angles, ring angle and ``Q^3`` (the map is not copied: the next
         update copies it before a change; the others are replaced, not changed, by an update)."""
         self._shared = True
-        return self.damage_map, self._power.copy(), self._angle, self._psi, self._q3
-
-    def restore(self, checkpoint: tuple) -> None:
-        """Back to a :meth:`checkpoint`."""
-        self.damage_map, power, self._angle, self._psi, self._q3 = checkpoint
-        self._power = power.copy()
-        self._shared = True
-
-    def get_state(self) -> dict:
-        """The map's state (:meth:`checkpoint`'s, by name)."""
-        return dict(zip(("map", "power", "angle", "psi", "q3"), self.checkpoint()))
+        return {"map": self.damage_map, "power": self._power.copy(), "angle": self._angle, "psi": self._psi,
+                "q3": self._q3}
 
     def set_state(self, state: dict) -> None:
         self.damage_map = np.array(state["map"], dtype=float).reshape(4, self.slices)

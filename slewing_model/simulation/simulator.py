@@ -288,7 +288,7 @@ class BearingSimulator:
             self._friction_previous = self._friction_warm if converged and self._friction_converged else None
             self._friction_warm, self._friction_converged = friction.state, converged
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
-        if self.life is not None:
+        if self.life is not None:       # the last that can fail: a step that raises leaves life as it was
             self.life.step(None, psi, distribution)
         # an iterate on its way (a bounded step) is no point of the trajectory to extrapolate from or to
         keep = distribution.converged and self._warm_converged
@@ -303,21 +303,20 @@ class BearingSimulator:
     # ---- state -------------------------------------------------------------------
     def _checkpoint(self) -> tuple:
         """What a failed :meth:`step` restores (:meth:`_restore`): :meth:`get_state`'s entries as they are
-        (none is changed in place) and the life accumulator's :meth:`~slewing_model.life.LifeAccumulator.checkpoint`,
-        with no dictionary built (:meth:`get_state` took 17-22 us of the pitch bearing's NREL steps;
-        docs/speed.md, "Issue 31, sixteenth turn")."""
+        (none is changed in place), with no dictionary built (:meth:`get_state` took 17-22 us of the pitch
+        bearing's NREL steps; docs/speed.md, "Issue 31, sixteenth turn"). Not the life accumulator's: its
+        step is the step's last that can fail (:meth:`_step`), so a step that raises has not touched it
+        (its checkpoint made the raceway map copy itself at every step's update: docs/speed.md, "Issue 31,
+        eighteenth turn")."""
         return (self._warm, self._previous, self._loads, self._warm_converged, self._psi, self.solver.operator,
-                self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged,
-                None if self.life is None else self.life.checkpoint())
+                self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged)
 
     def _restore(self, checkpoint: tuple) -> None:
         """Back to a :meth:`_checkpoint`, as :meth:`set_state` restores a state."""
         (self._warm, self._previous, self._loads, self._warm_converged, self._psi, operator, pending,
-         self._friction_warm, self._friction_previous, self._friction_converged, life) = checkpoint
+         self._friction_warm, self._friction_previous, self._friction_converged) = checkpoint
         self.solver.set_rotation(self._psi)
         self.solver.operator, self.solver.pending_operator = operator, pending
-        if life is not None:
-            self.life.restore(life)
 
     def get_state(self) -> dict:
         """Everything that affects the next step: the warm start, the rotation and
