@@ -58,7 +58,8 @@ PARTS = (
     ("solve calls", bime.BimeSolver, "_kept_iterations"),
     ("evaluations", bime.BimeSolver, "_evaluate"),
     ("result", bime.BimeSolver, "_result"),
-    ("friction", simulator, "friction_torque"),
+    ("friction", simulator, "warm_torque"),             # the usual step's one compiled call, prepared
+    ("friction", simulator, "friction_torque"),         # ... or, where it declines, the general path
     ("life", LifeAccumulator, "step"),
 )
 #: work a millisecond, as BOUNDED_WORK counts it (its comment)

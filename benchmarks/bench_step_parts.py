@@ -45,7 +45,7 @@ from timing import print_table  # noqa: E402
 from slewing_model import Loads, load_bearing  # noqa: E402
 from slewing_model.distribution import bime  # noqa: E402
 from slewing_model.distribution import kernel as distribution_kernel  # noqa: E402
-from slewing_model.friction import ball_kinematics, torque  # noqa: E402
+from slewing_model.friction import ball_kinematics  # noqa: E402
 from slewing_model.life import raceway_map  # noqa: E402
 from slewing_model.life.duty import LifeAccumulator  # noqa: E402
 from slewing_model.rings.superelement import build_superelement  # noqa: E402
@@ -60,8 +60,8 @@ PARTS = (
     (" evaluate", bime.BimeSolver, "_evaluate"),
     (" turned", bime.BimeSolver, "_turned"),
     (" result", bime.BimeSolver, "_result"),
-    ("friction", simulator, "friction_torque"),
-    (" compiled call", torque, "warm_friction_step"),
+    ("friction", simulator, "warm_torque"),
+    (" compiled call", ball_kinematics.WarmFrictionStep, "__call__"),
     ("life", LifeAccumulator, "step"),
 )
 #: the label of the other compiled loops a step calls from Python (the start's trial point, the ring product,
