@@ -32,7 +32,6 @@ def test_bad_thread_count_is_refused(value):
         SimulatorSettings(blas_threads=value)
 
 
-
 @pytest.mark.skipif(not blas_thread_control(), reason="numpy's BLAS is not an OpenBLAS found in /proc/self/maps")
 def test_a_steps_operator_work_runs_on_the_settings_threads_and_a_usual_step_leaves_them(monkeypatch):
     """The ring operator's work in a simulator step (here each new operator formed) runs numpy's BLAS on

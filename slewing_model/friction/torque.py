@@ -386,6 +386,7 @@ def prepare_warm_torque(bearing: Bearing, *, mu: float = DEFAULT_MU, omega: floa
     """The operands of :func:`friction_torque`'s one compiled call for these arguments (its own, with
     the same defaults), prepared once for :func:`warm_torque` step after step."""
     mu = check_number("mu", mu, 0.0)
+    omega = check_number("omega", omega)
     sliding_regularisation = check_number("sliding_regularisation", sliding_regularisation, 0.0, strict=True)
     tol = check_number("tol", tol, 0.0, strict=True)
     quad, solve_quad = _rules(quadrature, solve_quadrature)
