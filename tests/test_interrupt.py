@@ -284,3 +284,68 @@ def test_the_embedded_clusters_workers_drop_only_a_heartbeat_that_meets_its_clos
     finally:
         for thing in reversed(owned):
             thing.close()
+
+
+def test_a_ctrl_c_inside_distributeds_sync_before_its_future_exists_logs_nothing_in_a_run(monkeypatch):
+    """A Ctrl-C that lands in ``distributed.utils.sync`` before the coroutine it runs has made its future
+    makes the cancel callback read that future unassigned: tornado logs a NameError with a traceback
+    (seen once in the Ctrl-C test above). Reproduced here: the wait for the coroutine interrupted at once.
+    Within a run (``_quiet_sync_cancel``) that record is dropped, and no other; outside it, it is logged."""
+    import asyncio
+    import logging
+    import threading
+
+    from distributed.utils import sync
+    from tornado.ioloop import IOLoop
+
+    from slewing_model.study.engine import _quiet_sync_cancel
+
+    ready, holder = threading.Event(), {}
+
+    def serve():
+        asyncio.set_event_loop(asyncio.new_event_loop())
+        holder["loop"] = IOLoop.current()
+        ready.set()
+        holder["loop"].start()
+
+    threading.Thread(target=serve, daemon=True).start()
+    ready.wait(10)
+    loop = holder["loop"]
+    logged = []
+
+    class Kept(logging.Handler):
+        def emit(self, record):
+            logged.append(record)
+
+    logger = logging.getLogger("tornado.application")
+    handler = Kept(level=logging.ERROR)
+    logger.addHandler(handler)
+
+    async def work():
+        await asyncio.sleep(0.01)
+
+    def interrupted(self, timeout=None):
+        raise KeyboardInterrupt
+
+    def ctrl_c_in_sync():
+        held = threading.Lock()                     # the loop held, so that the coroutine's first step and the
+        held.acquire()                              # cancel callback are both queued before it runs on
+        loop.add_callback(lambda: (held.acquire(), held.release()))
+        with monkeypatch.context() as patch:
+            patch.setattr(threading.Event, "wait", interrupted)
+            with pytest.raises(KeyboardInterrupt):
+                sync(loop, work)
+        held.release()
+        sync(loop, work)                            # the loop has run the queued callbacks
+    try:
+        with _quiet_sync_cancel():
+            ctrl_c_in_sync()
+            logger.error("another error")           # the filter drops that one record only
+        quiet = [r.getMessage() for r in logged]
+        logged.clear()
+        ctrl_c_in_sync()
+    finally:
+        logger.removeHandler(handler)
+        loop.add_callback(loop.stop)
+    assert quiet == ["another error"]
+    assert any(isinstance(r.exc_info[1], NameError) and "sync.<locals>.cancel" in r.getMessage() for r in logged)
