@@ -170,12 +170,16 @@ class RacewayMap:
     def track_damage(self) -> np.ndarray:
         """``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)`` of contacts 1..4, (4,), from the sums kept step by
         step (:func:`track_damage` sums the whole map again; they agree to round-off)."""
-        return (np.maximum(self._power, 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
+        return self._damage(self._power)
 
     def worst_track_damage(self) -> float:
         """The largest of :meth:`track_damage`, taken from the largest sum (the damage grows with it): the
         same number, without the arrays (the FMU's ``life_damage`` output, every step)."""
-        return (max(max(self._power.tolist()), 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
+        return float(self._damage(max(self._power.tolist())))
+
+    def _damage(self, power):
+        """``D = [(1/N) max(power, 0)]^(9/10)`` of a track's kept sum, or of each of an array of them."""
+        return (np.maximum(power, 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
 
     def get_state(self) -> dict:
         """The map, its sums, the last ball angles, ring angle and ``Q^3`` (the map is not copied: the next

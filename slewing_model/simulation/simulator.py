@@ -270,7 +270,7 @@ class BearingSimulator:
         load = self.solver.scaled_load(loads)
         share = load_share(load, *self._loads)
         distribution = self.solver.solve(loads, initial=extrapolated_start(self._warm, self._previous, share))
-        magnitude = self.settings.seal_torque
+        magnitude = self._seal_torque
         if self.settings.friction_coefficient > 0.0:
             initial = extrapolated_motion(self._friction_warm, self._friction_previous, share)
             capped = {} if distribution.converged else {"max_iterations": BOUNDED_FRICTION_ITERATIONS}
