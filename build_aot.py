@@ -69,8 +69,10 @@ def build_kernels(output_dir=None, stage=None) -> Path:
         say("compiling the loops ahead of time with numba's pycc (about a minute, once per change of the "
             "kernels) ...")
         with tempfile.TemporaryDirectory(prefix="slewing_aot_") as tmp:
+            # TMPDIR: numba's check of the C compiler leaves a folder in the temporary directory
+            # (numba.pycc.platform._gentmpfile removes neither file nor folder); here it goes with ``tmp``
             run = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--compile", tmp], cwd=ROOT,
-                                 capture_output=True, text=True)
+                                 capture_output=True, text=True, env={**os.environ, "TMPDIR": tmp})
             built = Path(tmp) / module_file_name()
             if run.returncode != 0 or not built.exists():
                 raise RuntimeError(f"compiling the loops ahead of time failed (exit {run.returncode}):\n"

@@ -1,4 +1,6 @@
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +46,44 @@ def rigid_loop_calls(monkeypatch):
     loop = bime.compiled_rigid_solve()
     monkeypatch.setattr(bime, "compiled_rigid_solve", lambda: lambda *args: calls.append(1) or loop(*args))
     return calls
+
+
+# a session's folders take about 3.5 GB at their largest (built FMUs, unzipped ones, wine runs)
+DISK_NEEDED = 5e9
+
+
+def pytest_sessionstart(session):
+    # a full disk fails tests at random places with OSError (as it did on a CI machine): say so first
+    folder = tempfile.gettempdir()
+    free = shutil.disk_usage(folder).free
+    if free < DISK_NEEDED:
+        pytest.exit(f"{free / 1e9:.1f} GB free in the temporary directory {folder}: the tests need "
+                    f"{DISK_NEEDED / 1e9:.0f} GB (built and unzipped FMUs, wine runs); free some space first",
+                    returncode=3)
+
+
+# left in the temporary directory by design, not by a leak: distributed's scratch root (its lock files)
+KEPT_IN_TMPDIR = {"dask-scratch-space"}
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _private_tmpdir(tmp_path_factory):
+    """The temporary directory of the tests and of every process they start is a folder of this
+    session's, removed with the session's other folders when it passes. Whatever is left in it at
+    the end is a leak, and fails the session: an unzipped FMU is 130-330 MB, and such leaks, run
+    after run, once filled a CI machine's disk."""
+    folder = tmp_path_factory.mktemp("tmpdir", numbered=False)
+    before = os.environ.get("TMPDIR"), tempfile.tempdir
+    os.environ["TMPDIR"] = tempfile.tempdir = str(folder)
+    yield folder
+    if before[0] is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = before[0]
+    tempfile.tempdir = before[1]
+    left = sorted(path.name for path in folder.iterdir() if path.name not in KEPT_IN_TMPDIR)
+    assert not left, (f"the tests left {left} in their temporary directory {folder}: "
+                      "a test must remove what it unzips or writes there (or write it in its tmp_path)")
 
 
 @pytest.fixture(autouse=True, scope="session")

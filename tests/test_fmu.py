@@ -255,6 +255,7 @@ def test_two_instances_run_independently(table3_fmu):
         runs[tuple(loads)] = [_step(fmu, refs, 0.01 * k, psi=0.05 * k, omega=0.05, **loads) for k in range(3)]
         fmu.terminate()
         fmu.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
     a, ra, _, ua = _slave(table3_fmu, name="a")
     b, rb, _, ub = _slave(table3_fmu, name="b")
     for f in (a, b):
@@ -269,6 +270,8 @@ def test_two_instances_run_independently(table3_fmu):
     for f in (a, b):
         f.terminate()
         f.freeInstance()
+    for folder in (ua, ub):
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.mark.parametrize("inputs,message", [

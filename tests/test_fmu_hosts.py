@@ -347,7 +347,9 @@ try:
 except Exception as exc:
     print("RAISED", exc)
 """)
-    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    # TMPDIR: simulate_fmu does not remove the FMU it unzipped when a step fails; tmp_path is removed
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
+                         env={**os.environ, "TMPDIR": str(tmp_path)})
     assert "RAISED fmi2DoStep failed with status 3 (error)" in run.stdout, run.stdout + run.stderr
     assert "step at t = 0.05 refused again with the same inputs, so it cannot succeed" in run.stdout + run.stderr
     assert "input Fz = nan" in run.stdout + run.stderr

@@ -298,7 +298,7 @@ print(json.dumps({"available": AVAILABLE, "torque": friction_torque(b, d).magnit
 
 
 @needs_numba
-def test_fmu_ships_its_compiled_loops(table3_numba_fmu):
+def test_fmu_ships_its_compiled_loops(table3_numba_fmu, tmp_path):
     table3_fmu = table3_numba_fmu
     # unpacked to a new folder, an instance loads the loops from the cache the FMU carries
     # (numba keys it by the source's content): no compilation at instantiation
@@ -307,7 +307,7 @@ import json, sys
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 md = read_model_description({str(table3_fmu)!r})
-folder = extract({str(table3_fmu)!r})
+folder = extract({str(table3_fmu)!r}, unzipdir={str(tmp_path / "unzipped")!r})
 fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
                 instanceName="cache")
 fmu.instantiate()
