@@ -50,16 +50,26 @@ def rigid_loop_calls(monkeypatch):
 
 # a session's folders take about 3.5 GB at their largest (built FMUs, unzipped ones, wine runs)
 DISK_NEEDED = 5e9
+FREE_AT_START = pytest.StashKey[tuple]()
 
 
 def pytest_sessionstart(session):
     # a full disk fails tests at random places with OSError (as it did on a CI machine): say so first
     folder = tempfile.gettempdir()
     free = shutil.disk_usage(folder).free
+    session.config.stash[FREE_AT_START] = folder, free
     if free < DISK_NEEDED:
         pytest.exit(f"{free / 1e9:.1f} GB free in the temporary directory {folder}: the tests need "
                     f"{DISK_NEEDED / 1e9:.0f} GB (built and unzipped FMUs, wine runs); free some space first",
                     returncode=3)
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    # shown even with -q: the first thing to look at when tests fail with OSError
+    if FREE_AT_START in config.stash:
+        folder, free = config.stash[FREE_AT_START]
+        terminalreporter.write_line(f"disk: {free / 1e9:.1f} GB free in {folder} at the start, "
+                                    f"{shutil.disk_usage(folder).free / 1e9:.1f} GB at the end")
 
 
 # left in the temporary directory by design, not by a leak: distributed's scratch root (its lock files)
