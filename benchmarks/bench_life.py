@@ -48,7 +48,7 @@ def main() -> None:
         times, last = {0: [], 1: []}, {}
         for r in range(args.runs):
             for life, w in workers.items():
-                answer = w.run(WARM + r * args.steps, args.steps)
+                answer = w.run(WARM + r * args.steps, args.steps, rewarm=True)   # Worker.run
                 times[life] += answer["times"]
                 last[life] = answer["last"]
         for w in workers.values():
