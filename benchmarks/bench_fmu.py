@@ -100,9 +100,9 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
     for line in sys.stdin:
         first, count, rewarm = (*map(int, line.split()), 0)[:3]
         if rewarm:
-            # this machine takes the pages of a process idle for a second or more (its next step then
-            # took 9-40 ms of CPU time instead of 1, without a page fault in the process): the block's
-            # first step, made once and rolled back, brings them back before the timed steps
+            # on this machine a step whose memory was not touched for a second or more took 8-40 ms of
+            # CPU time instead of 1 (no page fault: out of the shared host's caches; docs/speed.md,
+            # nineteenth turn): the block's first step, made once and rolled back, warms it first
             state = fmu.getFMUstate()
             fmu.setReal(inputs, values_at(first))
             fmu.doStep(first * DT, DT)

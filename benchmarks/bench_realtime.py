@@ -16,9 +16,9 @@ tolerance), the same FMU with ``step_work`` = 2 (bounded: a step's work capped, 
 carried over and flagged by ``equilibrium_residual`` above the tolerance; the table counts those
 steps), and a baseline revision's (built by that revision's own build_fmu.py). Each runs in a
 worker process of its own through fmpy (``bench_fmu.Worker``); their runs of each scenario
-alternate in blocks, so all see the same machine load. This machine takes the pages of a process
-that waits a second or more (the next step then took 9-40 ms of CPU time, not 1, with no page fault
-in the process: measured in issue 31's nineteenth turn), so each block after a worker's first starts
+alternate in blocks, so all see the same machine load. On this machine a step whose memory was not
+touched for a second or more takes 8-40 ms of CPU time, not 1 (docs/speed.md, issue 31's nineteenth
+turn), and a worker waits while the others run, so each block after a worker's first starts
 with its first step made once and rolled back (``rewarm``), and each worker's first block follows its
 instantiation at once. A step is ``setReal`` of the 7 inputs,
 ``doStep`` (10 ms) and ``getReal`` of 5 outputs. "first step" is the first ``doStep`` after
