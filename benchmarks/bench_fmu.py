@@ -94,6 +94,7 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
     compiled = "numba" in sys.modules
     print(json.dumps({"instantiate": instantiate, "compiled": compiled}), flush=True)
     traced = refs[trace] if trace else None
+
     def values_at(k):
         return [*map(float, case.loads[k]), float(case.psi[k]), float(case.omega[k])]
 
