@@ -83,14 +83,10 @@ def _private_tmpdir(tmp_path_factory):
     the end is a leak, and fails the session: an unzipped FMU is 130-330 MB, and such leaks, run
     after run, once filled a CI machine's disk."""
     folder = tmp_path_factory.mktemp("tmpdir", numbered=False)
-    before = os.environ.get("TMPDIR"), tempfile.tempdir
-    os.environ["TMPDIR"] = tempfile.tempdir = str(folder)
-    yield folder
-    if before[0] is None:
-        os.environ.pop("TMPDIR", None)
-    else:
-        os.environ["TMPDIR"] = before[0]
-    tempfile.tempdir = before[1]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("TMPDIR", str(folder))
+        patch.setattr(tempfile, "tempdir", str(folder))
+        yield folder
     left = sorted(path.name for path in folder.iterdir() if path.name not in KEPT_IN_TMPDIR)
     assert not left, (f"the tests left {left} in their temporary directory {folder}: "
                       "a test must remove what it unzips or writes there (or write it in its tmp_path)")
