@@ -104,7 +104,7 @@ def _compile(output_dir: str) -> None:
     error_models = {}
     for name in KERNEL_MODULES:
         module = importlib.import_module(name)
-        compile_helpers(vars(module), module._HELPERS, module.ERROR_MODEL)
+        compile_helpers(vars(module), module._HELPERS, module.ERROR_MODEL, getattr(module, "_INLINE", ()))
         for factory, function in module.KERNELS:
             cc.export(aot_name(function), factory.signature)(function)
             error_models[function] = module.ERROR_MODEL

@@ -19,7 +19,7 @@ import pytest
 from slewing_model import Loads, friction_torque, load_bearing, solve
 from slewing_model.friction.ball_kinematics import ContactPoints, ContactSet
 from slewing_model.friction.ellipse_quadrature import ellipse_quadrature
-from slewing_model.friction.kernel import AVAILABLE
+from slewing_model.friction.kernel import AVAILABLE, SINE_SERIES_LIMIT, _sine_series
 
 from conftest import BEARINGS, ROOT, simulators_per_kernel
 
@@ -44,6 +44,44 @@ def _distributions():
     return [(table3, solve(table3, Loads(Fz=3e5))),
             (table3.with_preload(20e-6), solve(table3.with_preload(20e-6))),
             (errors, solve(errors, Loads(Fx=2e4, Fz=5e4, Mx=4e3), psi=0.3))]
+
+
+def test_the_sine_series_is_the_sine_to_round_off():
+    """The points' sines where a contact's angles are small (both paths take it): its Taylor series within
+    two units of round-off of numpy's sin over its whole range, and odd."""
+    x = np.linspace(-SINE_SERIES_LIMIT, SINE_SERIES_LIMIT, 20001)
+    series = getattr(_sine_series, "py_func", _sine_series)(x)
+    assert np.all(np.abs(series - np.sin(x)) <= 2.0 * np.spacing(np.abs(np.sin(x))))
+    assert np.array_equal(series, -getattr(_sine_series, "py_func", _sine_series)(-x))
+
+
+@needs_numba
+@pytest.mark.parametrize("quadrature", [(12, 2), (20, 4), (7, 3)])
+def test_wide_and_narrow_contacts_take_the_same_sines_in_both_paths(quadrature):
+    """Contacts whose angles ``a u / Rd`` reach past the series' limit take the C library's sine, the others the
+    series, in the compiled loop and in numpy alike: the coefficients equal to round-off either side of it."""
+    from types import SimpleNamespace
+
+    from slewing_model.friction.kernel import compiled_point_coefficients
+
+    ratio = np.linspace(0.05, 1.2, 24)                        # a / Rd, across SINE_SERIES_LIMIT
+    rd = np.full(ratio.size, 0.02)
+    angle = np.linspace(0.3, 1.2, ratio.size)
+    geo = SimpleNamespace(a=(ratio * rd)[:, None], b=(0.2 * ratio * rd)[:, None], rb=np.full((ratio.size, 1), 0.019),
+                          rd=rd[:, None], n_r=np.cos(angle)[:, None], n_z=np.sin(angle)[:, None],
+                          ring_speed=np.where(np.arange(ratio.size) % 2, 0.3, 0.0)[:, None],
+                          moving=(np.arange(ratio.size) % 2 == 1)[:, None], length_scale=0.019, pitch_radius=1.2)
+    u_nodes = ellipse_quadrature(*quadrature).writable_arrays[0]
+    assert np.any(ratio * np.abs(u_nodes).max() > SINE_SERIES_LIMIT)
+    assert np.any(ratio * np.abs(u_nodes).max() <= SINE_SERIES_LIMIT)
+    numpy_path = object.__new__(ContactPoints)
+    numpy_path._coefficients(geo, u_nodes)
+    columns = [np.ascontiguousarray(np.ravel(getattr(geo, name))) for name in ("a", "b", "rb", "rd", "n_r", "n_z",
+                                                                              "ring_speed", "moving")]
+    got = compiled_point_coefficients()(*columns, u_nodes, geo.length_scale, geo.pitch_radius)
+    for name, a in zip(("g10", "g12", "h1", "s0", "s1", "hs", "arm1", "arm2"), got):
+        b = getattr(numpy_path, name)
+        assert np.allclose(a, b, rtol=1e-14, atol=1e-14 * np.abs(b).max()), name
 
 
 @needs_numba
@@ -282,7 +320,7 @@ def test_library_without_numba_gives_the_same_torque():
     there = _run("""
 import json
 from slewing_model import Loads, friction_torque, load_bearing, solve
-from slewing_model.friction.kernel import AVAILABLE
+from slewing_model.friction.kernel import AVAILABLE, SINE_SERIES_LIMIT, _sine_series
 b = load_bearing("examples/bearings/table3_errors.toml").with_preload(10e-6)
 d = solve(b, Loads(Fx=2e4, Fz=5e4, Mx=4e3), psi=0.3)
 try:

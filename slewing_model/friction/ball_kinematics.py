@@ -27,7 +27,8 @@ from ..distribution.assembly import ball_diameters
 from .contact import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .kernel import (
-    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, WARM_ROLLING, compiled_ball_results, compiled_contact_set,
+    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, SINE_SERIES_LIMIT, WARM_ROLLING, _sine_series,
+    compiled_ball_results, compiled_contact_set,
     compiled_evaluate_points, compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients,
     compiled_tractions,
 )
@@ -112,14 +113,14 @@ def _first(mask: np.ndarray) -> int:
 
 def distribution_arrays(bearing: Bearing, distribution, writable: bool = False) -> dict:
     """The contact loads, angles and semi-axes (B, 4) of a load distribution for this bearing (a
-    ValueError naming a field of another shape); ``writable`` copies where read-only (the compiled
-    loops take writable arrays)."""
+    ValueError naming a field of another shape); ``writable`` copies where read-only or not in C order
+    (the compiled loops take writable arrays in C order)."""
     n_balls = bearing.ball_count
     arrays = {}
     for name in _DISTRIBUTION_FIELDS:
         value = np.asarray(getattr(distribution, name), dtype=float)
-        if writable and not value.flags.writeable:
-            value = value.copy()
+        if writable and not (value.flags.writeable and value.flags.c_contiguous):
+            value = np.array(value, order="C")
         if value.shape != (n_balls, 4):
             raise ValueError(f"distribution.{name} has shape {value.shape}, expected ({n_balls}, 4) "
                              f"for this bearing ({bearing.name})")
@@ -338,10 +339,16 @@ class ContactPoints:
         """The velocity coefficients ``g10 .. hs`` and lever arms ``arm1, arm2`` (C, I), numpy."""
         ls, big_r = geo.length_scale, geo.pitch_radius
         rb, rd, n_r, n_z, ring_speed = geo.rb, geo.rd, geo.n_r, geo.n_z, geo.ring_speed
-        # sin of the angle a u / Rd (C, I), |angle| < pi/2; the nodes u are symmetric and sin is odd
+        # sin of the angle a u / Rd (C, I), |angle| < pi/2: a contact whose angles are all within
+        # SINE_SERIES_LIMIT takes the sine's series, as the compiled loop does (the same numbers); the others
+        # np.sin, of the nodes u > 0 (the nodes are symmetric and sin is odd)
         n_i, n_neg = u_nodes.size, u_nodes.size // 2
         sin_pos = np.sin(geo.a * (u_nodes[n_neg:] / rd))
         sin_t = np.concatenate([-sin_pos[:, n_i - n_neg - 1::-1][:, :n_neg], sin_pos], axis=1)
+        series = geo.a * (np.abs(u_nodes).max() / rd) <= SINE_SERIES_LIMIT
+        if np.any(series):
+            angle = geo.a * (u_nodes / rd)
+            sin_t = np.where(series, getattr(_sine_series, "py_func", _sine_series)(angle), sin_t)
         cos_t = np.sqrt(1.0 - sin_t * sin_t)
         # point relative to the ball centre in the ball frame (r, t, z):
         # (rb - Rd + Rd cos) n + Rd sin g + xi t,  g = n x t = (-n_z, 0, n_r)
@@ -382,7 +389,7 @@ class ContactPoints:
                                force_scale=geo.force_scale[balls], active=geo.active[balls])
         for name in ("g10", "g12", "h1", "s0", "s1", "hs", "arm1", "arm2"):
             setattr(sub, name, getattr(self, name)[rows])
-        sub.t2, sub.weight = self.t2, self.weight[:, rows]
+        sub.t2, sub.weight = self.t2, np.ascontiguousarray(self.weight[:, rows])   # (the compiled loops take C order)
         sub._s, sub._k, sub._k3 = (np.empty_like(sub.weight) for _ in range(3))
         sub._products = None
         sub._ones = self._ones
