@@ -81,12 +81,19 @@ def use_compiled(kernel: str, name: str = "kernel") -> bool:
 
 
 def c_order(signature: str) -> str:
-    """``signature`` with every array in C order (``f8[:, :]`` -> ``f8[:, ::1]``). numba types an array of
+    """``signature`` (``returns(arguments)``) with every array argument in C order (``f8[:, :]`` ->
+    ``f8[:, ::1]``; what it returns is left as it is). numba types an array of
     ``f8[:, :]`` as of any layout: its strides are known only at run time and LLVM does not turn the loops
     over its last axis into vector operations. In C order it does (measured: the friction's points'
     coefficients of a pitch bearing's step 100 -> 58 us). The caller must then pass arrays in C order:
     numba refuses others (TypeError: no matching definition)."""
-    return signature.replace("[:, :, :]", "[:, :, ::1]").replace("[:, :]", "[:, ::1]").replace("[:]", "[::1]")
+    depth, start = 0, len(signature)
+    for start in range(len(signature) - 1, -1, -1):         # the arguments: from the '(' matching the last ')'
+        depth += {")": 1, "(": -1}.get(signature[start], 0)
+        if depth == 0:
+            break
+    arguments = signature[start:].replace("[:, :, :]", "[:, :, ::1]").replace("[:, :]", "[:, ::1]")
+    return signature[:start] + arguments.replace("[:]", "[::1]")
 
 
 def compile_loop(function, signature: str, helpers: tuple = (), error_model: str = "python", inline: tuple = ()):
