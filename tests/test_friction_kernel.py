@@ -49,10 +49,11 @@ def _distributions():
 def test_the_sine_series_is_the_sine_to_round_off():
     """The points' sines where a contact's angles are small (both paths take it): its Taylor series within
     two units of round-off of numpy's sin over its whole range, and odd."""
+    sine_series = getattr(_sine_series, "py_func", _sine_series)   # the Python function, on arrays
     x = np.linspace(-SINE_SERIES_LIMIT, SINE_SERIES_LIMIT, 20001)
-    series = getattr(_sine_series, "py_func", _sine_series)(x)
+    series = sine_series(x)
     assert np.all(np.abs(series - np.sin(x)) <= 2.0 * np.spacing(np.abs(np.sin(x))))
-    assert np.array_equal(series, -getattr(_sine_series, "py_func", _sine_series)(-x))
+    assert np.array_equal(series, -sine_series(-x))
 
 
 @needs_numba
@@ -320,7 +321,7 @@ def test_library_without_numba_gives_the_same_torque():
     there = _run("""
 import json
 from slewing_model import Loads, friction_torque, load_bearing, solve
-from slewing_model.friction.kernel import AVAILABLE, SINE_SERIES_LIMIT, _sine_series
+from slewing_model.friction.kernel import AVAILABLE
 b = load_bearing("examples/bearings/table3_errors.toml").with_preload(10e-6)
 d = solve(b, Loads(Fx=2e4, Fz=5e4, Mx=4e3), psi=0.3)
 try:

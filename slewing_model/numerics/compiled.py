@@ -104,7 +104,7 @@ def compile_loop(function, signature: str, helpers: tuple = (), error_model: str
     compiles it: they must be compiled functions by then, so each helper is compiled in place
     of its Python definition, once. The Python definitions are used by nothing else (the numpy
     paths are the library's own code). ``error_model`` "numpy": a division by zero gives inf or
-    NaN as numpy does, instead of raising."""
+    NaN as numpy does, instead of raising. ``inline``: the helpers numba inlines into their callers."""
     import numba
 
     compile_helpers(function.__globals__, helpers, error_model, inline)
