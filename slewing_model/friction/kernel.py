@@ -253,7 +253,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
         while True:
             minus_g[:] = -g
             _solve3(h, minus_g, newton, work)
-            slope, _ = _quadratic(g, h, newton)
+            slope = _quadratic(g, h, newton)[0]
             decrement = -slope
             if decrement <= tol * (f + floor):           # converged: the last Newton step where it lowers D
                 trial[:] = x + newton
@@ -275,7 +275,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
                 slope, predicted = -decrement, 0.5 * decrement
             trial[:] = x + du
             good = False
-            for _ in range(12):
+            for _attempt in range(12):
                 with_extra = theta > 0.0
                 f_t = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, with_extra,
                                      g_t, h_t, e_t)
@@ -440,7 +440,7 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     flipped: ``ContactSet.stale_warm_start``), starts as ``friction_torque``'s general path starts it
     (:func:`_cold_start`), so that a step whose contacts changed stays one call."""
     n_balls = load.shape[0]
-    (status, _, ball_index, contact_index, owner, active, inactive, rows, moving_c, force_scale) = _contact_set(
+    (status, where, ball_index, contact_index, owner, active, inactive, rows, moving_c, force_scale) = _contact_set(
         load, angle, semi_a, semi_b, ball_radius, groove_radius, moving, sign_r, sign_z, mu, speed,
         sliding_regularisation)
     empty_i = np.zeros(0, np.int64)
@@ -484,8 +484,9 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     if same_rule:                                   # the rule the balls are solved on: the torque's, or its own
         c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2 = g10, g12, h1, s0, s1, hs, weight, fine_t2
     else:
-        c10, c12, c1, c0, c1s, chs, _, _ = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
-                                                               solve_nodes, length_scale, pitch_radius)
+        # (each unused value named: numba, inlining the helpers, types every '_' as one variable)
+        c10, c12, c1, c0, c1s, chs, _arm1, _arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
+                                                                       solve_nodes, length_scale, pitch_radius)
         rule_weight, rule_t2 = _rule_weight(solve_weight, mu_load), solve_t2
     if cold.any():
         _cold_start(u, cold, active, first, load, angle, ball_radius, moving[1], speed, length_scale,   # moving[1]:
