@@ -36,8 +36,13 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(PY) examples/demo.py
 
+# the test files run on TEST_WORKERS processes (pytest-xdist), a file's tests on one of them (its module
+# fixtures built once); numba's loops are compiled first, once, into its cache, which both then load
+TEST_WORKERS ?= 2
+
 test: $(STAMP)
-	$(PY) -m pytest -q --durations=15
+	$(PY) -c "from slewing_model.friction.kernel import compile_all; compile_all()"
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
 # speed figures of the README (several minutes: the FMU memory run takes 100 000 steps)
 bench: $(STAMP)
