@@ -20,7 +20,7 @@ TABLE3 = (ROOT / "examples" / "bearings" / "table3.toml").as_posix()
 
 pytest.importorskip("distributed", reason="the study engine needs dask[distributed] (extra 'study')")
 
-# 40 small cases (rigid rings, 300 steps each, a few tenths of a second) on one worker: the run
+# 40 small cases (rigid rings, 100 steps each, a tenth of a second or so) on one worker: the run
 # lasts long enough to be interrupted after a few of them have finished
 STUDY = f"""[study]
 name = "sigint"
@@ -29,7 +29,7 @@ name = "light"
 constant = [0, 0, 1e4, 0, 0, 0]
 omega_rad_s = 0.1
 duration_s = 10.0
-steps = 300
+steps = 100
 [bearings]
 files = ["{TABLE3}"]
 ring_model = ["rigid"]
