@@ -37,16 +37,15 @@ demo: $(STAMP)
 	$(PY) examples/demo.py
 
 # the test files run on TEST_WORKERS processes (pytest-xdist), a file's tests on one of them (its module
-# fixtures built once), the long files first (tests/conftest.py). numba's loops are compiled first, once,
-# into its cache, which the tests then load: for this CPU and, beside it, for a generic x86-64 one (what
-# build_fmu.py adds to the FMU)
+# fixtures built once). numba's loops are compiled first, once, into its cache, which the tests then load:
+# for this CPU and, beside it, for a generic x86-64 one (what build_fmu.py adds to the FMU)
 TEST_WORKERS ?= 2
 COMPILE_LOOPS := from slewing_model.friction.kernel import compile_all; compile_all()
 
 test: $(STAMP)
 	NUMBA_CPU_NAME=generic $(PY) -c "$(COMPILE_LOOPS)" & generic=$$!; \
 	$(PY) -c "$(COMPILE_LOOPS)" && wait $$generic
-	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder --durations=15
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
 # speed figures of the README (several minutes: the FMU memory run takes 100 000 steps)
 bench: $(STAMP)

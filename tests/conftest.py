@@ -72,20 +72,6 @@ def pytest_terminal_summary(terminalreporter, config):
                                     f"{shutil.disk_usage(folder).free / 1e9:.1f} GB at the end")
 
 
-#: the test files that take longest (one process: 35-330 s each, most of it building or running FMUs), in
-#: that order, first: ``make test`` runs the files on two processes (pytest-xdist, ``--dist loadfile``, which
-#: hands out files in this order with ``--no-loadscope-reorder``), and a long file handed out last would
-#: leave the other process idle at the end
-LONG_FILES = ("test_standalone.py", "test_win64.py", "test_aot.py", "test_interrupt.py", "test_ssp.py", "test_fmu.py",
-              "test_friction_kernel.py", "test_drive_fmu.py", "test_fmi3.py", "test_study.py", "test_readme.py",
-              "test_fmu_hosts.py", "test_connection.py")
-
-
-def pytest_collection_modifyitems(session, config, items):
-    rank = {name: k for k, name in enumerate(LONG_FILES)}
-    items.sort(key=lambda item: rank.get(item.path.name, len(LONG_FILES)))   # stable: a file's order kept
-
-
 # left in the temporary directory by design, not by a leak: distributed's scratch root (its lock files)
 KEPT_IN_TMPDIR = {"dask-scratch-space"}
 

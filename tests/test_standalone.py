@@ -86,7 +86,6 @@ def _make_bare_system(release: str, target: Path) -> Path:
         pytest.fail("debootstrap is not installed: `make` installs it (apt-get install debootstrap)")
     partial = CHROOTS / f"{release}.partial"
     shutil.rmtree(partial, ignore_errors=True)
-    CHROOTS.mkdir(parents=True, exist_ok=True)
     run = subprocess.run([debootstrap, "--variant=minbase", release, str(partial)], capture_output=True, text=True,
                          timeout=900)
     assert run.returncode == 0, f"debootstrap {release} failed:\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
