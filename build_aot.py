@@ -101,21 +101,25 @@ def _compile(output_dir: str) -> None:
     cc = CC(AOT_MODULE)
     cc.output_dir = output_dir
     cc.verbose = False
-    error_models = {}
+    error_models, fastmath = {}, {}
     for name in KERNEL_MODULES:
         module = importlib.import_module(name)
-        compile_helpers(vars(module), module._HELPERS, module.ERROR_MODEL, getattr(module, "_INLINE", ()))
+        flags = getattr(module, "FASTMATH", frozenset())
+        compile_helpers(vars(module), module._HELPERS, module.ERROR_MODEL, getattr(module, "_INLINE", ()), flags)
         for factory, function in module.KERNELS:
             cc.export(aot_name(function), factory.signature)(function)
-            error_models[function] = module.ERROR_MODEL
+            error_models[function], fastmath[function] = module.ERROR_MODEL, flags
     source_hash = kernel_source_hash()
     cc.export("source_hash", "i8()")(lambda: source_hash)
 
-    # pycc compiles every export with one set of flags: give each loop its module's error model
+    # pycc compiles every export with one set of flags: give each loop its module's error model and fast-math
+    # flags (pycc compiles for a generic x86-64 CPU, which has no fused multiply-add: the friction's
+    # ``contract`` then changes nothing)
     original = pycc_compiler.compile_extra
 
     def compile_extra(typingctx, targetctx, func, args, return_type, flags, locals, **kwargs):
         flags.error_model = error_models.get(func, "python")
+        flags.fastmath = set(fastmath.get(func, ()))
         return original(typingctx, targetctx, func, args, return_type, flags, locals, **kwargs)
 
     pycc_compiler.compile_extra = compile_extra

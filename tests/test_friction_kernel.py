@@ -104,20 +104,31 @@ def test_compiled_sums_equal_the_numpy_sums(case, quadrature):
     for u in (start, start * (1.0 + 0.3 * rng.standard_normal(start.shape))):
         want = numpy_path.evaluate(u, geometry.eps2, majorant=True)
         got = compiled.evaluate(u, geometry.eps2, majorant=True)
-        for name, a, b in zip(("power", "gradient", "hessian", "majorant"), got, want):
-            scale = np.abs(b).max()
-            assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * scale), name
+        nudged = numpy_path.evaluate(u * (1.0 + np.finfo(float).eps), geometry.eps2, majorant=True)
+        for name, a, b, c in zip(("power", "gradient", "hessian", "majorant"), got, want, nudged):
+            assert _within_round_off(a, b, c), name
         power_only = compiled.evaluate(u, geometry.eps2, derivatives=False)
         assert power_only[1] is None and np.allclose(power_only[0], want[0], rtol=1e-12)
         # each contact's power and torque on the moving ring (the torque's sign changes across the contacts)
-        for name, a, b in zip(("power", "torque"), compiled.tractions(u), numpy_path.tractions(u)):
-            assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * np.abs(b).max()), name
+        for name, a, b, c in zip(("power", "torque"), compiled.tractions(u), numpy_path.tractions(u),
+                                 numpy_path.tractions(u * (1.0 + np.finfo(float).eps))):
+            assert _within_round_off(a, b, c), name
     # a subset of the balls (the stragglers' path) keeps the compiled loop
     balls = np.arange(0, geometry.active.size, 3)
     sub_np, sub_c = numpy_path.subset(balls), compiled.subset(balls)
     eps2 = geometry.eps2[np.isin(geometry.owner, balls)]
-    assert np.allclose(sub_c.evaluate(start[balls], eps2)[2], sub_np.evaluate(start[balls], eps2)[2], rtol=1e-12,
-                       atol=1e-12 * np.abs(sub_np.evaluate(start[balls], eps2)[2]).max())
+    assert _within_round_off(sub_c.evaluate(start[balls], eps2)[2], sub_np.evaluate(start[balls], eps2)[2],
+                             sub_np.evaluate(start[balls] * (1.0 + np.finfo(float).eps), eps2)[2])
+
+
+def _within_round_off(got, want, nudged) -> bool:
+    """``got`` equals ``want`` as far as the sums are defined: within 1e-12 of ``want`` (relative, and of its
+    largest entry) and eight times what moves numpy's own sums (``nudged``: at motions one unit of round-off
+    away). The Hessian's and the torques' terms cancel: on the distribution with errors a rounding of the
+    motions moves the Hessian by 2e-12 of its largest entry, and the compiled loop rounds otherwise (fused
+    multiply-adds, ``friction.kernel.FASTMATH``)."""
+    bound = 1e-12 * np.abs(want).max() + 8.0 * np.abs(nudged - want).max()
+    return want.shape == got.shape and bool(np.all(np.abs(got - want) <= bound + 1e-12 * np.abs(want)))
 
 
 @needs_numba
@@ -146,8 +157,12 @@ def test_compiled_contact_set_equals_the_numpy_one(case):
     u = rng.standard_normal((sets[False].active.size, 3))
     power = rng.uniform(0.0, 1.0, sets[False].ball_index.size)
     results = [ball_results(sets[k], u, power, bearing.ball_count, 0.31, compiled=k) for k in (False, True)]
-    for want, got in zip(*results):
-        assert want.shape == got.shape and np.array_equal(want, got)
+    names = ("contact_power", "power per ball", "omega_ball", "orbital", "state", "spin_roll", "count")
+    for name, want, got in zip(names, *results):
+        if name == "spin_roll":     # spin / roll: the compiled loop fuses multiply-adds (friction.kernel.FASTMATH)
+            assert want.shape == got.shape and np.allclose(got, want, rtol=0.0, atol=1e-13 * np.abs(want).max())
+        else:
+            assert want.shape == got.shape and np.array_equal(want, got), name
     assert results[0][3][sets[False].inactive].tolist() == [0.31] * sets[False].inactive.size
     load = distribution.contact_load
     ball, contact = np.argwhere(load > 0)[1]                   # the second loaded contact

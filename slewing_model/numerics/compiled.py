@@ -96,7 +96,8 @@ def c_order(signature: str) -> str:
     return signature[:start] + arguments.replace("[:]", "[::1]")
 
 
-def compile_loop(function, signature: str, helpers: tuple = (), error_model: str = "python", inline: tuple = ()):
+def compile_loop(function, signature: str, helpers: tuple = (), error_model: str = "python", inline: tuple = (),
+                 fastmath: frozenset = frozenset()):
     """``function`` compiled by numba for ``signature`` (eager, numba's on-disk cache), after the
     ``helpers`` it calls (names in its module).
 
@@ -104,21 +105,25 @@ def compile_loop(function, signature: str, helpers: tuple = (), error_model: str
     compiles it: they must be compiled functions by then, so each helper is compiled in place
     of its Python definition, once. The Python definitions are used by nothing else (the numpy
     paths are the library's own code). ``error_model`` "numpy": a division by zero gives inf or
-    NaN as numpy does, instead of raising. ``inline``: the helpers numba inlines into their callers."""
+    NaN as numpy does, instead of raising. ``inline``: the helpers numba inlines into their callers.
+    ``fastmath``: LLVM's fast-math flags for the loop and its helpers (numba's ``fastmath``; a module's
+    ``FASTMATH``); none of those that assume no NaN or infinity, which the loops' checks look for."""
     import numba
 
-    compile_helpers(function.__globals__, helpers, error_model, inline)
-    return numba.njit(signature, cache=True, nogil=True, error_model=error_model)(function)
+    compile_helpers(function.__globals__, helpers, error_model, inline, fastmath)
+    return numba.njit(signature, cache=True, nogil=True, error_model=error_model,
+                      fastmath=set(fastmath))(function)
 
 
-def compile_helpers(module: dict, helpers: tuple, error_model: str = "python", inline: tuple = ()) -> None:
+def compile_helpers(module: dict, helpers: tuple, error_model: str = "python", inline: tuple = (),
+                    fastmath: frozenset = frozenset()) -> None:
     """Each of ``helpers`` (names in the globals ``module``) compiled in place of its Python
     definition, once (:func:`compile_loop`; ``build_aot.py`` before it exports the loops)."""
     import numba
 
     for name in helpers:
         if not hasattr(module[name], "py_func"):          # not compiled yet
-            module[name] = numba.njit(cache=True, nogil=True, error_model=error_model,
+            module[name] = numba.njit(cache=True, nogil=True, error_model=error_model, fastmath=set(fastmath),
                                       inline="always" if name in inline else "never")(module[name])
 
 
