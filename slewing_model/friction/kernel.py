@@ -525,10 +525,11 @@ _INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate")
 
 
 #: LLVM's fast-math flags of these loops: ``contract``, a product and the sum it enters as one fused
-#: multiply-add (rounded once instead of twice), where the CPU has them. Measured: the pitch bearing's NREL
-#: step, library, five alternating runs in their own processes, median 1712 -> 1571 us (docs/speed.md,
-#: "Issue 31, twenty-second turn"); torques 3e-16 from the loops without it. Not ``reassoc`` (no faster in the
-#: step) nor any flag that assumes no NaN or infinity (the loops look for them)
+#: multiply-add (rounded once instead of twice), where the CPU has them. Measured: the friction's one call of
+#: the pitch bearing's NREL steps, hot, alternating with and without it call by call in one process, 0.88
+#: (821 -> 724 us on a slow day; about 4 % of a step, below what the step's own A/B runs resolve here:
+#: docs/speed.md, "Issue 31, twenty-second turn"); torques 3e-16 from the loops without it. Not ``reassoc``
+#: (no faster) nor any flag that assumes no NaN or infinity (the loops look for them)
 FASTMATH = frozenset({"contract"})
 
 
