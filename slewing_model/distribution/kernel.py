@@ -976,7 +976,7 @@ ERROR_MODEL = "numpy"
 #: LLVM's fast-math flags of these loops (as the friction's, :data:`slewing_model.friction.kernel.FASTMATH`):
 #: ``contract``, a product and the sum it enters as one fused multiply-add (rounded once instead of twice),
 #: where the CPU has them. Measured: the usual solve's one call (:func:`_warm_solve`) of the pitch bearing's
-#: NREL steps, hot, alternating with and without it call by call in one process (``benchmarks/bench_kernel_flags.py``,
+#: NREL steps, hot, alternating with and without it call by call in one process (``benchmarks/bench_kernel_ab.py``,
 #: 43 calls, two runs): without it 1.036 and 1.059 times as long (575 -> 600, 603 -> 639 us a call; the call is
 #: about 0.43 of a step), the answers 2e-13 of the largest contact load apart, the same iterations.
 #: ``reassoc`` with it: 1.017 times as long again. Nor any flag that assumes no NaN or infinity (the loops look

@@ -427,9 +427,10 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
     """A warm-started friction torque (:func:`slewing_model.friction.friction_torque`) in one call: the
     loaded contacts (:func:`_contact_set`), the points of the rule the balls are solved on and of
     the torque's (:func:`_point_coefficients`), the balls' equilibrium from ``warm`` (the last
-    state, (B, 4); :func:`_minimise_balls`), the contacts' powers and torques (:func:`_tractions`)
-    and what is reported per ball (:func:`_ball_results`): the loops ``friction_torque`` calls one
-    by one, with the same arguments, so the same numbers bit for bit.
+    state, (B, 4); :func:`_minimise_balls`), the contacts' powers and torques (:func:`_rule_tractions`,
+    the torque rule's points formed where they are summed) and what is reported per ball
+    (:func:`_ball_results`): the loops ``friction_torque`` calls one by one, with the same arguments, so
+    the same numbers bit for bit.
 
     Returns a status (0; :data:`GENERAL_PATH` where the general path must run: a refused
     distribution, whose refusal it words, or no loaded contact),
@@ -473,28 +474,28 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
             cold[row] = not u[row, 0] * rolling[0] >= least * rolling[0] * rolling[0]
     a, b, rb, rd, n_r, n_z, ring_speed = rows[4], rows[5], rows[0], rows[1], rows[2], rows[3], rows[6]
     mu_load, eps2 = rows[7], rows[8]
-    g10, g12, h1, s0, s1, hs, arm1, arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
-                                                               fine_nodes, length_scale, pitch_radius)
-    weight = _rule_weight(fine_weight, mu_load)
     first = np.zeros(active.size + 1, np.int64)     # the contacts of each active ball (ordered by ball)
     for j in range(owner.size):
         first[owner[j] + 1] = j + 1
     for row in range(active.size):
         first[row + 1] = max(first[row + 1], first[row])
     if same_rule:                                   # the rule the balls are solved on: the torque's, or its own
-        c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2 = g10, g12, h1, s0, s1, hs, weight, fine_t2
+        nodes, folded_weight, rule_t2 = fine_nodes, fine_weight, fine_t2
     else:
-        # (each unused value named: numba, inlining the helpers, types every '_' as one variable)
-        c10, c12, c1, c0, c1s, chs, _arm1, _arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
-                                                                       solve_nodes, length_scale, pitch_radius)
-        rule_weight, rule_t2 = _rule_weight(solve_weight, mu_load), solve_t2
+        nodes, folded_weight, rule_t2 = solve_nodes, solve_weight, solve_t2
+    # (each unused value named: numba, inlining the helpers, types every '_' as one variable)
+    c10, c12, c1, c0, c1s, chs, _arm1, _arm2 = _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving_c,
+                                                                   nodes, length_scale, pitch_radius)
+    rule_weight = _rule_weight(folded_weight, mu_load)
     if cold.any():
         _cold_start(u, cold, active, first, load, angle, ball_radius, moving[1], speed, length_scale,   # moving[1]:
                     pitch_radius, c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2, eps2)  # contact 2's, inner ring
     u, iterations, residual, converged = _minimise_balls(
         u, first, c10, c12, c1, c0, c1s, chs, rule_weight, rule_t2, eps2, force_scale, tol, -1.0, max_iterations,
         theta_down, theta_up, theta_min_up)
-    power_c, torque_c = _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, fine_t2, eps2, arm1, arm2)
+    # the torque's rule: its points formed where they are summed (its arrays would be used for nothing else)
+    power_c, torque_c = _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving_c, fine_nodes,
+                                        length_scale, pitch_radius, fine_weight, mu_load, fine_t2, eps2)
     all_converged = True
     most, largest = 0, 0.0
     for row in range(active.size):                  # as numpy's max(initial=0): a NaN residual shows
@@ -510,8 +511,9 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
 
 #: the helpers the friction's loops call
 _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
-            "_contact_set", "_point_coefficients", "_rule_weight", "_minimise_balls", "_tractions", "_ball_results",
-            "_cold_start", "_diagonal_rolling", "_sine_series")
+            "_contact_set", "_node_sines", "_largest_node", "_contact_points", "_point_coefficients", "_rule_weight",
+            "_minimise_balls", "_tractions", "_rule_tractions", "_ball_results", "_cold_start", "_diagonal_rolling",
+            "_sine_series")
 
 
 #: numba's error model of these loops (Python's: a division by zero raises)
@@ -521,7 +523,7 @@ ERROR_MODEL = "python"
 #: the helpers numba inlines into their callers (its own inlining, before LLVM's choices). Measured on a pitch
 #: bearing's step, hot: the balls' equilibrium 360 -> 300 us (``_ball_evaluate``), an evaluation of every ball
 #: 197 -> 172 us (``_contact_sums``)
-_INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate")
+_INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate", "_contact_points")
 
 
 #: LLVM's fast-math flags of these loops: ``contract``, a product and the sum it enters as one fused
@@ -687,55 +689,117 @@ _COEFFICIENT_SIGNATURE = c_order("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[
                                  "f8, f8)")
 
 
+def _node_sines(a_c, rd_c, u_nodes, largest_node, sin_t):
+    """``sin t_i`` of a contact's points across the groove into ``sin_t`` (I,): ``t_i = a u_i / Rd``, the
+    angle of node ``u_i`` (symmetric about 0) on the groove, for the semi-axis ``a_c`` and groove radius
+    ``rd_c`` (``ContactPoints.__init__``). Where every angle is within :data:`SINE_SERIES_LIMIT` (a
+    contact's a / Rd is at most 0.25 on the pitch bearing), their series: a loop free of calls, which runs
+    as vector operations (measured 1.6 times faster). Else the C library's sin, of the nodes u > 0: sin is
+    odd and the nodes symmetric, the node I - 1 - i has -sin."""
+    n_across = u_nodes.size
+    if a_c * (largest_node / rd_c) <= SINE_SERIES_LIMIT:
+        for i in range(n_across):
+            sin_t[i] = _sine_series(a_c * (u_nodes[i] / rd_c))
+    else:
+        for i in range(n_across // 2, n_across):
+            sin_pos = math.sin(a_c * (u_nodes[i] / rd_c))
+            sin_t[n_across - 1 - i] = -sin_pos
+            sin_t[i] = sin_pos                       # last: an odd rule's middle node (u = 0) is its own mirror
+
+
+def _largest_node(u_nodes):
+    largest = 0.0
+    for i in range(u_nodes.size):
+        largest = max(largest, abs(u_nodes[i]))
+    return largest
+
+
+def _contact_points(sin_t, root, rb_c, rd_c, nr, nz, speed, half_width, arm, length_scale, pitch_radius,
+                    g10, g12, h1, s0, s1, hs, arm1, arm2):
+    """The velocity and lever-arm coefficients ``g10, g12, h1, s0, s1, hs, arm1, arm2`` (I,) of one contact's
+    points (their nodes' ``sin t`` and ``sqrt(1 - u^2)``; the contact's ball and groove radii, normal, ring
+    speed, semi-axis ``b``, whether its ring is the moving one: the fixed ring's contacts take no torque arm)
+    written into the given arrays: the formulas of ``ContactPoints.__init__``
+    (:mod:`slewing_model.friction.ball_kinematics`), which derives them, in the same order of operations. A
+    loop free of calls: it runs as vector operations."""
+    for k in range(sin_t.size):
+        sin_k = sin_t[k]
+        cos_t = math.sqrt(1.0 - sin_k * sin_k)
+        rho = rb_c - rd_c + rd_c * cos_t
+        r_r = rho * nr - rd_c * sin_k * nz
+        r_z = rho * nz + rd_c * sin_k * nr
+        t2_r = -cos_t * nz - sin_k * nr
+        t2_z = cos_t * nr - sin_k * nz
+        half = half_width * root[k]
+        g10[k] = r_z / length_scale
+        g12[k] = -r_r / length_scale
+        h1[k] = speed * (pitch_radius + r_r)
+        s0[k] = -half * t2_z / length_scale
+        s1[k] = half * t2_r / length_scale
+        hs[k] = -half * speed * t2_r
+        arm1[k] = pitch_radius + r_r if arm else 0.0
+        arm2[k] = -t2_r * half if arm else 0.0
+
+
+_COEFFICIENT_SIGNATURE = c_order("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], b1[:], f8[:], "
+                                 "f8, f8)")
+
+
 def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, length_scale, pitch_radius):
     """Velocity and lever-arm coefficients (C, I) of every contact (C,) at the across nodes
-    ``u_nodes`` (I,, symmetric about 0): ``g10, g12, h1, s0, s1, hs, arm1, arm2``, the
-    formulas of ``ContactPoints.__init__`` (:mod:`slewing_model.friction.ball_kinematics`), which
-    derives them, in the same order of operations."""
+    ``u_nodes`` (I,, symmetric about 0): ``g10, g12, h1, s0, s1, hs, arm1, arm2``
+    (:func:`_node_sines`, :func:`_contact_points`)."""
     n_contacts, n_across = a.size, u_nodes.size
-    n_neg = n_across // 2
     shape = (n_contacts, n_across)     # eight arrays, each its own (not from a list: then they might alias)
     g10, g12, h1, s0, s1, hs = np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), \
         np.empty(shape)
     arm1, arm2 = np.empty(shape), np.empty(shape)
     root = np.sqrt(1.0 - u_nodes ** 2)
     sin_t = np.empty(n_across)
-    largest_node = 0.0
-    for i in range(n_across):
-        largest_node = max(largest_node, abs(u_nodes[i]))
+    largest_node = _largest_node(u_nodes)
     for c in range(n_contacts):
-        rb_c, rd_c, nr, nz, speed, half_width = rb[c], rd[c], n_r[c], n_z[c], ring_speed[c], b[c]
-        arm = moving[c]                              # the fixed ring's contacts take no torque arm
-        # the sines first, so that the loop below, free of calls, runs as vector operations (measured 1.6
-        # times faster). Where every angle is within SINE_SERIES_LIMIT (a contact's a / Rd is at most 0.25
-        # on the pitch bearing), their series: a loop free of calls too. Else the C library's sin, of
-        # the nodes u > 0: sin is odd and the nodes symmetric, the node n_across - 1 - i has -sin
-        if a[c] * (largest_node / rd_c) <= SINE_SERIES_LIMIT:
-            for i in range(n_across):
-                sin_t[i] = _sine_series(a[c] * (u_nodes[i] / rd_c))
-        else:
-            for i in range(n_neg, n_across):
-                sin_pos = math.sin(a[c] * (u_nodes[i] / rd_c))
-                sin_t[n_across - 1 - i] = -sin_pos
-                sin_t[i] = sin_pos                   # last: an odd rule's middle node (u = 0) is its own mirror
-        for k in range(n_across):
-            sin_k = sin_t[k]
-            cos_t = math.sqrt(1.0 - sin_k * sin_k)
-            rho = rb_c - rd_c + rd_c * cos_t
-            r_r = rho * nr - rd_c * sin_k * nz
-            r_z = rho * nz + rd_c * sin_k * nr
-            t2_r = -cos_t * nz - sin_k * nr
-            t2_z = cos_t * nr - sin_k * nz
-            half = half_width * root[k]
-            g10[c, k] = r_z / length_scale
-            g12[c, k] = -r_r / length_scale
-            h1[c, k] = speed * (pitch_radius + r_r)
-            s0[c, k] = -half * t2_z / length_scale
-            s1[c, k] = half * t2_r / length_scale
-            hs[c, k] = -half * speed * t2_r
-            arm1[c, k] = pitch_radius + r_r if arm else 0.0
-            arm2[c, k] = -t2_r * half if arm else 0.0
+        _node_sines(a[c], rd[c], u_nodes, largest_node, sin_t)
+        _contact_points(sin_t, root, rb[c], rd[c], n_r[c], n_z[c], ring_speed[c], b[c], moving[c], length_scale,
+                        pitch_radius, g10[c], g12[c], h1[c], s0[c], s1[c], hs[c], arm1[c], arm2[c])
     return g10, g12, h1, s0, s1, hs, arm1, arm2
+
+
+def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, length_scale, pitch_radius,
+                    folded_weight, mu_load, t2, eps2):
+    """:func:`_tractions` on a rule whose points' coefficients are used for nothing else (the torque's
+    rule where the balls are solved on another): each contact's points formed (:func:`_contact_points`)
+    where they are summed, in arrays of one contact's size, instead of the rule's arrays of every contact
+    (:func:`_point_coefficients`, :func:`_rule_weight`): the same numbers, with the rule's ten arrays
+    neither written nor read again."""
+    n_contacts, n_across = a.size, u_nodes.size
+    power = np.zeros(n_contacts)
+    torque = np.zeros(n_contacts)
+    root = np.sqrt(1.0 - u_nodes ** 2)
+    sin_t = np.empty(n_across)
+    g10, g12, h1, s0, s1, hs = np.empty(n_across), np.empty(n_across), np.empty(n_across), np.empty(n_across), \
+        np.empty(n_across), np.empty(n_across)
+    arm1, arm2 = np.empty(n_across), np.empty(n_across)
+    largest_node = _largest_node(u_nodes)
+    for c in range(n_contacts):
+        _node_sines(a[c], rd[c], u_nodes, largest_node, sin_t)
+        _contact_points(sin_t, root, rb[c], rd[c], n_r[c], n_z[c], ring_speed[c], b[c], moving[c], length_scale,
+                        pitch_radius, g10, g12, h1, s0, s1, hs, arm1, arm2)
+        ball = owner[c]
+        u0, u1, u2, e2, load = u[ball, 0], u[ball, 1], u[ball, 2], eps2[c], mu_load[c]
+        contact_power = contact_torque = 0.0
+        for i in range(n_across):
+            a_i, s_i = g10[i] * u0 + g12[i] * u1 + (h1[i] - u2), s0[i] * u0 + s1[i] * u1 + hs[i]     # _sliding
+            a2, s2 = a_i * a_i, s_i * s_i
+            alpha = beta = 0.0
+            for k in range(t2.shape[0]):
+                ws = folded_weight[k, i] * load / math.sqrt(a2 + t2[k] * s2 + e2)
+                alpha += ws
+                beta += ws * t2[k]
+            ga, gs = alpha * a_i, beta * s_i
+            contact_power += ga * a_i + gs * s_i
+            contact_torque -= ga * arm1[i] + gs * arm2[i]   # the traction on the ring is minus that on the ball
+        power[c], torque[c] = contact_power, contact_torque
+    return power, torque
 
 
 #: (factory, Python function) of each compiled loop of the friction model

@@ -1,5 +1,6 @@
-"""One compiled call of a step, replayed hot: the library's loops against the same loops compiled with other
-fast-math flags, alternating call by call in one process (issue 31).
+"""One compiled call of a step, replayed hot: the library's loop against the same loop compiled with other
+fast-math flags, or from the kernel's source at another revision, alternating call by call in one process
+(issue 31).
 
 A change inside one compiled call that saves a few percent of a step is below what a step-level A/B
 resolves on a noisy machine (runs of the same pair of revisions gave ratios 0.78-1.02 here: docs/speed.md,
@@ -13,7 +14,8 @@ and the arguments of one compiled call are recorded every tenth step from the 50
   torque).
 
 The kernel module is then loaded again from a copy of its source (in a temporary folder: its own numba
-cache) with ``FASTMATH`` set to ``--flags`` (none: ``--flags`` alone), and its loop compiled. Each round
+cache), this checkout's or that of git revision ``--revision``, with ``FASTMATH`` set to ``--flags`` where
+given (none: ``--flags`` alone), and its loop compiled; the call's signature must be the same. Each round
 calls every recorded call once with the library's loop and once with the variant's, in alternating order,
 each on fresh copies of its arguments; a round's time is the sum over the recorded calls. The table gives
 the rounds' median and tail percentiles of each loop, and the ratio variant / library of each round (its
@@ -22,14 +24,14 @@ largest entry) and whether their iterations agree are printed under it: a change
 round-off, and where the distribution's stop rule then flips an iteration the answers differ by up to
 its tolerance.
 
-Run: .venv/bin/python benchmarks/bench_kernel_flags.py --kernel distribution --flags [--flags contract reassoc]
-     [--scenario nrel] [--steps 550] [--rounds 30]
+Run: .venv/bin/python benchmarks/bench_kernel_ab.py --kernel distribution --flags [--flags contract reassoc]
+     [--revision HEAD~1] [--scenario nrel] [--steps 550] [--rounds 30]
 """
 from __future__ import annotations
 
 import argparse
 import importlib.util
-import shutil
+import subprocess
 import sys
 import tempfile
 import time
@@ -59,6 +61,7 @@ KERNELS = {"distribution": (bime, "compiled_warm_solve", "slewing_model.distribu
 ANSWERS = {"distribution": ((("ring displacements", 5), ("ring motions y", 6), ("contact loads", 10)), (0, 1, 3, 4)),
            "friction": ((("contact powers", 4), ("contact torques", 5)), (0, 1, 3))}
 FLAGS = ("contract", "reassoc", "arcp", "afn", "nsz")
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def record(kernel: str, name: str, steps: int) -> list:
@@ -79,17 +82,24 @@ def record(kernel: str, name: str, steps: int) -> list:
     return recorded
 
 
-def variant(kernel: str, flags: frozenset, folder: Path):
-    """``kernel``'s loop compiled from a copy of its module's source with ``FASTMATH = flags``."""
+def variant(kernel: str, flags: frozenset | None, revision: str | None, folder: Path):
+    """``kernel``'s loop compiled from a copy of its module's source (this checkout's, or ``revision``'s)
+    with ``FASTMATH = flags`` (None: the source's own)."""
     *_, module_name, function, signature = KERNELS[kernel]
     source = Path(importlib.util.find_spec(module_name).origin)
+    text = source.read_text()
+    if revision is not None:
+        path = source.relative_to(ROOT).as_posix()
+        text = subprocess.run(["git", "show", f"{revision}:{path}"], cwd=ROOT, check=True, capture_output=True,
+                              text=True).stdout
     copy = folder / source.name
-    shutil.copyfile(source, copy)
+    copy.write_text(text)
     spec = importlib.util.spec_from_file_location(module_name.rsplit(".", 1)[0] + "._flags_variant", copy)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    module.FASTMATH = flags
-    return module._compile(getattr(module, function), getattr(module, signature))
+    if flags is not None:
+        module.FASTMATH = flags
+    return module._compile(getattr(module, function), getattr(module, signature)), sorted(module.FASTMATH)
 
 
 def fresh(args: list) -> list:
@@ -125,7 +135,8 @@ def replay(calls: list, loops: dict, rounds: int) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--kernel", choices=sorted(KERNELS), default="distribution")
-    parser.add_argument("--flags", nargs="*", choices=FLAGS, default=[], help="the variant's FASTMATH (none: empty)")
+    parser.add_argument("--flags", nargs="*", choices=FLAGS, help="the variant's FASTMATH (none: --flags alone)")
+    parser.add_argument("--revision", help="the variant's kernel source from this git revision")
     parser.add_argument("--scenario", default="nrel")
     parser.add_argument("--steps", type=int, default=550)
     parser.add_argument("--rounds", type=int, default=30)
@@ -135,11 +146,13 @@ def main() -> None:
     owner, factory, module_name, *_ = KERNELS[args.kernel]
     library = getattr(owner, factory)()
     calls = record(args.kernel, args.scenario, args.steps)
-    flags = frozenset(args.flags)
+    if args.flags is None and args.revision is None:
+        raise SystemExit("give the variant's --flags, its --revision or both")
     own = sorted(importlib.import_module(module_name).FASTMATH)
     with tempfile.TemporaryDirectory() as folder:
-        loops = {f"library {own or '[]'}": library, f"variant {sorted(flags) or '[]'}": variant(args.kernel, flags,
-                                                                                                 Path(folder))}
+        loop, flags = variant(args.kernel, None if args.flags is None else frozenset(args.flags), args.revision,
+                              Path(folder))
+        loops = {f"library {own}": library, f"variant {args.revision or 'this source'} {flags}": loop}
         worst, same = {}, 0
         for call in calls:
             one, other = (loop(*fresh(call)) for loop in loops.values())
