@@ -79,17 +79,18 @@ class BlockCirculant:
 def product_operands(matrix: BlockCirculant) -> tuple:
     """What the compiled product ``M v`` (:func:`slewing_model.distribution.kernel._ring_times`) takes of a
     :class:`BlockCirculant`, always through its harmonics (compiled, that is faster than the dense
-    product from a few balls on): the tables ``cos``, ``sin`` (K, B) of ``2 pi j b / B`` for the
-    harmonics ``j < K = B // 2 + 1`` and their transposes (B, K), with ``j b`` taken modulo ``B``
-    (the tables then as exact as numpy's FFT's twiddles: 6e-16, not 1e-13 at 180 balls), and the
-    real and imaginary parts of its harmonics (K, m, m)."""
+    product from a few balls on): the tables ``cos``, ``sin`` (K, K) of ``2 pi j b / B`` for the
+    harmonics ``j < K = B // 2 + 1`` and the balls ``b < K`` (symmetric in ``j`` and ``b``; the DFT and its
+    inverse need no other balls), with ``j b`` taken modulo ``B`` (the tables then as exact as numpy's
+    FFT's twiddles: 6e-16, not 1e-13 at 180 balls), and the real and imaginary parts of its harmonics
+    (K, m, m)."""
     n_harmonics, n_balls = matrix.harmonics.shape[0], matrix.balls
-    turns = np.outer(np.arange(n_harmonics), np.arange(n_balls)) % n_balls      # j b mod B: angles below 2 pi
+    turns = np.outer(np.arange(n_harmonics), np.arange(n_harmonics)) % n_balls  # j b mod B: angles below 2 pi
     angle = 2.0 * np.pi * turns / n_balls
     cos_table, sin_table = np.cos(angle), np.sin(angle)
     sin_table[2 * turns == n_balls] = 0.0                # the angle pi exactly (the harmonic B/2)
-    return (cos_table, sin_table, np.ascontiguousarray(cos_table.T), np.ascontiguousarray(sin_table.T),
-            np.ascontiguousarray(matrix.harmonics.real), np.ascontiguousarray(matrix.harmonics.imag))
+    return (cos_table, sin_table, np.ascontiguousarray(matrix.harmonics.real),
+            np.ascontiguousarray(matrix.harmonics.imag))
 
 
 def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
