@@ -303,28 +303,36 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     return out, iterations, residual, converged
 
 
+def _contact_tractions(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, arm1, arm2):
+    """Dissipated power and torque on the moving ring of contact ``c`` (its rows of the points'
+    coefficients (C, I) and weights (K, C, I)) for its ball's unknowns ``(u0, u1, u2)``: the sums of
+    ``ContactPoints.tractions`` (:mod:`slewing_model.friction.ball_kinematics`), whose formulas they are,
+    summed here, not in arrays: the same order, no stores."""
+    contact_power = contact_torque = 0.0
+    for i in range(g10.shape[1]):
+        a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
+        a2, s2 = a * a, s_ * s_
+        alpha = beta = 0.0
+        for k in range(t2.shape[0]):
+            ws = weight[k, c, i] / math.sqrt(a2 + t2[k] * s2 + e2)
+            alpha += ws
+            beta += ws * t2[k]
+        ga, gs = alpha * a, beta * s_
+        contact_power += ga * a + gs * s_
+        contact_torque -= ga * arm1[c, i] + gs * arm2[c, i]   # the traction on the ring is minus that on the ball
+    return contact_power, contact_torque
+
+
 def _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, t2, eps2, arm1, arm2):
-    """Dissipated power (C,) and torque on the moving ring (C,) of every contact: the sums of
-    ``ContactPoints.tractions`` (:mod:`slewing_model.friction.ball_kinematics`), whose formulas they are."""
-    n_contacts, n_across = g10.shape
+    """Dissipated power (C,) and torque on the moving ring (C,) of every contact
+    (:func:`_contact_tractions`)."""
+    n_contacts = g10.shape[0]
     power = np.zeros(n_contacts)
     torque = np.zeros(n_contacts)
     for c in range(n_contacts):
         b = owner[c]
-        u0, u1, u2, e2 = u[b, 0], u[b, 1], u[b, 2], eps2[c]
-        contact_power = contact_torque = 0.0        # summed here, not in the arrays: the same order, no stores
-        for i in range(n_across):
-            a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
-            a2, s2 = a * a, s_ * s_
-            alpha = beta = 0.0
-            for k in range(t2.shape[0]):
-                ws = weight[k, c, i] / math.sqrt(a2 + t2[k] * s2 + e2)
-                alpha += ws
-                beta += ws * t2[k]
-            ga, gs = alpha * a, beta * s_
-            contact_power += ga * a + gs * s_
-            contact_torque -= ga * arm1[c, i] + gs * arm2[c, i]   # the traction on the ring is minus that on the ball
-        power[c], torque[c] = contact_power, contact_torque
+        power[c], torque[c] = _contact_tractions(c, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs, weight, t2,
+                                                 eps2[c], arm1, arm2)
     return power, torque
 
 
@@ -512,8 +520,8 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
 #: the helpers the friction's loops call
 _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
             "_contact_set", "_node_sines", "_largest_node", "_contact_points", "_point_coefficients", "_rule_weight",
-            "_minimise_balls", "_tractions", "_rule_tractions", "_ball_results", "_cold_start", "_diagonal_rolling",
-            "_sine_series")
+            "_minimise_balls", "_contact_tractions", "_tractions", "_rule_tractions", "_ball_results", "_cold_start",
+            "_diagonal_rolling", "_sine_series")
 
 
 #: numba's error model of these loops (Python's: a division by zero raises)
@@ -523,7 +531,7 @@ ERROR_MODEL = "python"
 #: the helpers numba inlines into their callers (its own inlining, before LLVM's choices). Measured on a pitch
 #: bearing's step, hot: the balls' equilibrium 360 -> 300 us (``_ball_evaluate``), an evaluation of every ball
 #: 197 -> 172 us (``_contact_sums``)
-_INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate", "_contact_points")
+_INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate", "_contact_points", "_contact_tractions")
 
 
 #: LLVM's fast-math flags of these loops: ``contract``, a product and the sum it enters as one fused
@@ -685,10 +693,6 @@ def _sine_series(x):
         1.0 / 362880.0 + x2 * (-1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (-1.0 / 1307674368000.0))))))))
 
 
-_COEFFICIENT_SIGNATURE = c_order("UniTuple(f8[:, :], 8)(f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], f8[:], b1[:], f8[:], "
-                                 "f8, f8)")
-
-
 def _node_sines(a_c, rd_c, u_nodes, largest_node, sin_t):
     """``sin t_i`` of a contact's points across the groove into ``sin_t`` (I,): ``t_i = a u_i / Rd``, the
     angle of node ``u_i`` (symmetric about 0) on the groove, for the semi-axis ``a_c`` and groove radius
@@ -767,38 +771,31 @@ def _point_coefficients(a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, len
 def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_nodes, length_scale, pitch_radius,
                     folded_weight, mu_load, t2, eps2):
     """:func:`_tractions` on a rule whose points' coefficients are used for nothing else (the torque's
-    rule where the balls are solved on another): each contact's points formed (:func:`_contact_points`)
-    where they are summed, in arrays of one contact's size, instead of the rule's arrays of every contact
-    (:func:`_point_coefficients`, :func:`_rule_weight`): the same numbers, with the rule's ten arrays
-    neither written nor read again."""
-    n_contacts, n_across = a.size, u_nodes.size
+    rule where the balls are solved on another): each contact's points formed (:func:`_contact_points`,
+    and :func:`_rule_weight`'s weights) where they are summed (:func:`_contact_tractions`), in arrays of
+    one contact's size instead of the rule's arrays of every contact (:func:`_point_coefficients`): the
+    same numbers, with the rule's ten arrays neither written nor read again."""
+    n_contacts, n_across, n_fold = a.size, u_nodes.size, t2.size
     power = np.zeros(n_contacts)
     torque = np.zeros(n_contacts)
     root = np.sqrt(1.0 - u_nodes ** 2)
     sin_t = np.empty(n_across)
-    g10, g12, h1, s0, s1, hs = np.empty(n_across), np.empty(n_across), np.empty(n_across), np.empty(n_across), \
-        np.empty(n_across), np.empty(n_across)
-    arm1, arm2 = np.empty(n_across), np.empty(n_across)
+    shape = (1, n_across)              # one contact's rows, each array its own
+    g10, g12, h1, s0, s1, hs = np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), \
+        np.empty(shape)
+    arm1, arm2 = np.empty(shape), np.empty(shape)
+    weight = np.empty((n_fold, 1, n_across))
     largest_node = _largest_node(u_nodes)
     for c in range(n_contacts):
         _node_sines(a[c], rd[c], u_nodes, largest_node, sin_t)
         _contact_points(sin_t, root, rb[c], rd[c], n_r[c], n_z[c], ring_speed[c], b[c], moving[c], length_scale,
-                        pitch_radius, g10, g12, h1, s0, s1, hs, arm1, arm2)
+                        pitch_radius, g10[0], g12[0], h1[0], s0[0], s1[0], hs[0], arm1[0], arm2[0])
+        for k in range(n_fold):
+            for i in range(n_across):
+                weight[k, 0, i] = folded_weight[k, i] * mu_load[c]
         ball = owner[c]
-        u0, u1, u2, e2, load = u[ball, 0], u[ball, 1], u[ball, 2], eps2[c], mu_load[c]
-        contact_power = contact_torque = 0.0
-        for i in range(n_across):
-            a_i, s_i = g10[i] * u0 + g12[i] * u1 + (h1[i] - u2), s0[i] * u0 + s1[i] * u1 + hs[i]     # _sliding
-            a2, s2 = a_i * a_i, s_i * s_i
-            alpha = beta = 0.0
-            for k in range(t2.shape[0]):
-                ws = folded_weight[k, i] * load / math.sqrt(a2 + t2[k] * s2 + e2)
-                alpha += ws
-                beta += ws * t2[k]
-            ga, gs = alpha * a_i, beta * s_i
-            contact_power += ga * a_i + gs * s_i
-            contact_torque -= ga * arm1[i] + gs * arm2[i]   # the traction on the ring is minus that on the ball
-        power[c], torque[c] = contact_power, contact_torque
+        power[c], torque[c] = _contact_tractions(0, u[ball, 0], u[ball, 1], u[ball, 2], g10, g12, h1, s0, s1, hs,
+                                                 weight, t2, eps2[c], arm1, arm2)
     return power, torque
 
 
