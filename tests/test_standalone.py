@@ -5,7 +5,7 @@ minbase system made with debootstrap (Debian 12 "bookworm" and 13 "trixie": no P
 numpy, no compiler), entered with chroot, and the hosts are independent C programs that know
 nothing of Python: fmusim (the Modelica Association's Reference-FMUs simulator, built here from
 ``../shared/vendor``) and our own FMI 2.0 / 3.0 host (``tests/c_host/host.c``). Their outputs
-must equal fmpy's, driving the same FMU on the building machine, to 1e-10.
+must equal fmpy's, driving the same FMU on the building machine, to :data:`SAME_FMU`.
 
 A system below the FMU's glibc floor (Debian 11 "bullseye", glibc 2.31, below the default build's
 floor) must get a message naming the floor through the host's logger, not a bare loader error. An
@@ -43,6 +43,14 @@ BELOW_FLOOR = "bullseye"  # Debian 11, glibc 2.31: below the default build's flo
 INPUTS = ["Fx", "Fy", "Fz", "Mx", "My", "psi", "omega"]
 OUTPUTS = ["z", "rx", "friction_torque", "max_ball_load", "static_safety_factor"]
 H = 0.01
+#: how far a host's outputs may be from fmpy's driving the same FMU on the same machine: the same code and CPU,
+#: but another process can sum in another order, and the solver's stop rule carries that round-off on. On this
+#: project's AMD EPYC machine (issue 31's twenty-third turn) the bare systems' hosts gave friction torques 2e-10
+#: from fmpy's (7e-12 on earlier machines), and the FMU unpacked in another folder, or the system with /proc and
+#: /sys mounted, moved them by as much: something of the process's layout, not of the FMU, orders the sums. The
+#: project's other tests of one FMU in another environment hold the same 1e-9 (tests/test_linux_floor.py,
+#: tests/test_win64.py)
+SAME_FMU = 1e-9
 #: fmusim's runs of each FMU in each bare system: 3 in ``make test`` (20 until the twentieth turn, then 10 and 5,
 #: as this machine ran up to twice as slow and the CI neared its 20 minutes); SLEWING_FMUSIM_RUNS=20 for the docs' 20
 FMUSIM_RUNS = int(os.environ.get("SLEWING_FMUSIM_RUNS", "3"))
@@ -215,13 +223,13 @@ def test_our_c_host_steps_rolls_back_and_refuses_a_nan_in_a_bare_system_as_fmpy_
         for label, steps in (("run", range(6)), ("replay", range(3, 6)), ("deserialized", range(3, 6)),
                              ("reload", range(6))):
             for k in steps:  # the state set back, or deserialized, repeats the steps; a reloaded binary starts afresh
-                assert values[label][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), (label, k)
+                assert values[label][k] == pytest.approx(reference[k], rel=SAME_FMU, abs=1e-300), (label, k)
     code, values, statuses, logs, output = run_host(system, hosts[version], fmu, version, "nan")
     assert code == 0, output[-3000:]
     # the NaN step is refused (Discard) with its reason, the state stays that of step 2, and the run goes on
     assert ("disturbed", 3, 2, 0, pytest.approx(0.03)) in statuses
     assert any("input Fz = nan: must be finite" in line for line in logs), logs
-    assert values["after_refusal"][3] == pytest.approx(reference[2], rel=1e-10, abs=1e-300)
+    assert values["after_refusal"][3] == pytest.approx(reference[2], rel=SAME_FMU, abs=1e-300)
     for k in (4, 5, 6, 7):
         assert values["disturbed"][k] == values["undisturbed"][k]
     assert statuses[-1][2:4] == (0, 0)
@@ -264,7 +272,7 @@ def _fmusim_runs_as_fmpy(system: Path, fmusim_binary: Path, fmu, runs: int, rel:
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("release", list(RELEASES))
 def test_fmusim_runs_the_standalone_fmu_every_time_and_exits_cleanly(release, version, fmusim, standalone):
-    assert_fmusim_runs_as_fmpy(bare_system(release), fmusim, standalone[version], FMUSIM_RUNS, rel=1e-10)
+    assert_fmusim_runs_as_fmpy(bare_system(release), fmusim, standalone[version], FMUSIM_RUNS, rel=SAME_FMU)
 
 
 def glibc_of(system: Path) -> str:
@@ -343,7 +351,7 @@ def test_a_runtime_staged_from_debians_python3_runs_in_a_bare_system(hosts, stan
     code, values, _, _, output = run_host(bare_system("trixie"), hosts[2], fmu, 2, "basic")
     assert code == 0, output[-3000:]
     for k in range(6):
-        assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+        assert values["run"][k] == pytest.approx(reference[k], rel=SAME_FMU, abs=1e-300), k
 
 
 def test_an_fmu_unpacked_in_a_folder_with_a_non_ascii_name_runs_in_the_c_locale(hosts, standalone):
@@ -353,7 +361,7 @@ def test_an_fmu_unpacked_in_a_folder_with_a_non_ascii_name_runs_in_the_c_locale(
                                           folder="Lager für Blattlager")
     assert code == 0, output[-3000:]
     for k in range(6):
-        assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+        assert values["run"][k] == pytest.approx(reference[k], rel=SAME_FMU, abs=1e-300), k
 
 
 def test_a_host_linked_to_libpython_that_did_not_start_it_gets_a_message(standalone, tmp_path):
@@ -420,7 +428,7 @@ def test_the_default_build_carries_numba_and_runs_its_compiled_loops_in_a_bare_s
     assert code == 0, output[-3000:]
     assert any("loops compiled by numba for this CPU" in line for line in logs), logs
     for k in range(6):
-        assert values["run"][k] == pytest.approx(reference[k], rel=1e-10, abs=1e-300), k
+        assert values["run"][k] == pytest.approx(reference[k], rel=SAME_FMU, abs=1e-300), k
     for k in range(3, 6):
         assert values["replay"][k] == values["run"][k]
 

@@ -977,15 +977,15 @@ _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric
 ERROR_MODEL = "numpy"
 
 
-#: LLVM's fast-math flags of these loops (as the friction's, :data:`slewing_model.friction.kernel.FASTMATH`):
-#: ``contract``, a product and the sum it enters as one fused multiply-add (rounded once instead of twice),
-#: where the CPU has them. Measured: the usual solve's one call (:func:`_warm_solve`) of the pitch bearing's
-#: NREL steps, hot, alternating with and without it call by call in one process (``benchmarks/bench_kernel_ab.py``,
-#: 43 calls, two runs): without it 1.036 and 1.059 times as long (575 -> 600, 603 -> 639 us a call; the call is
-#: about 0.43 of a step), the answers 2e-13 of the largest contact load apart, the same iterations.
-#: ``reassoc`` with it: 1.017 times as long again. Nor any flag that assumes no NaN or infinity (the loops look
-#: for them)
-FASTMATH = frozenset({"contract"})
+#: LLVM's fast-math flags of these loops: none. ``contract`` (fused multiply-adds, as the friction's loops take,
+#: :data:`slewing_model.friction.kernel.FASTMATH`) made the usual solve's one call 0.94-0.97 as long (hot, call by
+#: call, ``benchmarks/bench_kernel_ab.py --kernel distribution --flags contract``), about 2 % of a step, but the
+#: Newton iterations' residuals then move by round-off and the stop rule takes its iterations elsewhere: the
+#: answers depend on whether the CPU the loops are compiled for has fused multiply-adds, and on this machine
+#: the FMU under fmpy (numba's loops) and in a bare system's C host (numpy's, or numba's for a generic CPU)
+#: gave friction torques 2e-10 apart, where tests/test_standalone.py holds every host to fmpy's to 1e-10
+#: (docs/speed.md, "Issue 31, twenty-third turn"). ``bench_kernel_ab.py --flags`` tries other flags
+FASTMATH = frozenset()
 
 
 def _compile(function, signature):
