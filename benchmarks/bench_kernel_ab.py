@@ -143,11 +143,11 @@ def main() -> None:
     args = parser.parse_args()
     if aot_kernels() is not None:
         raise SystemExit("the loops compiled ahead of time are installed here: this compares numba's loops")
+    if args.flags is None and args.revision is None:
+        raise SystemExit("give the variant's --flags, its --revision or both")
     owner, factory, module_name, *_ = KERNELS[args.kernel]
     library = getattr(owner, factory)()
     calls = record(args.kernel, args.scenario, args.steps)
-    if args.flags is None and args.revision is None:
-        raise SystemExit("give the variant's --flags, its --revision or both")
     own = sorted(importlib.import_module(module_name).FASTMATH)
     with tempfile.TemporaryDirectory() as folder:
         loop, flags = variant(args.kernel, None if args.flags is None else frozenset(args.flags), args.revision,
@@ -159,8 +159,7 @@ def main() -> None:
             moved, agree = difference(args.kernel, other, one)
             worst = {name: max(value, worst.get(name, 0.0)) for name, value in moved.items()}
             same += agree
-        loops_list = list(loops.values())
-        for loop in loops_list:                  # warm both before timing
+        for loop in loops.values():              # warm both before timing
             for call in calls[:5]:
                 loop(*fresh(call))
         totals = replay(calls, loops, args.rounds)

@@ -980,10 +980,9 @@ ERROR_MODEL = "numpy"
 #: LLVM's fast-math flags of these loops: none. ``contract`` (fused multiply-adds, as the friction's loops take,
 #: :data:`slewing_model.friction.kernel.FASTMATH`) made the usual solve's one call 0.94-0.97 as long (hot, call by
 #: call, ``benchmarks/bench_kernel_ab.py --kernel distribution --flags contract``), about 2 % of a step, but the
-#: Newton iterations' residuals then move by round-off and the stop rule takes its iterations elsewhere: the
-#: answers depend on whether the CPU the loops are compiled for has fused multiply-adds, and on this machine
-#: the FMU under fmpy (numba's loops) and in a bare system's C host (numpy's, or numba's for a generic CPU)
-#: gave friction torques 2e-10 apart, where tests/test_standalone.py holds every host to fmpy's to 1e-10
+#: Newton iterations' residuals then move by round-off, and where one sits at the stop rule's tolerance the
+#: rounding decides an iteration: the answers would depend on whether the CPU the loops are compiled for has
+#: fused multiply-adds (numba's loops for this CPU against the generic ones, or numpy's), by more than round-off
 #: (docs/speed.md, "Issue 31, twenty-third turn"). ``bench_kernel_ab.py --flags`` tries other flags
 FASTMATH = frozenset()
 

@@ -354,15 +354,21 @@ _FRICTION_STEP_SIGNATURE = c_order(
 GENERAL_PATH = -1
 
 
+def _contact_weight(folded_weight, mu_load_c, weight, c):
+    """Row ``c`` of the points' weights ``weight`` (K, C, I): a rule's folded weights (K, I) times a
+    contact's ``mu Q``, as ``ContactPoints`` multiplies them."""
+    for k in range(folded_weight.shape[0]):
+        for i in range(folded_weight.shape[1]):
+            weight[k, c, i] = folded_weight[k, i] * mu_load_c
+
+
 def _rule_weight(folded_weight, mu_load):
     """The points' weights (K, C, I) of a rule's folded weights (K, I) for the contacts' ``mu Q``
-    (C,), as ``ContactPoints`` multiplies them."""
+    (C,) (:func:`_contact_weight`)."""
     n_fold, n_across = folded_weight.shape
     weight = np.empty((n_fold, mu_load.size, n_across))
-    for k in range(n_fold):
-        for c in range(mu_load.size):
-            for i in range(n_across):
-                weight[k, c, i] = folded_weight[k, i] * mu_load[c]
+    for c in range(mu_load.size):
+        _contact_weight(folded_weight, mu_load[c], weight, c)
     return weight
 
 
@@ -519,9 +525,9 @@ def _friction_step(load, angle, semi_a, semi_b, ball_radius, groove_radius, movi
 
 #: the helpers the friction's loops call
 _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evaluate", "_quadratic", "_damped_step",
-            "_contact_set", "_node_sines", "_largest_node", "_contact_points", "_point_coefficients", "_rule_weight",
-            "_minimise_balls", "_contact_tractions", "_tractions", "_rule_tractions", "_ball_results", "_cold_start",
-            "_diagonal_rolling", "_sine_series")
+            "_contact_set", "_node_sines", "_largest_node", "_contact_points", "_point_coefficients", "_contact_weight",
+            "_rule_weight", "_minimise_balls", "_contact_tractions", "_tractions", "_rule_tractions", "_ball_results",
+            "_cold_start", "_diagonal_rolling", "_sine_series")
 
 
 #: numba's error model of these loops (Python's: a division by zero raises)
@@ -531,7 +537,8 @@ ERROR_MODEL = "python"
 #: the helpers numba inlines into their callers (its own inlining, before LLVM's choices). Measured on a pitch
 #: bearing's step, hot: the balls' equilibrium 360 -> 300 us (``_ball_evaluate``), an evaluation of every ball
 #: 197 -> 172 us (``_contact_sums``)
-_INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate", "_contact_points", "_contact_tractions")
+_INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate", "_contact_points", "_contact_tractions",
+           "_contact_weight")
 
 
 #: LLVM's fast-math flags of these loops: ``contract``, a product and the sum it enters as one fused
@@ -775,7 +782,7 @@ def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_node
     and :func:`_rule_weight`'s weights) where they are summed (:func:`_contact_tractions`), in arrays of
     one contact's size instead of the rule's arrays of every contact (:func:`_point_coefficients`): the
     same numbers, with the rule's ten arrays neither written nor read again."""
-    n_contacts, n_across, n_fold = a.size, u_nodes.size, t2.size
+    n_contacts, n_across = a.size, u_nodes.size
     power = np.zeros(n_contacts)
     torque = np.zeros(n_contacts)
     root = np.sqrt(1.0 - u_nodes ** 2)
@@ -784,15 +791,13 @@ def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_node
     g10, g12, h1, s0, s1, hs = np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape), \
         np.empty(shape)
     arm1, arm2 = np.empty(shape), np.empty(shape)
-    weight = np.empty((n_fold, 1, n_across))
+    weight = np.empty((t2.size, 1, n_across))
     largest_node = _largest_node(u_nodes)
     for c in range(n_contacts):
         _node_sines(a[c], rd[c], u_nodes, largest_node, sin_t)
         _contact_points(sin_t, root, rb[c], rd[c], n_r[c], n_z[c], ring_speed[c], b[c], moving[c], length_scale,
                         pitch_radius, g10[0], g12[0], h1[0], s0[0], s1[0], hs[0], arm1[0], arm2[0])
-        for k in range(n_fold):
-            for i in range(n_across):
-                weight[k, 0, i] = folded_weight[k, i] * mu_load[c]
+        _contact_weight(folded_weight, mu_load[c], weight, 0)
         ball = owner[c]
         power[c], torque[c] = _contact_tractions(0, u[ball, 0], u[ball, 1], u[ball, 2], g10, g12, h1, s0, s1, hs,
                                                  weight, t2, eps2[c], arm1, arm2)
