@@ -475,18 +475,21 @@ def _schur_inverse(jacobian, coupling, mu):
 
 def _segment(x, xp, guess):
     """The ``j`` with ``xp[j] <= x < xp[j + 1]`` for ``xp[0] <= x < xp[-1]`` (``guess`` first, then
-    by bisection, as ``np.interp`` searches)."""
+    by bisection; one segment fits, so it is the one ``np.interp`` finds).
+
+    The bisection halves the range ``[base, base + size)`` that holds ``j`` by moving its start or not:
+    a choice LLVM makes without a branch, where ``lo, hi`` moved by an ``if`` mispredicted about half of
+    its 13 steps in the 6001-row Hertz table (the contacts' results 114 -> 101 us hot, pitch bearing;
+    docs/speed.md, "Issue 31, twenty-fourth turn")."""
     last = xp.size - 1
     if 0 <= guess < last and xp[guess] <= x < xp[guess + 1]:
         return guess
-    lo, hi = 0, last
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if xp[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    base, size = 0, last
+    while size > 1:
+        half = size // 2
+        base = base + half if xp[base + half] <= x else base
+        size -= half
+    return base
 
 
 def _interp(x, xp, fp, left, right, guess):
@@ -629,7 +632,12 @@ def _ring_times(cos_table, sin_table, harmonic_real, harmonic_imag, v):
     the pitch bearing's 150 balls where the tables of every ball and their transposes were 365 kB,
     read at every product after the kept inverse's 540 kB have pushed them out of the cache. Differs
     from the FFT (and the dense product) by round-off; faster than the dense product from a few balls
-    on (67 balls: 4.6 against 7.6 us)."""
+    on (67 balls: 4.6 against 7.6 us).
+
+    Both sums take four balls (four harmonics) a pass over a row of ``V`` (of the result): each entry
+    read and written once for four terms, added one after the other in the order of a pass per ball,
+    so the same numbers as that, bit for bit, in 25 instead of 32 us (pitch bearing, hot; docs/speed.md,
+    "Issue 31, twenty-fourth turn")."""
     n_harmonics = cos_table.shape[0]
     m = harmonic_real.shape[1]
     n_balls = v.size // m
@@ -642,14 +650,35 @@ def _ring_times(cos_table, sin_table, harmonic_real, harmonic_imag, v):
             value = v[b * m + a]
             for j in range(n_harmonics):
                 v_real[a, j] += cos_table[b, j] * value
-    for b in range(1, pairs + 1):                  # V_j, the two balls' blocks added to every harmonic
-        for a in range(m):
-            both, apart = v[b * m + a] + v[(n_balls - b) * m + a], v[b * m + a] - v[(n_balls - b) * m + a]
-            if both == 0.0 and apart == 0.0:       # (the rows off the reduced operator's)
-                continue
+    ball = np.empty(pairs, np.int64)
+    both = np.empty(pairs)
+    apart = np.empty(pairs)
+    for a in range(m):                             # V_j, the two balls' blocks added to every harmonic
+        count = 0
+        for b in range(1, pairs + 1):
+            plus, minus = v[b * m + a] + v[(n_balls - b) * m + a], v[b * m + a] - v[(n_balls - b) * m + a]
+            if plus != 0.0 or minus != 0.0:        # (not the rows off the reduced operator's)
+                ball[count], both[count], apart[count] = b, plus, minus
+                count += 1
+        k = 0
+        while k + 4 <= count:
+            b0, b1, b2, b3 = ball[k], ball[k + 1], ball[k + 2], ball[k + 3]
+            s0, s1, s2, s3 = both[k], both[k + 1], both[k + 2], both[k + 3]
+            d0, d1, d2, d3 = apart[k], apart[k + 1], apart[k + 2], apart[k + 3]
             for j in range(n_harmonics):
-                v_real[a, j] += cos_table[b, j] * both
-                v_imag[a, j] -= sin_table[b, j] * apart
+                real = v_real[a, j] + cos_table[b0, j] * s0
+                real += cos_table[b1, j] * s1
+                real += cos_table[b2, j] * s2
+                v_real[a, j] = real + cos_table[b3, j] * s3
+                imag = v_imag[a, j] - sin_table[b0, j] * d0
+                imag -= sin_table[b1, j] * d1
+                imag -= sin_table[b2, j] * d2
+                v_imag[a, j] = imag - sin_table[b3, j] * d3
+            k += 4
+        for k in range(k, count):
+            for j in range(n_harmonics):
+                v_real[a, j] += cos_table[ball[k], j] * both[k]
+                v_imag[a, j] -= sin_table[ball[k], j] * apart[k]
     p_real = np.empty((m, n_harmonics))
     p_imag = np.empty((m, n_harmonics))
     for j in range(n_harmonics):                   # R_j; the inverse's weights (numpy's irfft: the
@@ -666,11 +695,24 @@ def _ring_times(cos_table, sin_table, harmonic_real, harmonic_imag, v):
     cos_part = np.zeros((m, half))
     sin_part = np.zeros((m, half))
     for a in range(m):                             # the inverse DFT, each harmonic added to half the balls
-        for j in range(n_harmonics):
-            real, imag = p_real[a, j], p_imag[a, j]
+        j = 0
+        while j + 4 <= n_harmonics:
+            r0, r1, r2, r3 = p_real[a, j], p_real[a, j + 1], p_real[a, j + 2], p_real[a, j + 3]
+            i0, i1, i2, i3 = p_imag[a, j], p_imag[a, j + 1], p_imag[a, j + 2], p_imag[a, j + 3]
             for b in range(half):
-                cos_part[a, b] += real * cos_table[j, b]
-                sin_part[a, b] += imag * sin_table[j, b]
+                real = cos_part[a, b] + r0 * cos_table[j, b]
+                real += r1 * cos_table[j + 1, b]
+                real += r2 * cos_table[j + 2, b]
+                cos_part[a, b] = real + r3 * cos_table[j + 3, b]
+                imag = sin_part[a, b] + i0 * sin_table[j, b]
+                imag += i1 * sin_table[j + 1, b]
+                imag += i2 * sin_table[j + 2, b]
+                sin_part[a, b] = imag + i3 * sin_table[j + 3, b]
+            j += 4
+        for j in range(j, n_harmonics):
+            for b in range(half):
+                cos_part[a, b] += p_real[a, j] * cos_table[j, b]
+                sin_part[a, b] += p_imag[a, j] * sin_table[j, b]
     out = np.empty(v.size)
     for b in range(half):                          # ball b: cos - sin; ball B - b: cos + sin
         for a in range(m):
