@@ -47,13 +47,17 @@ def _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs):
 
 
 def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, derivatives, majorant,
-                  gradient, hessian, extra):
+                  gradient, hessian, extra, points):
     """Power of contact ``c`` at the ball unknowns ``(u0, u1, u2)``, returned; with
     ``derivatives`` its gradient (3,) and the upper triangle of its Hessian (3, 3) added to
     ``gradient`` and ``hessian``, with ``majorant`` that of ``M - H`` to ``extra``.
-    The formulas are those of ``ContactPoints.evaluate`` (:mod:`slewing_model.friction.ball_kinematics`)."""
+    The formulas are those of ``ContactPoints.evaluate`` (:mod:`slewing_model.friction.ball_kinematics`).
+
+    First each point across the ellipse on its own (its sliding ``A``, ``S`` and sums along it, into
+    ``points`` (8, I), the caller's): a loop whose square roots and divisions run four points at a
+    time; then the points' terms summed into the ball's, in the order of one loop over the points, so
+    the same numbers bit for bit as that loop (docs/speed.md, "Issue 31, twenty-fourth turn")."""
     n_across, n_along = g10.shape[1], t2.shape[0]
-    power = 0.0
     for i in range(n_across):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
         a2, s2 = a * a, s_ * s_
@@ -72,9 +76,16 @@ def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, deriv
                 m0 += ws3
                 m1 += ws3 * t2[k]
                 m2 += ws3 * t2[k] * t2[k]
-        power += total
+        points[0, i], points[1, i], points[2, i] = a, s_, total
+        points[3, i], points[4, i], points[5, i], points[6, i], points[7, i] = alpha, beta, m0, m1, m2
+    power = 0.0
+    for i in range(n_across):
+        power += points[2, i]
         if not derivatives:
             continue
+        a, s_, alpha, beta = points[0, i], points[1, i], points[3, i], points[4, i]
+        a2, s2 = a * a, s_ * s_
+        m0, m1, m2 = points[5, i], points[6, i], points[7, i]
         ga_0, ga_1 = g10[c, i], g12[c, i]           # GA = (g10, g12, -1), GS = (s0, s1, 0)
         gs_0, gs_1 = s0[c, i], s1[c, i]
         grad_a, grad_s = alpha * a, beta * s_       # dD/dA, dD/dS
@@ -119,10 +130,11 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
     gradient = np.zeros((n_balls, 3))
     hessian = np.zeros((n_balls, 3, 3))
     extra = np.zeros((n_balls, 3, 3))
+    points = np.empty((8, g10.shape[1]))
     for c in range(g10.shape[0]):
         b = owner[c]
         power[b] += _contact_sums(c, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs, weight, t2, eps2[c],
-                                  derivatives, majorant, gradient[b], hessian[b], extra[b])
+                                  derivatives, majorant, gradient[b], hessian[b], extra[b], points)
     for b in range(n_balls):                            # the lower triangles
         _symmetrise(hessian[b])
         _symmetrise(extra[b])
@@ -172,7 +184,7 @@ def _solve3(a, rhs, out, m):
 
 
 def _ball_evaluate(u, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, derivatives, majorant,
-                   gradient, hessian, extra):
+                   gradient, hessian, extra, points):
     """Power of one ball (its contacts ``c_first .. c_last - 1``), its gradient, Hessian and
     ``M - H`` written into the given arrays (as :func:`_evaluate_points` for one ball)."""
     gradient[:] = 0.0
@@ -181,7 +193,7 @@ def _ball_evaluate(u, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps
     power = 0.0
     for c in range(c_first, c_last):
         power += _contact_sums(c, u[0], u[1], u[2], g10, g12, h1, s0, s1, hs, weight, t2, eps2[c],
-                               derivatives, majorant, gradient, hessian, extra)
+                               derivatives, majorant, gradient, hessian, extra, points)
     _symmetrise(hessian)
     _symmetrise(extra)
     return power
@@ -198,13 +210,14 @@ def _quadratic(g, h, du):
 
 
 def _damped_step(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta, has_extra, f, g, h, extra,
-                 minus_g, damped, du, work):
+                 minus_g, damped, du, work, points):
     """The damped step ``du = -(H + theta (M - H))^-1 g`` of one ball at ``x`` into ``du``,
-    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra`` (``damped``
-    and ``work`` the caller's scratch arrays); returns the power at ``x``, the slope ``g . du`` and
+    after evaluating ``M - H`` there (into ``g``, ``h``, ``extra``) unless ``has_extra`` (``damped``,
+    ``work`` and ``points`` the caller's scratch arrays); returns the power at ``x``, the slope ``g . du`` and
     the decrease the quadratic model predicts, ``-(g . du + du . H du / 2)``."""
     if not has_extra:
-        f = _ball_evaluate(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, extra)
+        f = _ball_evaluate(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, True, g, h, extra,
+                           points)
     damped[:, :] = h + theta * extra
     _solve3(damped, minus_g, du, work)
     slope, curvature = _quadratic(g, h, du)
@@ -231,6 +244,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     g_t, h_t, e_t = np.empty(3), np.empty((3, 3)), np.empty((3, 3))    # at the trial point
     newton, du, trial, minus_g = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     damped, work = np.empty((3, 3)), np.empty((3, 4))
+    points = np.empty((8, g10.shape[1]))                              # a contact's points (_contact_sums)
     # every ball's power, gradient and Hessian at its start: they give the floor (the mean power) and
     # start each ball's loop, one evaluation a ball (the power is summed as without derivatives)
     start_f = np.empty(n_balls)
@@ -238,7 +252,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     total = 0.0
     for b in range(n_balls):
         start_f[b] = _ball_evaluate(out[b], first[b], first[b + 1], g10, g12, h1, s0, s1, hs, weight, t2, eps2,
-                                    True, False, start_g[b], start_h[b], e)
+                                    True, False, start_g[b], start_h[b], e, points)
         total += start_f[b]
     if floor < 0.0:
         floor = total / max(n_balls, 1)
@@ -258,7 +272,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
             if decrement <= tol * (f + floor):           # converged: the last Newton step where it lowers D
                 trial[:] = x + newton
                 if _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False,
-                                  g_t, h_t, e_t) <= f * (1.0 + 1e-12):
+                                  g_t, h_t, e_t, points) <= f * (1.0 + 1e-12):
                     x[:] = trial
                 count += 1
                 converged[b] = True
@@ -268,7 +282,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
             count += 1
             if theta > 0.0:
                 f, slope, predicted = _damped_step(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta,
-                                                   has_extra, f, g, h, e, minus_g, damped, du, work)
+                                                   has_extra, f, g, h, e, minus_g, damped, du, work, points)
                 has_extra = True
             else:
                 du[:] = newton
@@ -278,7 +292,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
             for _attempt in range(12):
                 with_extra = theta > 0.0
                 f_t = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, with_extra,
-                                     g_t, h_t, e_t)
+                                     g_t, h_t, e_t, points)
                 actual = f - f_t
                 good = actual >= -1e-4 * slope or abs(actual) <= 1e-13 * abs(f)
                 if good:
@@ -289,7 +303,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
                     break
                 theta = min(1.0, max(theta_up * theta, theta_min_up))
                 f, slope, predicted = _damped_step(x, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, theta,
-                                                   has_extra, f, g, h, e, minus_g, damped, du, work)
+                                                   has_extra, f, g, h, e, minus_g, damped, du, work, points)
                 has_extra = True
                 trial[:] = x + du
             if good:                                      # else no step lowered its power: the ball stays
@@ -307,7 +321,8 @@ def _contact_tractions(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, 
     """Dissipated power and torque on the moving ring of contact ``c`` (its rows of the points'
     coefficients (C, I) and weights (K, C, I)) for its ball's unknowns ``(u0, u1, u2)``: the sums of
     ``ContactPoints.tractions`` (:mod:`slewing_model.friction.ball_kinematics`), whose formulas they are,
-    summed here, not in arrays: the same order, no stores."""
+    summed here, not in arrays: the same order, no stores. (Its points first, then their sums, as
+    :func:`_contact_sums` does, measured no faster: docs/speed.md, "Issue 31, twenty-fourth turn".)"""
     contact_power = contact_torque = 0.0
     for i in range(g10.shape[1]):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
@@ -404,7 +419,7 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
     big_r, ls = pitch_radius, length_scale
     g, h, e = np.empty(3), np.empty((3, 3)), np.empty((3, 3))
     best, other, du, minus_g, trial = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    work = np.empty((3, 4))
+    work, points = np.empty((3, 4)), np.empty((8, g10.shape[1]))
     for row in range(active.size):
         if not cold[row]:
             continue
@@ -419,16 +434,18 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
             w_z = (w_i * (big_r + r_i) - w_o * (big_r + r_o)) / (r_i - r_o)
             w_c = (w_o * (big_r + r_o) - r_o * w_z) / big_r
             other[0], other[1], other[2] = 0.0, w_z * ls, w_c * big_r
-            if _ball_evaluate(other, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e) < \
-                    _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e):
+            if _ball_evaluate(other, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e,
+                              points) < _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2,
+                                                       False, False, g, h, e, points):
                 best[:] = other
-        f = _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, False, g, h, e)
+        f = _ball_evaluate(best, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, True, False, g, h, e, points)
         minus_g[:] = -g
         _solve3(h, minus_g, du, work)
         length, lowest = 0.0, f
         for t in COLD_STEPS:
             trial[:] = best + t * du
-            power = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e)
+            power = _ball_evaluate(trial, c0, c1, g10, g12, h1, s0, s1, hs, weight, t2, eps2, False, False, g, h, e,
+                                   points)
             if power < lowest:
                 length, lowest = t, power
         u[row] = best + length * du
@@ -530,8 +547,11 @@ _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evalua
             "_cold_start", "_diagonal_rolling", "_sine_series")
 
 
-#: numba's error model of these loops (Python's: a division by zero raises)
-ERROR_MODEL = "python"
+#: numba's error model of these loops: numpy's, a division by zero gives inf or NaN (the divisors are lengths,
+#: speeds and pivots that the inputs' checks and the regularisation keep from zero). Python's checks each
+#: division and raises: that branch kept LLVM from running a contact's points four at a time
+#: (:func:`_contact_sums`; docs/speed.md, "Issue 31, twenty-fourth turn")
+ERROR_MODEL = "numpy"
 
 
 #: the helpers numba inlines into their callers (its own inlining, before LLVM's choices). Measured on a pitch
