@@ -65,7 +65,12 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
     ``f`` and unit vectors ``n`` (B, 2, 2), the lengths ``|e|``, the gradient (5,), the mismatch
     (4B,), the loaded diagonals (2B,; ``delta > loaded_from``) and ``(springs' energy, rings'
     energy, work, largest force, largest residual, loaded diagonals)``, the largest force over
-    ``q`` and ``|y|``, the largest residual over the gradient and mismatch."""
+    ``q`` and ``|y|``, the largest residual over the gradient and mismatch.
+
+    Three passes over the springs: ``e``; then each spring's length, direction and force; then the
+    sums, in the order of one pass (so the same numbers bit for bit), the gradient's five in locals.
+    Apart, the first two carry no chain of sums, whose latency held the one pass: 33 -> 26 us (pitch
+    bearing, hot; docs/speed.md, "Issue 31, twenty-fourth turn")."""
     n_balls = separation.shape[0]
     qs_t = qs + t * dq
     y_t = y + t * dy
@@ -79,37 +84,55 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
     gradient = -f_scaled
     mismatch = np.empty(y.size)
     loaded = np.empty(2 * n_balls, np.bool_)
-    n_loaded = 0
-    energy = ring = 0.0
-    peak_force = peak_residual = 0.0
-    for b in range(n_balls):
+    x0, x1, x2, x3, x4 = qs_t[0], qs_t[1], qs_t[2], qs_t[3], qs_t[4]
+    for b in range(n_balls):                        # e = separation + J qs - M y
         for d in range(2):
             row = 4 * b + 2 * d
             for c in range(2):
                 motion = 0.0
-                for k in range(5):
-                    motion += jacobian_rows[row + c, k] * qs_t[k]
+                motion += jacobian_rows[row + c, 0] * x0
+                motion += jacobian_rows[row + c, 1] * x1
+                motion += jacobian_rows[row + c, 2] * x2
+                motion += jacobian_rows[row + c, 3] * x3
+                motion += jacobian_rows[row + c, 4] * x4
                 e[b, d, c] = separation[b, d, c] + motion - motion_t[row + c]
-            size = math.sqrt(e[b, d, 0] ** 2 + e[b, d, 1] ** 2)
+    for b in range(n_balls):                        # |e|, n, delta (eq 7), q (eq 8), f = q n
+        for d in range(2):
+            e_r, e_z = e[b, d, 0], e[b, d, 1]
+            size = math.sqrt(e_r ** 2 + e_z ** 2)
             length[b, d] = size
-            n[b, d, 0] = e[b, d, 0] / size
-            n[b, d, 1] = e[b, d, 1] / size
+            n_r, n_z = e_r / size, e_z / size
+            n[b, d, 0] = n_r
+            n[b, d, 1] = n_z
             delta[b, d] = size - natural_length[b, d]
+            closed = max(delta[b, d], 0.0)
+            q[b, d] = stiffness[b, d] * (closed * math.sqrt(closed))
+            force[b, d, 0] = q[b, d] * n_r
+            force[b, d, 1] = q[b, d] * n_z
+    g0, g1, g2, g3, g4 = gradient[0], gradient[1], gradient[2], gradient[3], gradient[4]
+    n_loaded = 0
+    energy = ring = 0.0
+    peak_force = peak_residual = 0.0
+    for b in range(n_balls):                        # the sums
+        for d in range(2):
+            row = 4 * b + 2 * d
             loaded[2 * b + d] = delta[b, d] > loaded_from
             n_loaded += loaded[2 * b + d]
             closed = max(delta[b, d], 0.0)
-            q[b, d] = stiffness[b, d] * (closed * math.sqrt(closed))
             energy += q[b, d] * closed
             peak_force = max(peak_force, q[b, d])
             for c in range(2):
-                f = q[b, d] * n[b, d, c]
-                force[b, d, c] = f
-                for k in range(5):
-                    gradient[k] += jacobian_rows[row + c, k] * f
+                f = force[b, d, c]
+                g0 += jacobian_rows[row + c, 0] * f
+                g1 += jacobian_rows[row + c, 1] * f
+                g2 += jacobian_rows[row + c, 2] * f
+                g3 += jacobian_rows[row + c, 3] * f
+                g4 += jacobian_rows[row + c, 4] * f
                 mismatch[row + c] = f - y_t[row + c]
                 ring += y_t[row + c] * motion_t[row + c]
                 peak_force = max(peak_force, abs(y_t[row + c]))
                 peak_residual = max(peak_residual, abs(mismatch[row + c]))
+    gradient[0], gradient[1], gradient[2], gradient[3], gradient[4] = g0, g1, g2, g3, g4
     work = 0.0
     for k in range(5):
         work += f_scaled[k] * qs_t[k]
