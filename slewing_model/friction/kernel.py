@@ -317,22 +317,32 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     return out, iterations, residual, converged
 
 
-def _contact_tractions(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, arm1, arm2):
+def _contact_tractions(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, arm1, arm2, points):
     """Dissipated power and torque on the moving ring of contact ``c`` (its rows of the points'
     coefficients (C, I) and weights (K, C, I)) for its ball's unknowns ``(u0, u1, u2)``: the sums of
     ``ContactPoints.tractions`` (:mod:`slewing_model.friction.ball_kinematics`), whose formulas they are,
-    summed here, not in arrays: the same order, no stores. (Its points first, then their sums, as
-    :func:`_contact_sums` does, measured no faster: docs/speed.md, "Issue 31, twenty-fourth turn".)"""
-    contact_power = contact_torque = 0.0
-    for i in range(g10.shape[1]):
+    in the same order, so the same numbers bit for bit.
+
+    The points' sums along the ellipse are formed for all points across at once (into ``points`` (8, I),
+    the caller's scratch: ``A``, ``S``, ``A^2``, ``S^2``, ``sum w / s``, ``sum w t^2 / s``), each row of
+    the rule along (``t2``) a pass over the points across: a loop without a chain of sums, whose square
+    roots and divisions run four points at a time (the torque's rule of a pitch bearing's step, hot,
+    155 -> 123 us; docs/speed.md, "Issue 31, twenty-fourth turn")."""
+    n_across = g10.shape[1]
+    for i in range(n_across):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
-        a2, s2 = a * a, s_ * s_
-        alpha = beta = 0.0
-        for k in range(t2.shape[0]):
-            ws = weight[k, c, i] / math.sqrt(a2 + t2[k] * s2 + e2)
-            alpha += ws
-            beta += ws * t2[k]
-        ga, gs = alpha * a, beta * s_
+        points[0, i], points[1, i], points[2, i], points[3, i] = a, s_, a * a, s_ * s_
+        points[4, i] = points[5, i] = 0.0
+    for k in range(t2.shape[0]):
+        t2_k = t2[k]
+        for i in range(n_across):
+            ws = weight[k, c, i] / math.sqrt(points[2, i] + t2_k * points[3, i] + e2)
+            points[4, i] += ws
+            points[5, i] += ws * t2_k
+    contact_power = contact_torque = 0.0
+    for i in range(n_across):
+        a, s_ = points[0, i], points[1, i]
+        ga, gs = points[4, i] * a, points[5, i] * s_
         contact_power += ga * a + gs * s_
         contact_torque -= ga * arm1[c, i] + gs * arm2[c, i]   # the traction on the ring is minus that on the ball
     return contact_power, contact_torque
@@ -344,10 +354,11 @@ def _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, t2, eps2, arm1, arm2)
     n_contacts = g10.shape[0]
     power = np.zeros(n_contacts)
     torque = np.zeros(n_contacts)
+    points = np.empty((8, g10.shape[1]))
     for c in range(n_contacts):
         b = owner[c]
         power[c], torque[c] = _contact_tractions(c, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs, weight, t2,
-                                                 eps2[c], arm1, arm2)
+                                                 eps2[c], arm1, arm2, points)
     return power, torque
 
 
@@ -812,6 +823,7 @@ def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_node
         np.empty(shape)
     arm1, arm2 = np.empty(shape), np.empty(shape)
     weight = np.empty((t2.size, 1, n_across))
+    points = np.empty((8, n_across))
     largest_node = _largest_node(u_nodes)
     for c in range(n_contacts):
         _node_sines(a[c], rd[c], u_nodes, largest_node, sin_t)
@@ -820,7 +832,7 @@ def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_node
         _contact_weight(folded_weight, mu_load[c], weight, 0)
         ball = owner[c]
         power[c], torque[c] = _contact_tractions(0, u[ball, 0], u[ball, 1], u[ball, 2], g10, g12, h1, s0, s1, hs,
-                                                 weight, t2, eps2[c], arm1, arm2)
+                                                 weight, t2, eps2[c], arm1, arm2, points)
     return power, torque
 
 
