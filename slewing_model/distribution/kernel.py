@@ -659,7 +659,7 @@ def _ring_times(cos_table, sin_table, harmonic_real, harmonic_imag, v):
 
     Both sums take four balls (four harmonics) a pass over a row of ``V`` (of the result): each entry
     read and written once for four terms, added one after the other in the order of a pass per ball,
-    so the same numbers as that, bit for bit, in 25 instead of 32 us (pitch bearing, hot; docs/speed.md,
+    so the same numbers as that, bit for bit, in 26 instead of 32 us (pitch bearing, hot; docs/speed.md,
     "Issue 31, twenty-fourth turn")."""
     n_harmonics = cos_table.shape[0]
     m = harmonic_real.shape[1]
