@@ -40,6 +40,11 @@ _SIGNATURE = c_order("Tuple((f8[:], f8[:, :], f8[:, :, :], f8[:, :, :]))("
                      "f8[:], f8[:], b1, b1)")
 
 
+#: the rows of the scratch array a contact's points are summed through (``points``, (POINT_ROWS, I)):
+#: :func:`_contact_sums` keeps eight per point, :func:`_contact_tractions` six
+POINT_ROWS = 8
+
+
 def _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs):
     """``A`` and ``S`` of point ``(c, i)`` for the ball unknowns ``(u0, u1, u2)``
     (``ContactPoints.velocity``)."""
@@ -54,9 +59,11 @@ def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, deriv
     The formulas are those of ``ContactPoints.evaluate`` (:mod:`slewing_model.friction.ball_kinematics`).
 
     First each point across the ellipse on its own (its sliding ``A``, ``S`` and sums along it, into
-    ``points`` (8, I), the caller's): a loop whose square roots and divisions run four points at a
-    time; then the points' terms summed into the ball's, in the order of one loop over the points, so
-    the same numbers bit for bit as that loop (docs/speed.md, "Issue 31, twenty-fourth turn")."""
+    ``points`` (:data:`POINT_ROWS`, I), the caller's): a loop with no chain of the ball's sums through it,
+    so that the points' square roots and divisions overlap (scalar ones: the loop along the ellipse inside
+    it keeps LLVM from making vector operations of it); then the points' terms summed into the ball's, in
+    the order of one loop over the points, so the same numbers bit for bit as that loop (docs/speed.md,
+    "Issue 31, twenty-fourth turn")."""
     n_across, n_along = g10.shape[1], t2.shape[0]
     for i in range(n_across):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
@@ -130,7 +137,7 @@ def _evaluate_points(u, owner, n_balls, g10, g12, h1, s0, s1, hs, weight, t2, ep
     gradient = np.zeros((n_balls, 3))
     hessian = np.zeros((n_balls, 3, 3))
     extra = np.zeros((n_balls, 3, 3))
-    points = np.empty((8, g10.shape[1]))
+    points = np.empty((POINT_ROWS, g10.shape[1]))
     for c in range(g10.shape[0]):
         b = owner[c]
         power[b] += _contact_sums(c, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs, weight, t2, eps2[c],
@@ -244,7 +251,7 @@ def _minimise_balls(u, first, g10, g12, h1, s0, s1, hs, weight, t2, eps2, force_
     g_t, h_t, e_t = np.empty(3), np.empty((3, 3)), np.empty((3, 3))    # at the trial point
     newton, du, trial, minus_g = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     damped, work = np.empty((3, 3)), np.empty((3, 4))
-    points = np.empty((8, g10.shape[1]))                              # a contact's points (_contact_sums)
+    points = np.empty((POINT_ROWS, g10.shape[1]))                     # a contact's points (_contact_sums)
     # every ball's power, gradient and Hessian at its start: they give the floor (the mean power) and
     # start each ball's loop, one evaluation a ball (the power is summed as without derivatives)
     start_f = np.empty(n_balls)
@@ -323,11 +330,12 @@ def _contact_tractions(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, 
     ``ContactPoints.tractions`` (:mod:`slewing_model.friction.ball_kinematics`), whose formulas they are,
     in the same order, so the same numbers bit for bit.
 
-    The points' sums along the ellipse are formed for all points across at once (into ``points`` (8, I),
-    the caller's scratch: ``A``, ``S``, ``A^2``, ``S^2``, ``sum w / s``, ``sum w t^2 / s``), each row of
-    the rule along (``t2``) a pass over the points across: a loop without a chain of sums, whose square
-    roots and divisions run four points at a time (the torque's rule of a pitch bearing's step, hot,
-    155 -> 123 us; docs/speed.md, "Issue 31, twenty-fourth turn")."""
+    The points' sums along the ellipse are formed for all points across at once (into ``points``
+    (:data:`POINT_ROWS`, I), the caller's scratch: ``A``, ``S``, ``A^2``, ``S^2``, ``sum w / s``,
+    ``sum w t^2 / s``), each row of the rule along (``t2``) a pass over the points across: a loop without
+    a chain of sums, whose square roots and divisions run four points at a time (vector operations,
+    checked in the compiled code; the torque's rule of a pitch bearing's step, hot, 155 -> 123 us;
+    docs/speed.md, "Issue 31, twenty-fourth turn")."""
     n_across = g10.shape[1]
     for i in range(n_across):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
@@ -354,7 +362,7 @@ def _tractions(u, owner, g10, g12, h1, s0, s1, hs, weight, t2, eps2, arm1, arm2)
     n_contacts = g10.shape[0]
     power = np.zeros(n_contacts)
     torque = np.zeros(n_contacts)
-    points = np.empty((8, g10.shape[1]))
+    points = np.empty((POINT_ROWS, g10.shape[1]))
     for c in range(n_contacts):
         b = owner[c]
         power[c], torque[c] = _contact_tractions(c, u[b, 0], u[b, 1], u[b, 2], g10, g12, h1, s0, s1, hs, weight, t2,
@@ -430,7 +438,7 @@ def _cold_start(u, cold, active, first, load, angle, ball_radius, inner_moves, s
     big_r, ls = pitch_radius, length_scale
     g, h, e = np.empty(3), np.empty((3, 3)), np.empty((3, 3))
     best, other, du, minus_g, trial = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    work, points = np.empty((3, 4)), np.empty((8, g10.shape[1]))
+    work, points = np.empty((3, 4)), np.empty((POINT_ROWS, g10.shape[1]))
     for row in range(active.size):
         if not cold[row]:
             continue
@@ -560,8 +568,9 @@ _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evalua
 
 #: numba's error model of these loops: numpy's, a division by zero gives inf or NaN (the divisors are lengths,
 #: speeds and pivots that the inputs' checks and the regularisation keep from zero). Python's checks each
-#: division and raises: that branch kept LLVM from running a contact's points four at a time
-#: (:func:`_contact_sums`; docs/speed.md, "Issue 31, twenty-fourth turn")
+#: division and raises: a branch at every point of :func:`_contact_sums` and :func:`_contact_tractions`, which
+#: kept their divisions from overlapping and the tractions' from becoming vector operations (docs/speed.md,
+#: "Issue 31, twenty-fourth turn")
 ERROR_MODEL = "numpy"
 
 
@@ -823,7 +832,7 @@ def _rule_tractions(u, owner, a, b, rb, rd, n_r, n_z, ring_speed, moving, u_node
         np.empty(shape)
     arm1, arm2 = np.empty(shape), np.empty(shape)
     weight = np.empty((t2.size, 1, n_across))
-    points = np.empty((8, n_across))
+    points = np.empty((POINT_ROWS, n_across))
     largest_node = _largest_node(u_nodes)
     for c in range(n_contacts):
         _node_sines(a[c], rd[c], u_nodes, largest_node, sin_t)
