@@ -425,9 +425,14 @@ def test_a_bounded_steps_newton_iterations_count_in_its_work(table1, rings, monk
 @pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")
 def test_a_bounded_run_takes_the_same_steps_with_numpy_and_compiled_loops(table1, rings, monkeypatch):
     """The work a bounded solve counts, its iterations' and its operator's, is the same whichever runs
-    its loops (numpy's loop of iterations, or the compiled loop of the kept ones with the limit the work
     left allows): the moment reversed and back twice, every step the same iterations, the same flag and
-    the same state to round-off. An iteration here costs a fifth of the bound, that the limit binds."""
+    the same state to 1e-7 of its largest entry. An iteration here costs a fifth of the bound, that the
+    limit binds.
+
+    Not to round-off: the Newton step rounds its right side to single precision for the kept inverse's
+    product (``reduced_operator.single_product``, the same operations in both paths), so where the paths'
+    right sides differ by double round-off, a rounding to single can differ by one unit (6e-8 relative);
+    a flagged step's iterate, 1e-2 off its equilibrium here, carries that on. Measured: 1.5e-8."""
     monkeypatch.setattr(bime, "ITERATION_WEIGHT", (0.0, BOUNDED_WORK / 5 / table1.ball_count))
     runs = []
     for kernel in ("numpy", "auto"):
@@ -441,7 +446,7 @@ def test_a_bounded_run_takes_the_same_steps_with_numpy_and_compiled_loops(table1
     assert [r.iterations for r in with_numpy] == [r.iterations for r in compiled]
     assert [r.converged for r in with_numpy] == [r.converged for r in compiled]
     for a, b in zip(with_numpy, compiled):
-        assert np.allclose(a.state, b.state, rtol=0, atol=1e-9 * np.abs(b.state).max())
+        assert np.allclose(a.state, b.state, rtol=0, atol=1e-7 * np.abs(b.state).max())
 
 
 @pytest.mark.skipif(not AVAILABLE, reason="numba is not installed")

@@ -255,6 +255,34 @@ def test_compiled_error_tables_equal_numpy_interp(table3):
                 assert not np.array_equal(want.groove_centre, last.groove_centre)    # other grooves under the balls
 
 
+@pytest.mark.parametrize("rows", [2, 6, 8, 14, 376])
+def test_single_precision_sums_are_the_same_in_both_paths_and_within_their_rounding(rows):
+    """The Newton step's product with a kept single-precision ``W^-1``, summed in single precision block
+    by block (``kernel._single_times``, ``reduced_operator.single_product``): the compiled loop and
+    numpy give the same bits (the same exactly rounded operations in the same order; numpy's reduction
+    order included), for fewer rows than a block, whole blocks and a block left over. Each entry is
+    within the rounding bound of its operations, ``v`` rounded (u), each product rounded (u) and a
+    block's at most eight terms summed in single precision (7u): ``|p - W v| <= 10 u |W| |v|``
+    entry by entry, ``u = 2^-24``; and not within double precision's (it is summed in single)."""
+    from slewing_model.distribution import kernel
+    from slewing_model.numerics.compiled import compile_helpers
+    from slewing_model.rings.reduced_operator import single_product
+
+    compile_helpers(vars(kernel), ("_single_times",), kernel.ERROR_MODEL, fastmath=kernel.FASTMATH)
+    compiled = kernel._single_times                     # the helper the Newton step calls, compiled in place
+    rng = np.random.default_rng(rows)
+    a = rng.standard_normal((rows, rows)) * 10.0 ** rng.uniform(-2, 2, (rows, rows))
+    inverse = (a + a.T).astype(np.float32)
+    unit = 2.0 ** -24
+    for v in (rng.standard_normal(rows) * 10.0 ** rng.uniform(-3, 3, rows), np.full(rows, 1.0 / 3.0)):
+        got = single_product(inverse, v)
+        assert np.array_equal(compiled(inverse, v), got)
+        exact = inverse.astype(np.float64) @ v
+        scale = np.abs(inverse.astype(np.float64)) @ np.abs(v)
+        assert np.all(np.abs(got - exact) <= 10.0 * unit * scale)
+        assert np.abs(got - exact).max() > 1e-12 * scale.max()
+
+
 @pytest.mark.parametrize("balls", [2, 5, 67, 150, 151, 180])
 def test_compiled_ring_product_equals_the_dense_product(balls):
     """The ring compliance's product in the compiled iterations (``contact_kernel._ring_times``), a

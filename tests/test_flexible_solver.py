@@ -384,8 +384,9 @@ def test_an_operator_the_inverse_by_halves_misses_in_single_precision_is_inverte
 def test_operator_in_single_precision_reaches_the_double_precision_equilibrium(monkeypatch):
     """``W``'s inverse computed in single precision (``reduced_operator.OPERATOR_PRECISION``) is within
     a few ``eps cond(W)`` of the exact inverse, and the solver, whose step is in increments, reaches the
-    equilibrium an operator in double precision gives, to its tolerance: the inverse's error slows its
-    contraction, it does not stay in the answer (with the step computing the forces themselves, as it
+    equilibrium an operator in double precision gives, to its tolerance: the inverse's error (and the
+    rounding of the Newton step's product with it, partly summed in single precision,
+    ``reduced_operator.single_product``) slows its contraction, it does not stay in the answer (with the step computing the forces themselves, as it
     did, the solves stalled at 1.5-3.7e-7: docs/speed.md). Its cost in Newton iterations is counted
     over this load and four others (single at most 1.25 times double; measured 143 against 127):
     one solve alone follows its own path of operators (this one: 33 against 22 iterations since its

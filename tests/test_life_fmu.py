@@ -51,7 +51,13 @@ def step(fmu, refs, k):
 
 def test_fmu_life_outputs_equal_the_library(slave):
     """The library stepped as the FMU steps (an initial solve at zero inputs, then each step) gives the
-    same worst-track damage and x/2b of the last completed half-cycle."""
+    same worst-track damage and x/2b of the last completed half-cycle, to 1e-7 relative.
+
+    Not to round-off (1e-12 until the twenty-fifth turn of issue 31): the two differ at round-off (the
+    FMU's superelement and loops are built apart from this test's), and the Newton step rounds its right
+    side to single precision for the kept inverse's product (``reduced_operator.single_product``), where a
+    round-off difference can change a rounding by one unit (6e-8 of that side): the equilibria then differ
+    within the solver's tolerance, not at round-off. Measured: 7e-9 on the damage (three times the loads')."""
     from slewing_model.rings.superelement import build_superelement
 
     fmu, refs = slave
@@ -64,9 +70,9 @@ def test_fmu_life_outputs_equal_the_library(slave):
         damage, ratio = step(fmu, refs, k)
         u = inputs(k)
         sim.step(Loads(u["Fx"], u["Fy"], u["Fz"], u["Mx"], u["My"]), u["psi"], u["omega"])
-        assert damage == pytest.approx(sim.life.worst_damage, rel=1e-12, abs=0.0)
+        assert damage == pytest.approx(sim.life.worst_damage, rel=1e-7, abs=0.0)
         expected = sim.life.last_ratio
-        assert ratio == (0.0 if math.isnan(expected) else pytest.approx(expected, rel=1e-12))
+        assert ratio == (0.0 if math.isnan(expected) else pytest.approx(expected, rel=1e-7))
         ratios += not math.isnan(expected)
     assert damage > 0 and ratios > 20
 

@@ -12,7 +12,12 @@ fmpy's outputs on Linux within 1e-9 relative.
 The tolerance: the Windows half runs another numpy (1.26.4 with its OpenBLAS, against 2.x on Linux) and
 another C library's libm (wine's ucrtbase against glibc), so the last bits of the solver's
 floating-point results may differ; both Newton solvers converge to 1e-12 or better, and 3e-14 was
-measured. 1e-9 is what the Linux tests allow between machine codes (numba's generic loops).
+measured. 1e-9 is what the Linux tests allow between machine codes (numba's generic loops). Since the
+Newton step rounds its right side to single precision for the kept inverse's product
+(``reduced_operator.single_product``, issue 31's twenty-fifth turn), a round-off difference can change one
+such rounding and the two halves' equilibria differ within the solver's tolerance: measured 1.7e-10 (the
+friction torque; the others below 1e-10), a sixth of the tolerance. ``SLEWING_WIN64_REL`` sets another
+tolerance, to measure the margin.
 
 Wine (Debian's wine 8) and mingw-w64 are installed by ``make`` as root; the prefix and the Windows Python
 are kept in ``$SLEWING_WINE_DIR`` (default /var/cache/slewing-wine). Without root or without them the
@@ -46,7 +51,7 @@ DRIVE_OUTPUTS = ["psi", "omega", "motor_torque", "ring_torque"]
 CASES = {"bearing2": (2, "SlewingBearing", BEARING_INPUTS, BEARING_OUTPUTS),
          "bearing3": (3, "SlewingBearing3", BEARING_INPUTS, BEARING_OUTPUTS),
          "drive": (2, "SlewingDrive", DRIVE_INPUTS, DRIVE_OUTPUTS)}
-REL = 1e-9
+REL = float(os.environ.get("SLEWING_WIN64_REL", "1e-9"))
 
 pytestmark = [
     pytest.mark.skipif(os.geteuid() != 0, reason="SKIPPED, not root: the win64 tests need wine and mingw-w64, "

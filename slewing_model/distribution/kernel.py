@@ -25,7 +25,9 @@ of operations, one loop each:
   (:func:`_contact_results`).
 
 Where a loop sums ``W^-1 v`` it does so column by column (``W^-1`` symmetric), which differs from
-numpy's row sums by round-off. docs/speed.md has what each gave.
+numpy's row sums by round-off; the Newton step's product with a single-precision ``W^-1`` is partly
+summed in single precision, the same operations in both paths (:func:`_single_times`). docs/speed.md
+has what each gave.
 
 numba is optional, as for the friction's loops (:mod:`slewing_model.friction.kernel`, whose
 :func:`~slewing_model.friction.kernel.compile_all` compiles these too, and whose
@@ -172,6 +174,50 @@ def _symmetric_times(matrix, vectors):
     return out
 
 
+def _single_times(matrix, vector):
+    """``W^-1 v`` (n,) for a symmetric ``W^-1 = matrix`` kept in single precision (n, n) and ``v`` (n,):
+    :func:`slewing_model.rings.reduced_operator.single_product`, the same operations in the same order.
+
+    ``v`` rounded to single precision; per block of :data:`SINGLE_BLOCK` rows of ``W^-1`` (the last
+    block what is left), ``s = M_j v_j + M_j+1 v_j+1 + ...`` in single precision, added left to
+    right; ``s`` added to the sum in double, block after block. Each ``M_j v_j`` is a single-precision
+    product of single-precision numbers, exact in double: reading ``W^-1`` in its precision without
+    converting each entry to double (``vcvtps2pd``, which set the product's time) and eight lanes to a
+    vector instead of four make the product 0.45 as long (45 -> 21 us hot, 376 rows). The sum's rounding,
+    about ``1e-7`` of ``|W^-1| |v|``, is of the size of the single-precision inverse's own error (about
+    ``1e-7 cond(W)``): it changes the Newton direction, not the step's fixed point
+    (:func:`_newton_step`, in increments). docs/speed.md, "Issue 31, twenty-fifth turn"."""
+    n = vector.size
+    v = np.empty(n, np.float32)
+    for j in range(n):
+        v[j] = np.float32(vector[j])
+    out = np.zeros(n)
+    j = 0
+    while j < n:
+        rows = min(SINGLE_BLOCK, n - j)
+        if rows == SINGLE_BLOCK:
+            v0, v1, v2, v3 = v[j], v[j + 1], v[j + 2], v[j + 3]
+            v4, v5, v6, v7 = v[j + 4], v[j + 5], v[j + 6], v[j + 7]
+            for i in range(n):
+                s = (matrix[j, i] * v0 + matrix[j + 1, i] * v1 + matrix[j + 2, i] * v2 + matrix[j + 3, i] * v3
+                     + matrix[j + 4, i] * v4 + matrix[j + 5, i] * v5 + matrix[j + 6, i] * v6
+                     + matrix[j + 7, i] * v7)
+                out[i] += s
+        else:                                  # the last rows
+            for i in range(n):
+                s = matrix[j, i] * v[j]
+                for r in range(1, rows):
+                    s += matrix[j + r, i] * v[j + r]
+                out[i] += s
+        j += rows
+    return out
+
+
+#: rows of the kept single-precision ``W^-1`` whose products :func:`_single_times` sums in single precision
+#: before adding them to the sum in double (eight: one vector of single-precision lanes)
+SINGLE_BLOCK = 8
+
+
 _NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], "
                      "f8[:, :], f8[:], f8[:], f8[:], f8[:])")
 
@@ -185,7 +231,8 @@ def _newton_step(inverse, single_inverse, contact_compliance, rows, jacobian, co
 
     ``W^-1`` is ``inverse`` (double) or, where that is empty, ``single_inverse``
     (:func:`slewing_model.rings.reduced_operator.kept_precision`; :func:`product_inverses`);
-    ``W^-1 rhs`` is summed in double, column by column (:func:`_inverse_product`)."""
+    ``W^-1 rhs`` is summed in double, column by column (:func:`_symmetric_times`), or for the single
+    inverse partly in single precision (:func:`_single_times`)."""
     n = rows.size
     rhs = np.empty(n)
     for k in range(n // 2):                 # A^-1 (f - y) of each diagonal, + (M y_off) on its rows
@@ -195,7 +242,10 @@ def _newton_step(inverse, single_inverse, contact_compliance, rows, jacobian, co
         for c in range(2):
             rhs[2 * k + c] = (contact_compliance[k, c, 0] * m0 + contact_compliance[k, c, 1] * m1
                               + off_motion[rows[2 * k + c]])
-    w = _inverse_product(inverse, single_inverse, rhs.reshape(1, n))[0]
+    if inverse.shape[0] == n:
+        w = _symmetric_times(inverse, rhs.reshape(1, n))[0]
+    else:
+        w = _single_times(single_inverse, rhs)
     for i in range(n):
         w[i] += y[rows[i]]
     t = f_scaled.copy()                     # F - J_a^T w
@@ -1034,7 +1084,7 @@ def _rigid_solve(separation, jacobian_rows, qs, y, ring_motion, natural_length, 
 #: the helpers the load distribution's loops call
 _HELPERS = ("_segment", "_interp", "_solve_small", "_hertz_contact", "_symmetric_times", "_bordered_blocks",
             "_periodic_interp", "_trial_point", "_newton_step", "_off_motion", "_ring_times", "_schur_inverse",
-            "_column_turn", "_kept_iterations", "_contact_results", "_inverse_product")
+            "_column_turn", "_kept_iterations", "_contact_results", "_inverse_product", "_single_times")
 
 
 #: numpy's floating-point semantics: a division by zero gives inf or NaN as the numpy code does,

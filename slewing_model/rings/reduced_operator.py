@@ -17,7 +17,9 @@ Newton step, still a descent direction), bordered by the contacts that close
 (:func:`update_operator`; contacts that open keep their rows until a fresh operator), and
 rebuilt when convergence slows (:func:`assemble_operator`). A new one is inverted in single
 precision (:data:`OPERATOR_PRECISION`): the step is solved in increments of ``y``
-(:func:`newton_step`), so an approximate ``W^-1`` slows the iteration without moving its answer.
+(:func:`newton_step`), so an approximate ``W^-1`` slows the iteration without moving its answer; for
+the same reason the step's product with a single-precision ``W^-1`` is partly summed in single
+precision (:func:`single_product`).
 
 Run-time module: numpy.
 """
@@ -108,6 +110,37 @@ def inverse_product(inverse: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     product of the two precisions as they are runs without BLAS (in a bounded step after a moment
     reversal, 74-628 us for one vector, docs/speed.md, "Issue 31, fifteenth turn")."""
     return vectors @ inverse.astype(np.float64, copy=False)
+
+
+#: rows of a single-precision ``W^-1`` whose products :func:`single_product` sums in single precision before
+#: adding them to the sum in double (the compiled loop's ``SINGLE_BLOCK``,
+#: :func:`slewing_model.distribution.kernel._single_times`)
+SINGLE_BLOCK = 8
+
+
+def single_product(inverse: np.ndarray, vector: np.ndarray) -> np.ndarray:
+    """``W^-1 v`` (n,) for a symmetric ``W^-1 = inverse`` kept in single precision (n, n): the Newton
+    step's product (:func:`newton_step`), partly summed in single precision.
+
+    ``v`` is rounded to single precision; each block of :data:`SINGLE_BLOCK` rows of ``W^-1`` gives
+    ``s = M_j v_j + M_j+1 v_j+1 + ...``, summed in single precision left to right, and the blocks' ``s``
+    are added in double, one after the other (the last block what is left). These are the compiled
+    loop's operations in its order (:func:`slewing_model.distribution.kernel._single_times`), each
+    exactly rounded, so both give the same numbers. The rounding of ``s``, about ``1e-7`` of
+    ``|W^-1| |v|``, is of the size of the single-precision inverse's own error: the step in increments
+    takes it as it takes that, in its contraction, not in its fixed point."""
+    n = vector.size
+    v = vector.astype(np.float32)
+    full = n - n % SINGLE_BLOCK
+    out = np.zeros(n)
+    for rows in (slice(0, full), slice(full, n)):
+        terms = inverse[rows] * v[rows, None]
+        if terms.size:
+            # numpy reduces an axis that is not the innermost by adding its rows one after the other (left
+            # to right, as the compiled loop; tests/test_contact_kernel.py checks the two bit for bit)
+            s = np.add.reduce(terms.reshape(-1, min(SINGLE_BLOCK, terms.shape[0]), n), axis=1)
+            out += np.add.reduce(s.astype(np.float64), axis=0)     # in double, block after block
+    return out
 
 
 #: how far a turned Jacobian may be off the ring's own where errors move the grooves with it
@@ -757,7 +790,10 @@ def newton_step(op: ReducedOperator, point, f_scaled: np.ndarray, off_motion: np
     rhs = (op.contact_compliance @ mismatch[..., None]).ravel()
     if off_motion is not None:
         rhs = rhs + off_motion[op.rows]
-    w_vec = point.y[op.rows] + inverse_product(op.inverse, rhs[None, :])[0]
+    if op.inverse.dtype == np.float32:
+        w_vec = point.y[op.rows] + single_product(op.inverse, rhs)
+    else:
+        w_vec = point.y[op.rows] + inverse_product(op.inverse, rhs[None, :])[0]
     dq = op.schur_inverse @ (f_scaled - op.jacobian.T @ w_vec)
     y_new = np.zeros_like(point.y)
     y_new[op.rows] = w_vec + op.coupling @ dq
