@@ -43,7 +43,7 @@ import numpy as np
 
 from ..bearing.contact import _E_TABLE, _F_TABLE, _LOG_KAPPA, effective_modulus
 from ..numerics.compiled import compile_loop, loop_factory
-from ..rings.reduced_operator import OperatorArithmetic
+from ..rings.reduced_operator import SINGLE_BLOCK, OperatorArithmetic
 from ..rings.reduced_operator import bordered_inverse as _numpy_bordered_inverse
 
 _TRIAL_SIGNATURE = ("Tuple((f8[:], f8[:], f8[:], f8[:, :, :], f8[:, :], f8[:, :], f8[:, :, :], f8[:, :, :], "
@@ -178,12 +178,12 @@ def _single_times(matrix, vector):
     """``W^-1 v`` (n,) for a symmetric ``W^-1 = matrix`` kept in single precision (n, n) and ``v`` (n,):
     :func:`slewing_model.rings.reduced_operator.single_product`, the same operations in the same order.
 
-    ``v`` rounded to single precision; per block of :data:`SINGLE_BLOCK` rows of ``W^-1`` (the last
-    block what is left), ``s = M_j v_j + M_j+1 v_j+1 + ...`` in single precision, added left to
-    right; ``s`` added to the sum in double, block after block. Each ``M_j v_j`` is a single-precision
-    product of single-precision numbers, exact in double: reading ``W^-1`` in its precision without
-    converting each entry to double (``vcvtps2pd``, which set the product's time) and eight lanes to a
-    vector instead of four make the product 0.45 as long (45 -> 21 us hot, 376 rows). The sum's rounding,
+    ``v`` rounded to single precision; per block of eight rows of ``W^-1`` (``SINGLE_BLOCK``; the last
+    block what is left), ``s = M_j v_j + M_j+1 v_j+1 + ...``, each product and sum in single precision,
+    added left to right; ``s`` added to the sum in double, block after block. Reading ``W^-1`` in its
+    precision without converting each entry to double (``vcvtps2pd``, which set the product's time), eight
+    single-precision lanes to a vector instead of four double ones, makes the product 0.45 as long
+    (45 -> 21 us hot, 376 rows). The sum's rounding,
     about ``1e-7`` of ``|W^-1| |v|``, is of the size of the single-precision inverse's own error (about
     ``1e-7 cond(W)``): it changes the Newton direction, not the step's fixed point
     (:func:`_newton_step`, in increments). docs/speed.md, "Issue 31, twenty-fifth turn"."""
@@ -195,7 +195,7 @@ def _single_times(matrix, vector):
     j = 0
     while j < n:
         rows = min(SINGLE_BLOCK, n - j)
-        if rows == SINGLE_BLOCK:
+        if rows == SINGLE_BLOCK:                # a whole block: its pass written out for eight rows
             v0, v1, v2, v3 = v[j], v[j + 1], v[j + 2], v[j + 3]
             v4, v5, v6, v7 = v[j + 4], v[j + 5], v[j + 6], v[j + 7]
             for i in range(n):
@@ -212,10 +212,6 @@ def _single_times(matrix, vector):
         j += rows
     return out
 
-
-#: rows of the kept single-precision ``W^-1`` whose products :func:`_single_times` sums in single precision
-#: before adding them to the sum in double (eight: one vector of single-precision lanes)
-SINGLE_BLOCK = 8
 
 
 _NEWTON_SIGNATURE = ("Tuple((f8[:], f8[:]))(f8[:, ::1], f4[:, ::1], f8[:, :, :], i8[:], f8[:, :], f8[:, :], "

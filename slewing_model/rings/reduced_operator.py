@@ -113,8 +113,9 @@ def inverse_product(inverse: np.ndarray, vectors: np.ndarray) -> np.ndarray:
 
 
 #: rows of a single-precision ``W^-1`` whose products :func:`single_product` sums in single precision before
-#: adding them to the sum in double (the compiled loop's ``SINGLE_BLOCK``,
-#: :func:`slewing_model.distribution.kernel._single_times`)
+#: adding them to the sum in double: eight, one vector of single-precision lanes (the compiled loop,
+#: :func:`slewing_model.distribution.kernel._single_times`, takes it from here and has its pass written out
+#: for eight rows)
 SINGLE_BLOCK = 8
 
 
