@@ -15,9 +15,9 @@ floating-point results may differ; both Newton solvers converge to 1e-12 or bett
 measured. 1e-9 is what the Linux tests allow between machine codes (numba's generic loops). Since the
 Newton step rounds its right side to single precision for the kept inverse's product
 (``reduced_operator.single_product``, issue 31's twenty-fifth turn), a round-off difference can change one
-such rounding and the two halves' equilibria differ within the solver's tolerance: measured 1.7e-10 (the
-friction torque; the others below 1e-10), a sixth of the tolerance (the 3e-14 above is an older
-measurement; the commit before that change was not measured so). ``SLEWING_WIN64_REL`` sets another
+such rounding and the two halves' equilibria differ within the solver's tolerance: measured 2.6e-10 (the
+friction torque in the C host's six steps; z 1e-11, the others below 6e-11), against 2.2e-11 on the commit
+before (``50781ef``, the same steps; the 3e-14 above is an older measurement). ``SLEWING_WIN64_REL`` sets another
 tolerance, to measure the margin.
 
 Wine (Debian's wine 8) and mingw-w64 are installed by ``make`` as root; the prefix and the Windows Python
