@@ -188,9 +188,7 @@ def _single_times(matrix, vector):
     ``1e-7 cond(W)``): it changes the Newton direction, not the step's fixed point
     (:func:`_newton_step`, in increments). docs/speed.md, "Issue 31, twenty-fifth turn"."""
     n = vector.size
-    v = np.empty(n, np.float32)
-    for j in range(n):
-        v[j] = np.float32(vector[j])
+    v = vector.astype(np.float32)
     out = np.zeros(n)
     j = 0
     while j < n:
