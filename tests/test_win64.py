@@ -177,6 +177,30 @@ def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(
             assert got[k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
 
 
+BLAS_THREADS = r"""
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("blas", sys.argv[1])
+blas = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(blas)
+get, set_ = blas._openblas_threads()
+set_(2)
+with blas.blas_threads(1):
+    inside = get()
+print("threads", inside, get(), [p.rsplit(chr(92), 1)[-1] for p in blas._openblas_paths()])
+"""
+
+
+def test_the_blas_threads_of_a_step_are_set_on_windows_too():
+    """numpy 1.26's OpenBLAS on the embeddable Windows Python (the win64 FMU's) is found beside numpy's
+    package, so a step's BLAS work (numpy's loops: the win64 half's) runs on the settings' one thread and
+    the host's count comes back after it, as on Linux (tests/test_blas.py)."""
+    run = w.wine(w.windows_python(), "-c", BLAS_THREADS, w.windows_path(ROOT / "slewing_model" / "numerics" / "blas.py"))
+    assert run.returncode == 0, run.stdout + run.stderr
+    word, inside, after, paths = run.stdout.strip().splitlines()[-1].split(" ", 3)
+    assert (word, inside, after) == ("threads", "1", "2"), run.stdout
+    assert "openblas" in paths.lower() and ".dll" in paths.lower(), paths
+
+
 def test_a_missing_python_library_is_reported_through_the_hosts_logger(fmus, hosts, tmp_path):
     folder = w.unpack(fmus["bearing2"], tmp_path / "broken")
     (folder / "binaries" / "win64" / "python" / "python311.dll").unlink()

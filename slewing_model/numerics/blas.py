@@ -10,7 +10,8 @@ of code and restores it afterwards, so the host's own numpy work is not affected
 
 It talks to the OpenBLAS that numpy loaded (numpy's wheels bundle one, as
 ``scipy_openblas``) through ``ctypes``, found among the process's mapped libraries
-(``/proc/self/maps``, Linux). Elsewhere, or with another BLAS, it does nothing. Run-time
+(``/proc/self/maps``, Linux) or, on Windows, beside numpy's package (``numpy.libs``, the win64
+FMU's numpy 1.26). Elsewhere, or with another BLAS, it does nothing. Run-time
 module: the standard library only.
 """
 from __future__ import annotations
@@ -31,14 +32,7 @@ _SYMBOLS = (("scipy_openblas_get_num_threads64_", "scipy_openblas_set_num_thread
 @functools.lru_cache(maxsize=1)
 def _openblas_threads():
     """(get, set) of the thread count of the OpenBLAS loaded in this process, or None."""
-    import numpy  # noqa: F401  (its BLAS must be loaded to be found)
-
-    try:
-        with open("/proc/self/maps") as fh:
-            paths = {line.split()[-1] for line in fh if "openblas" in line.lower()}
-    except OSError:
-        return None
-    for path in sorted(p for p in paths if os.path.isfile(p)):
+    for path in _openblas_paths():
         try:
             library = ctypes.CDLL(path)
         except OSError:
@@ -50,6 +44,28 @@ def _openblas_threads():
                 set_.restype, set_.argtypes = None, [ctypes.c_int]
                 return get, set_
     return None
+
+
+def _openblas_paths() -> list:
+    """The files of the OpenBLAS numpy loaded: among the process's mapped libraries (``/proc/self/maps``,
+    Linux), else the DLLs beside numpy's package where its Windows wheel keeps them (``numpy.libs``,
+    ``numpy/.libs``; loaded already, so that ``ctypes`` hands back numpy's own copy)."""
+    import numpy  # (its BLAS must be loaded to be found)
+
+    paths = set()
+    if os.name == "nt":         # (under wine "/proc/self/maps" may be the Linux file of wine's process)
+        package = os.path.dirname(numpy.__file__)
+        for folder in (package + ".libs", os.path.join(package, ".libs")):
+            if os.path.isdir(folder):
+                paths.update(os.path.join(folder, name) for name in os.listdir(folder)
+                             if "openblas" in name.lower() and name.lower().endswith(".dll"))
+    else:
+        try:
+            with open("/proc/self/maps") as fh:
+                paths = {line.split()[-1] for line in fh if "openblas" in line.lower()}
+        except OSError:
+            pass
+    return sorted(p for p in paths if os.path.isfile(p))
 
 
 def blas_thread_control() -> bool:
