@@ -73,3 +73,37 @@ def test_a_steps_operator_work_runs_on_the_settings_threads_and_a_usual_step_lea
         set_(before)
     assert formed and set(formed) == {1} and set(entered) == {1}
     assert 0 < untouched < 40
+
+
+@pytest.mark.skipif(not blas_thread_control(), reason="numpy's BLAS is not an OpenBLAS found in /proc/self/maps")
+def test_the_friction_of_numpys_loops_runs_on_the_settings_threads(monkeypatch):
+    """With numpy's loops (the win64 FMU's, ``--no-numba``'s) the friction torque sums every contact's
+    points by BLAS products: each step's friction runs on ``blas_threads`` threads, and the host's count
+    is back after the step."""
+    from slewing_model import Loads, load_bearing
+    from slewing_model.friction import ball_kinematics
+    from slewing_model.rings.superelement import build_superelement
+    from slewing_model.simulation.simulator import BearingSimulator
+
+    from conftest import BEARINGS
+
+    bearing = load_bearing(BEARINGS / "table3.toml")
+    sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"),
+                           SimulatorSettings(blas_threads=1, friction_kernel="numpy", contact_kernel="numpy"))
+    get, set_ = _openblas_threads()
+    seen = []
+    original = ball_kinematics.ContactPoints.evaluate
+
+    def evaluate(self, *args, **kwargs):
+        seen.append(get())
+        return original(self, *args, **kwargs)
+    monkeypatch.setattr(ball_kinematics.ContactPoints, "evaluate", evaluate)
+    before = get()
+    set_(2)
+    try:
+        for k in range(5):
+            sim.step(Loads(Fz=8e4 + 2e3 * k, My=1e4 + 5e2 * k), 0.002 * k, 0.1)
+            assert get() == 2
+    finally:
+        set_(before)
+    assert seen and set(seen) == {1}

@@ -20,6 +20,7 @@ from ..distribution.bime import STEP_WORK, BimeSolver, LoadDistribution, Loads
 from ..friction.torque import friction_torque, prepare_warm_torque, regularised_torque, seal_torque_of, warm_torque
 from ..friction.kernel import compile_all, use_compiled
 from ..bearing.geometry import Bearing
+from ..numerics.blas import blas_threads
 from ..rings.reduced_operator import PendingOperator, ReducedOperator
 
 RING_MODELS = ("rigid", "flexible")
@@ -74,12 +75,14 @@ class SimulatorSettings:
         where a four-contact ball stopped on a flat stretch of its power
         (``tests/test_step_accuracy.py``).
     blas_threads : int or None
-        Threads of numpy's BLAS while a step's load distribution does its BLAS work, the ring
-        operator's inversions and borderings (:func:`slewing_model.numerics.blas.blas_threads`, restored
-        after; ``blas_threads`` of :class:`~slewing_model.distribution.bime.BimeSolver`: the usual step's
-        one compiled call uses no BLAS and leaves them be); None leaves them as the process has them.
-        Default 1: the step's matrices have a few hundred rows, and a second thread that spins while
-        other processes share the cores makes steps several times slower.
+        Threads of numpy's BLAS while a step does its BLAS work: the load distribution's, the ring
+        operator's inversions and borderings (``blas_threads`` of
+        :class:`~slewing_model.distribution.bime.BimeSolver`), and the friction torque's general path, whose
+        numpy loops sum every contact's points by BLAS products (:func:`slewing_model.numerics.blas.blas_threads`,
+        restored after; the usual step's two compiled calls use no BLAS and leave them be); None leaves them
+        as the process has them. Default 1: the step's matrices have a few hundred rows, and a second thread
+        that spins while other processes share the cores makes steps several times slower (numpy's loops,
+        pitch bearing, both cores busy with other work: the step 0.82-0.86 with one thread).
     friction_kernel : {"auto", "numpy", "compiled"}
         How the friction model runs its loops over points and balls (``kernel`` of
         :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loops
@@ -277,11 +280,12 @@ class BearingSimulator:
             friction = None
             if self._warm_friction is not None:          # the usual step: one compiled call, prepared
                 friction = warm_torque(self._warm_friction, distribution, initial, self._seal_torque, **capped)
-            if friction is None:
-                friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
-                                           omega=1.0, seal_torque=self.settings.seal_torque, initial=initial,
-                                           tol=self.settings.friction_tolerance,
-                                           kernel=self.settings.friction_kernel, **capped)
+            if friction is None:    # the general path: with numpy's loops, BLAS products over every point
+                with blas_threads(self.settings.blas_threads):
+                    friction = friction_torque(self.bearing, distribution, mu=self.settings.friction_coefficient,
+                                               omega=1.0, seal_torque=self.settings.seal_torque, initial=initial,
+                                               tol=self.settings.friction_tolerance,
+                                               kernel=self.settings.friction_kernel, **capped)
             magnitude = friction.magnitude
             converged = friction.converged and distribution.converged
             # a capped torque's motions (a flagged step's) are no point to extrapolate from or to
