@@ -44,11 +44,12 @@ _IS_MOVING = {ring: np.isin(np.arange(4), [c - 1 for c in RING_CONTACTS[ring]]) 
 SOLVED = [0, 2, 3]
 #: damping schedule of the Newton / Weiszfeld blend (see minimise_power)
 _THETA_DOWN, _THETA_UP, _THETA_MIN_UP = 0.2, 10.0, 0.1
-#: iterations after which at most a quarter of the balls left unconverged go on alone (see minimise_power).
-#: With the compiled loop an evaluation costs in proportion to its balls, so going alone early pays:
-#: measured on the pitch bearing's steps, after 1 iteration 1.24 ms, after 3 (numpy's best) 1.54 ms,
-#: the same torques (both within 3.8e-6 of a 1e-9 solve)
-_STRAGGLERS_AFTER = 1
+#: iterations after which at most a quarter of the balls left unconverged go on alone (see minimise_power):
+#: the numpy loop's (the compiled one solves ball by ball). At once: a warm-started step leaves a few balls
+#: unconverged at its start, and every batched evaluation costs all balls' points. Pitch bearing, NREL series,
+#: numpy's loops: the step 0.955 of going alone after 1 iteration, the torques equal to 2e-16 (each ball's
+#: iterates are its own); after 1 iteration 1.24 ms against 1.54 ms after 3 with an older compiled evaluation
+_STRAGGLERS_AFTER = 0
 
 
 class _Workspace:
@@ -343,12 +344,14 @@ class ContactPoints:
         # SINE_SERIES_LIMIT takes the sine's series, as the compiled loop does (the same numbers); the others
         # np.sin, of the nodes u > 0 (the nodes are symmetric and sin is odd)
         n_i, n_neg = u_nodes.size, u_nodes.size // 2
-        sin_pos = np.sin(geo.a * (u_nodes[n_neg:] / rd))
-        sin_t = np.concatenate([-sin_pos[:, n_i - n_neg - 1::-1][:, :n_neg], sin_pos], axis=1)
         series = geo.a * (np.abs(u_nodes).max() / rd) <= SINE_SERIES_LIMIT
-        if np.any(series):
+        if not np.all(series):
+            sin_pos = np.sin(geo.a * (u_nodes[n_neg:] / rd))
+            sin_t = np.concatenate([-sin_pos[:, n_i - n_neg - 1::-1][:, :n_neg], sin_pos], axis=1)
+        if np.any(series):          # (all of them, as a rule: a pitch bearing's contacts are narrow)
             angle = geo.a * (u_nodes / rd)
-            sin_t = np.where(series, getattr(_sine_series, "py_func", _sine_series)(angle), sin_t)
+            sine = getattr(_sine_series, "py_func", _sine_series)(angle)
+            sin_t = sine if np.all(series) else np.where(series, sine, sin_t)
         cos_t = np.sqrt(1.0 - sin_t * sin_t)
         # point relative to the ball centre in the ball frame (r, t, z):
         # (rb - Rd + Rd cos) n + Rd sin g + xi t,  g = n x t = (-n_z, 0, n_r)
@@ -409,9 +412,18 @@ class ContactPoints:
         for k, t2 in enumerate(self.t2):
             np.multiply(s2, t2, out=s[k])
             s[k] += a2
-        s += eps2
+        s += self._points_eps2(eps2, a2.shape)
         np.sqrt(s, out=s)
         return s
+
+    def _points_eps2(self, eps2, shape):
+        """``eps2`` (C, 1) spread over the points (C, I), kept while ``eps2`` is the same array: added to
+        the (K, C, I) speeds it is one pass over them, where the column took an inner loop of I points per
+        contact (60 against 25 us a pass, pitch bearing: C = 372, I = 20, K = 5)."""
+        kept = getattr(self, "_eps2", None)
+        if kept is None or kept[0] is not eps2 or kept[1].shape != shape:
+            kept = self._eps2 = (eps2, np.ascontiguousarray(np.broadcast_to(eps2, shape)))
+        return kept[1]
 
     def _moment(self, x, power):
         """``sum_K x t^(2 power)`` (C, I); with one ``t^2`` and ``power = 0``, a view of ``x[0]``."""
