@@ -7,8 +7,11 @@ Each version runs in a worker process of its own, importing ``slewing_model`` fr
 compiles them there); both step the same case of ``benchmarks/cases.py`` (fine superelement, free
 rings), in alternating blocks, so that both see the same machine load.
 
+``--kernels numpy`` runs both versions' numpy loops instead of numba's (``friction_kernel`` and
+``contact_kernel``): the arithmetic of the standalone and win64 FMUs, which carry no numba.
+
 Run: .venv/bin/python benchmarks/bench_simulator_ab.py [--baseline REV] [--cases pitch table3_heavy]
-     [--steps 300] [--runs 3] [--life off|on|both]
+     [--steps 300] [--runs 3] [--life off|on|both] [--kernels auto|numpy]
 """
 from __future__ import annotations
 
@@ -42,6 +45,8 @@ except ImportError:                                              # before the re
 case = CASES[case_name](steps)
 bearing = load_bearing(case.bearing)
 options = {"life": True} if life else {}
+if sys.argv[6] != "auto":
+    options.update(friction_kernel=sys.argv[6], contact_kernel=sys.argv[6])
 frame = "rotating" if case.parameters["load_frame"] == 2 else "fixed"
 ring_model = "rigid" if case.parameters["ring_model"] == 1 else "flexible"
 superelement = build_superelement(bearing, mesh="fine", progress=False) if ring_model == "flexible" else None
@@ -59,10 +64,10 @@ for line in sys.stdin:
 
 
 class Worker:
-    def __init__(self, tree: Path, case: str, steps: int, life: str):
+    def __init__(self, tree: Path, case: str, steps: int, life: str, kernels: str = "auto"):
         self.process = subprocess.Popen([sys.executable, "-c", WORKER, str(tree), case, str(steps), life,
-                                         str(ROOT / "benchmarks")], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                        text=True, cwd=tempfile.gettempdir())
+                                         str(ROOT / "benchmarks"), kernels], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, text=True, cwd=tempfile.gettempdir())
         self._answer()
 
     def _answer(self) -> dict:
@@ -89,6 +94,8 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3, help="blocks per version")
     parser.add_argument("--life", choices=("off", "on", "both"), default="both",
                         help="this tree's life accumulator (the baseline runs without: it may have none)")
+    parser.add_argument("--kernels", choices=("auto", "numpy"), default="auto",
+                        help="numpy: both versions run their numpy loops (the standalone and win64 FMUs')")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench_ab_") as tmp:
         tree = Path(tmp) / "baseline"
@@ -104,9 +111,9 @@ def main() -> None:
             # load them from there: a process that compiled them itself ran 3 % slower at the median and up to
             # 30 % at the slowest steps (docs/speed.md, "Issue 31, sixteenth turn")
             for t, life in versions.values():
-                Worker(t, args.cases[0], total, life).close()
+                Worker(t, args.cases[0], total, life, args.kernels).close()
             for case in args.cases:
-                workers = {v: Worker(t, case, total, life) for v, (t, life) in versions.items()}
+                workers = {v: Worker(t, case, total, life, args.kernels) for v, (t, life) in versions.items()}
                 for w in workers.values():
                     w.run(0, WARM)
                 times = {v: [] for v in versions}
@@ -121,7 +128,8 @@ def main() -> None:
                                  f"{np.median(t) / (base * 1e3):.2f}"])
         finally:
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
-    print_table(f"The library's simulator step (ms), {args.runs} alternating blocks of {args.steps} steps",
+    loops = "numpy's loops" if args.kernels == "numpy" else "numba's loops"
+    print_table(f"The library's simulator step (ms, {loops}), {args.runs} alternating blocks of {args.steps} steps",
                 ["case", "version", "median", "99th pct", "max", "median / baseline's"], rows)
 
 
