@@ -395,3 +395,24 @@ print(json.dumps({{"available": k.AVAILABLE, **{{n: float(r[n][-1]) for n in {na
     assert there.pop("available") is False
     for name in names:
         assert there[name] == pytest.approx(float(here[name][-1]), rel=1e-9, abs=1e-15), name
+
+
+@pytest.mark.parametrize("owner, n_balls", [([0, 0, 1, 2, 2, 2, 3], 4),      # contacts in ball order
+                                            ([0, 2, 2, 3], 4),               # ball 1 without a contact
+                                            ([1, 0, 2, 2], 3)])              # not in ball order
+def test_the_per_ball_sums_of_numpys_loops_add_each_balls_contacts(owner, n_balls):
+    """``ContactPoints._per_ball``: every ball's sum of its contacts' values, as the product with the
+    0/1 matrix ``sum_matrix`` gives it, whether the contacts follow one another (``np.add.reduceat``)
+    or not (that product)."""
+    from types import SimpleNamespace
+
+    owner = np.array(owner)
+    sum_matrix = np.zeros((n_balls, owner.size))
+    sum_matrix[owner, np.arange(owner.size)] = 1.0
+    points = SimpleNamespace(geometry=SimpleNamespace(owner=owner, active=np.arange(n_balls), sum_matrix=sum_matrix))
+    values = np.random.default_rng(3).standard_normal((9, owner.size))
+    want = np.array([[row[owner == b].sum() for b in range(n_balls)] for row in values])
+    for _ in range(2):                              # the second call takes the kept starts
+        got = ContactPoints._per_ball(points, values)
+        assert got.shape == (9, n_balls) and np.allclose(got, want, rtol=1e-15, atol=1e-15)
+    assert np.allclose(ContactPoints._per_ball(points, values[0]), want[0], rtol=1e-15, atol=1e-15)

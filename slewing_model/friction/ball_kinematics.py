@@ -468,7 +468,7 @@ class ContactPoints:
         ones = self._ones
         f_c = (k.reshape(-1, n_i) @ ones).reshape(k.shape[:2]).sum(axis=0)   # BLAS: short axis
         if not derivatives:
-            return geo.sum_matrix @ f_c, None, None, None
+            return self._per_ball(f_c), None, None, None
         if self._products is None:
             self._prepare_derivatives()
         p00, p01, p11, q00, q01, q11, x00, x01, x11 = self._products
@@ -514,11 +514,27 @@ class ContactPoints:
                 rows[row] += e_as * gs_k
                 np.negative(rows[row], out=rows[row])
             rows[14] = e_aa
-        sums = (rows[:n_rows].reshape(-1, n_i) @ ones).reshape(n_rows, -1) @ geo.sum_matrix.T   # (rows, B)
+        sums = self._per_ball((rows[:n_rows].reshape(-1, n_i) @ ones).reshape(n_rows, -1))   # (rows, B)
         sym = [0, 1, 2, 1, 3, 4, 2, 4, 5]
         hessian = sums[3:9].T[:, sym].reshape(-1, 3, 3)
         extra = sums[9:15].T[:, sym].reshape(-1, 3, 3) if majorant else None
-        return geo.sum_matrix @ f_c, sums[:3].T, hessian, extra
+        return self._per_ball(f_c), sums[:3].T, hessian, extra
+
+    def _per_ball(self, per_contact: np.ndarray) -> np.ndarray:
+        """Per-contact values (..., C) summed per active ball (..., B): each ball's contacts, which follow
+        one another (``owner`` is sorted), added in their order (``np.add.reduceat``), where the product
+        with ``sum_matrix`` (B, C) took 80 of a 500-us evaluation (pitch bearing, 370 contacts); that
+        product where a ball has no contact or ``owner`` is not sorted."""
+        starts = getattr(self, "_ball_starts", None)
+        if starts is None:
+            owner, n_balls = self.geometry.owner, self.geometry.active.size
+            starts = np.searchsorted(owner, np.arange(n_balls))
+            ordered = owner.size > 0 and bool(np.all(np.diff(owner) >= 0)) and bool(
+                np.all(np.diff(np.append(starts, owner.size)) > 0))
+            self._ball_starts = starts = starts if ordered else False
+        if starts is False:
+            return per_contact @ self.geometry.sum_matrix.T
+        return np.add.reduceat(per_contact, starts, axis=-1)
 
     def tractions(self, u: np.ndarray):
         """Dissipated power (W) and torque on the moving ring about +z (N m) of
