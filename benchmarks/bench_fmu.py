@@ -166,8 +166,9 @@ def build_current(out: Path) -> dict[str, Path]:
             for name in BEARINGS}
 
 
-def build_baseline(revision: str, out: Path, bearings=BEARINGS) -> dict[str, Path]:
-    """The FMUs of ``revision`` (of ``bearings``), built by that revision's own build_fmu.py from a git worktree."""
+def build_baseline(revision: str, out: Path, bearings=BEARINGS, options=()) -> dict[str, Path]:
+    """The FMUs of ``revision`` (of ``bearings``), built by that revision's own build_fmu.py from a git worktree
+    (with its command-line ``options``, e.g. ``("--no-numba",)``)."""
     tree = out / "baseline_tree"
     subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), revision], check=True,
                    capture_output=True)
@@ -175,8 +176,8 @@ def build_baseline(revision: str, out: Path, bearings=BEARINGS) -> dict[str, Pat
         fmus = {}
         for name in bearings:
             fmus[name] = out / f"baseline_{name}.fmu"
-            subprocess.run([sys.executable, "build_fmu.py", f"examples/bearings/{name}.toml", "-o", str(fmus[name])],
-                           cwd=tree, check=True, capture_output=True)
+            subprocess.run([sys.executable, "build_fmu.py", f"examples/bearings/{name}.toml", "-o", str(fmus[name]),
+                            *options], cwd=tree, check=True, capture_output=True)
         return fmus
     finally:
         subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)

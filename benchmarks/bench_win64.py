@@ -11,8 +11,13 @@ Linux and the wine runs alternating so that both see the same machine load. A ru
 out. Wine is not Windows: its timings say what the win64 half costs under wine on this machine, not on a
 Windows desktop.
 
+``--baseline REV``: instead of the two builds, this tree's ``--no-numba`` FMU against REV's (built by
+REV's own build_fmu.py from a git worktree), both halves of each, alternating: what a change did to numpy's
+loops, the win64 half's. ``--busy N``: N processes that only spin run beside the timed runs (and end with
+them), as a user's pitch system shares the cores with its other FMUs.
+
 Run (root, with wine and mingw-w64: ``make`` installs them):
-    .venv/bin/python benchmarks/bench_win64.py [--steps 1000] [--runs 3]
+    .venv/bin/python benchmarks/bench_win64.py [--steps 1000] [--runs 3] [--baseline REV] [--busy 2]
 """
 from __future__ import annotations
 
@@ -75,7 +80,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=1000)
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--baseline", help="git revision whose --no-numba FMU this tree's is compared with")
+    parser.add_argument("--busy", type=int, default=0, help="processes that spin beside the timed runs")
     args = parser.parse_args()
+    if args.steps < WARM + 1 or args.runs < 1 or args.busy < 0:
+        parser.error(f"--steps must be > {WARM}, --runs >= 1, --busy >= 0")
     if w.missing_tools():
         sys.exit(w.missing_tools())
     from fmpy import read_model_description
@@ -89,9 +98,18 @@ def main() -> None:
         inputs = tmp / "inputs.txt"
         np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
         built, size_rows = {}, []
-        for name, variant in VARIANTS.items():
-            fmu = tmp / f"pitch_{variant['numba']}.fmu"
-            build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", fmu, **variant)
+        variants = VARIANTS
+        if args.baseline:
+            from bench_fmu import build_baseline
+
+            variants = {"--no-numba, this tree": {"numba": False}, f"--no-numba, {args.baseline}": None}
+            baseline_fmu = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",), options=("--no-numba",))
+        for index, (name, variant) in enumerate(variants.items()):
+            fmu = tmp / f"pitch_{index}.fmu"
+            if variant is None:
+                baseline_fmu["pitch_bearing"].rename(fmu)
+            else:
+                build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", fmu, **variant)
             folder = tmp / fmu.stem
             with zipfile.ZipFile(fmu) as z:
                 z.extractall(folder)
@@ -105,32 +123,43 @@ def main() -> None:
                               f"{s['win64'][0] / 1e6:.1f} MB / {s['win64'][1] / 1e6:.0f} MB",
                               f"{s['shared'][0] / 1e6:.1f} MB / {s['shared'][1] / 1e6:.0f} MB",
                               f"{(s['shared'][0] + s['linux'][0]) / 1e6:.1f} MB"])
-        times = {(n, p): [] for n in VARIANTS for p in hosts}
-        starts = {(n, p): [] for n in VARIANTS for p in hosts}
+        times = {(n, p): [] for n in variants for p in hosts}
+        starts = {(n, p): [] for n in variants for p in hosts}
         finals = {}
-        for _ in range(args.runs):
-            for name in VARIANTS:
-                for platform, host in hosts.items():          # interleaved: Linux, wine, Linux, wine...
-                    folder, refs = built[name]
-                    instantiation, steps, final = run(platform, host, folder, refs, inputs, case.parameters)
-                    starts[name, platform].append(instantiation)
-                    times[name, platform].append(steps[WARM:])
-                    finals[name, platform] = final
+        busy = [subprocess.Popen([sys.executable, "-c", "import time\nend = time.time() + 3600\n"
+                                  "while time.time() < end: pass"]) for _ in range(args.busy)]
+        try:
+            for _ in range(args.runs):
+                for name in variants:
+                    for platform, host in hosts.items():          # interleaved: Linux, wine, Linux, wine...
+                        folder, refs = built[name]
+                        instantiation, steps, final = run(platform, host, folder, refs, inputs, case.parameters)
+                        starts[name, platform].append(instantiation)
+                        times[name, platform].append(steps[WARM:])
+                        finals[name, platform] = final
+        finally:
+            for process in busy:
+                process.kill()
+                process.wait()
     print(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU and platform, "
-          "our C host (Linux: PATH=/usr/bin:/bin; win64: mingw build under wine 8)")
+          "our C host (Linux: PATH=/usr/bin:/bin; win64: mingw build under wine 8)"
+          + (f"; {args.busy} spinning processes beside the runs" if args.busy else ""))
     print_table("The FMU's halves: zipped / unpacked", ["FMU", "zipped", "Linux half", "win64 half",
                                                        "model files", "zipped without win64"], size_rows)
     rows = []
-    for name in VARIANTS:
+    last = list(variants)[-1]
+    for name in variants:
         for platform in hosts:
             t = np.concatenate(times[name, platform]) * 1e3
+            against = np.median(t) / np.median(np.concatenate(times[last, platform]) * 1e3)
             rows.append([name, "Linux" if platform == "linux" else "win64 under wine", "numba" if
-                         (platform == "linux" and VARIANTS[name]["numba"]) else "numpy",
+                         (platform == "linux" and (variants[name] or {}).get("numba")) else "numpy",
                          f"{np.median(starts[name, platform]):.2f} s", f"{np.median(t):.2f} ms",
-                         f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms"])
+                         f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms", f"{against:.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",
-                ["FMU", "platform", "loops", "instantiation", "median", "95th pct", "99th pct"], rows)
-    for name in VARIANTS:
+                ["FMU", "platform", "loops", "instantiation", "median", "95th pct", "99th pct",
+                 f"median / {last}'s on that platform"], rows)
+    for name in variants:
         a, b = np.array(finals[name, "linux"]), np.array(finals[name, "win64"])
         print(f"{name}: final outputs, win64 under wine against Linux: largest relative difference "
               f"{np.max(np.abs(a - b) / np.maximum(np.abs(a), 1e-300)):.1e}")
