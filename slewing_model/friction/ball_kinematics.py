@@ -419,7 +419,7 @@ class ContactPoints:
     def _points_eps2(self, eps2, shape):
         """``eps2`` (C, 1) spread over the points (C, I), kept while ``eps2`` is the same array: added to
         the (K, C, I) speeds it is one pass over them, where the column took an inner loop of I points per
-        contact (60 against 25 us a pass, pitch bearing: C = 372, I = 20, K = 5)."""
+        contact (arrays of (5, 372, 20): 47-60 us a pass with the column, 24 us spread)."""
         kept = getattr(self, "_eps2", None)
         if kept is None or kept[0] is not eps2 or kept[1].shape != shape:
             kept = self._eps2 = (eps2, np.ascontiguousarray(np.broadcast_to(eps2, shape)))
