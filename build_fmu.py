@@ -41,8 +41,8 @@ from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
-              runtime="standalone", numba=None, aot=False, win64=True, stage=None, runtime_python=None,
-              export_library=None) -> Path:
+              runtime="standalone", numba=None, aot=False, win64=True, win64_numba=False, stage=None,
+              runtime_python=None, export_library=None) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
     Parameters
@@ -72,7 +72,13 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         numba's cache at instantiation. Default False; not with ``numba=True``.
     win64 : bool
         Also carry a standalone Windows binary (``binaries/win64``, FMI 3.0 ``binaries/x86_64-windows``:
-        :mod:`build_win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops.
+        :mod:`build_win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops,
+        unless ``win64_numba``.
+    win64_numba : bool
+        The win64 half carries numba too, and the loops compiled for a generic x86-64 Windows CPU (under
+        wine, here: :func:`build_win64.compile_kernels`, about three minutes once per version of the
+        loops): its steps as fast as the Linux half's instead of numpy's, for about 45 MB more zipped.
+        Default False; needs ``numba``, ``win64`` and wine.
     stage : callable, optional
         Called with one line as each stage of the build begins (e.g. ``print``): the build is
         silent for minutes otherwise on a fresh machine (the superelement, numba's compilation).
@@ -92,6 +98,10 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         raise ValueError("aot = True and numba = True: an FMU carries its loops compiled ahead of time or numba, "
                          "not both")
     numba = False if aot else resolve_numba(runtime, numba)
+    if win64_numba and not (numba and win64 and runtime == "standalone"):
+        raise ValueError(f"win64_numba = True needs numba, win64 and a standalone runtime (numba = {numba}, "
+                         f"win64 = {win64}, runtime = {runtime!r}): the win64 half shares the Linux half's "
+                         "numba cache")
     if export_library is not None and fmi_version != 2:
         raise ValueError("export_library is pythonfmu's FMI 2.0 library: for FMI 3.0 pythonfmu3's own is used "
                          "(it needs glibc 2.14 and GCC 5's libstdc++ already)")
@@ -140,12 +150,15 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
             )
     install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64,
-                        stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
+                        win64_numba=win64_numba, stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
                         export_library=export_library)
     if numba:
         say("compiling the loops with numba for this CPU and for any x86-64 CPU (about two minutes the "
             "first time on a machine, then read from numba's cache) ...")
-        ship_compiled_kernels(built)
+        if win64_numba:
+            say("... and for a generic x86-64 Windows CPU under wine (about three minutes the first time, "
+                "then read from its cache) ...")
+        ship_compiled_kernels(built, win64=win64_numba)
     return Path(built)
 
 
@@ -172,24 +185,11 @@ def resolve_numba(runtime: str, numba=None) -> bool:
     return bool(numba)
 
 
-def ship_compiled_kernels(fmu) -> list[Path]:
-    """Add numba's cache of the compiled loops (friction, contacts) to the FMU's copy of ``slewing_model``.
-
-    An instance compiles the loops when it starts (:func:`slewing_model.friction.kernel.compile_all`),
-    about a minute, unless numba's cache beside the source holds them for this CPU: numba keys
-    that cache by the source's content (not its path or time), numba's version and the CPU. The
-    loops are compiled (or loaded) here twice, in the ``__pycache__`` beside each kernel: for this machine's
-    CPU, and in a child process with ``NUMBA_CPU_NAME=generic`` for any x86-64 CPU; the FMU takes
-    the generic ones on another CPU (``fmu_src/bearing_variables.kernels_of``, which reads this
-    CPU's name and features from ``resources/numba_target.txt``, written here). The entry points'
-    files are added to the same folders below ``resources/slewing_model`` (pythonfmu leaves ``__pycache__``
-    folders out), with this machine's paths in their error texts overwritten. Nothing when numba
-    is not installed (the FMU then runs its numpy code). Returns the files added."""
+def compiled_kernel_files() -> tuple[Path, list[Path]]:
+    """The loops compiled (or loaded from numba's cache) for this CPU and, in a child process, for a
+    generic x86-64 CPU: (the ``slewing_model`` folder, the cache files of its loops beside their
+    sources). What :func:`ship_compiled_kernels` ships; numba must be installed."""
     from slewing_model.friction import kernel as friction_kernel
-
-    if not friction_kernel.AVAILABLE:
-        return []
-    import llvmlite.binding as llvm
 
     friction_kernel.compile_all()
     generic = subprocess.run([sys.executable, "-c", "from slewing_model.friction import kernel; "
@@ -208,9 +208,39 @@ def ship_compiled_kernels(fmu) -> list[Path]:
     if not files:
         warnings.warn(f"numba's cache of the compiled loops is not in {', '.join(map(str, caches))} (NUMBA_CACHE_DIR "
                       "set, or the folder not writable): the FMU will compile them when instantiated (about a minute)")
+    return package, files
+
+
+def ship_compiled_kernels(fmu, win64: bool = False) -> list[Path]:
+    """Add numba's cache of the compiled loops (friction, contacts) to the FMU's copy of ``slewing_model``.
+
+    An instance compiles the loops when it starts (:func:`slewing_model.friction.kernel.compile_all`),
+    about a minute, unless numba's cache beside the source holds them for this CPU: numba keys
+    that cache by the source's content (not its path or time), numba's version and the CPU. The
+    loops are compiled (or loaded) here twice, in the ``__pycache__`` beside each kernel: for this machine's
+    CPU, and in a child process with ``NUMBA_CPU_NAME=generic`` for any x86-64 CPU; the FMU takes
+    the generic ones on another CPU (``fmu_src/bearing_variables.kernels_of``, which reads this
+    CPU's name and features from ``resources/numba_target.txt``, written here). The entry points'
+    files are added to the same folders below ``resources/slewing_model`` (pythonfmu leaves ``__pycache__``
+    folders out), with this machine's paths in their error texts overwritten. With ``win64``
+    (``--win64-numba``) the same files also hold the loops compiled for Windows
+    (:func:`build_win64.merged_cache`). Nothing when numba is not installed (the FMU then runs its
+    numpy code). Returns the files added."""
+    from slewing_model.friction import kernel as friction_kernel
+
+    if not friction_kernel.AVAILABLE:
+        return []
+    import llvmlite.binding as llvm
+
+    package, files = compiled_kernel_files()
     paths = building_machine_paths()
     with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as archive, \
             tempfile.TemporaryDirectory(prefix="slewing_cache_") as tmp:
+        if win64:           # the same cache files with the Windows entries beside the Linux ones
+            import build_win64
+
+            merged = Path(tmp) / "merged" / "slewing_model"
+            files, package = build_win64.merged_cache(package, files, merged), merged
         for f in files:
             # the compiled code's error texts name the sources it was compiled from: overwritten with
             # '/' (numba checks the source's hash, numba's version and the CPU, not these texts)
@@ -298,7 +328,8 @@ def python_runtime() -> dict[str, str]:
 
 
 def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False, win64=True,
-                        stage=None, extra_needs=(), runtime_python=None, export_library=None) -> dict:
+                        win64_numba=False, stage=None, extra_needs=(), runtime_python=None,
+                        export_library=None) -> dict:
     """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
     for a standalone FMU the Python runtime beside it.
 
@@ -353,10 +384,11 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                     import build_win64
 
                     say("adding the Windows (win64) binary: our layer cross-compiled with mingw-w64, the "
-                        "embeddable CPython and numpy (read from its cache when staged before) ...")
+                        f"embeddable CPython and numpy{', numba' if win64_numba else ''} (read from its cache when "
+                        "staged before) ...")
                     with zipfile.ZipFile(fmu) as stock:
                         windows = build_win64.windows_entries(stock, model_identifier, fmi_version, tmp)
-                    base, win = build_win64.merged_archive(carried.archive, fmi_version)
+                    base, win = build_win64.merged_archive(carried.archive, fmi_version, numba=win64_numba)
                     described.update({"platforms": "linux64 win64", "win64_version": win["version"],
                                       "win64_library": win["library"], "win64_packages": win["packages"]})
                 shutil.copy2(base, rewritten)        # the runtimes' entries, compressed once
@@ -419,7 +451,8 @@ def describe_fmu(fmu) -> str:
     floor = f"Linux x86-64 with glibc {r['glibc']} or newer (check: ldd --version)"
     if r.get("runtime") == "standalone":
         windows = (f" Windows: 64-bit Windows 10 or 11 (8.1 with its Universal C Runtime update), nothing else (it carries Python {r['win64_version']} "
-                   f"with {r['win64_packages'].replace(' ', ', ')} and the Visual C++ runtime; numpy's loops; "
+                   f"with {r['win64_packages'].replace(' ', ', ')} and the Visual C++ runtime; "
+                   f"{'numba' if 'numba' in r['win64_packages'] else 'numpy'}'s loops; "
                    "tested under wine, not on Windows)." if r.get("win64_version") else " No standalone Windows binary.")
         return (f"standalone FMU: it carries Python {r['version']} with {r['packages'].replace(' ', ', ')}; "
                 f"the target needs {floor}, and no Python.{windows}")
@@ -444,6 +477,10 @@ def main(argv=None) -> int:
     parser.add_argument("--aot", action="store_true",
                         help="carry the loops compiled ahead of time (build_aot.py) instead of numba: the same "
                              "numbers and step time, about a quarter of the size, no JIT at instantiation")
+    parser.add_argument("--win64-numba", action="store_true",
+                        help="the win64 half carries numba and the loops compiled under wine for a generic x86-64 "
+                             "Windows CPU (about 45 MB more zipped; needs wine; three minutes once per version of "
+                             "the loops): steps as fast as the Linux half's instead of numpy's")
     parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
                         help="carry a standalone Windows (win64) binary beside the Linux one, built here with "
                              "mingw-w64 from PyPI's embeddable CPython and numpy (default: yes; --no-win64 leaves it out)")
@@ -475,7 +512,8 @@ def main(argv=None) -> int:
                                       ("export_library", args.pythonfmu_export)) if v})
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
                      fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba, aot=args.aot,
-                     win64=args.win64, stage=lambda line: print(line, flush=True), **lowered)
+                     win64=args.win64, win64_numba=args.win64_numba, stage=lambda line: print(line, flush=True),
+                     **lowered)
     print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")
     print(describe_fmu(path))
     return 0

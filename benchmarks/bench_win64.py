@@ -11,13 +11,16 @@ Linux and the wine runs alternating so that both see the same machine load. A ru
 out. Wine is not Windows: its timings say what the win64 half costs under wine on this machine, not on a
 Windows desktop.
 
-``--baseline REV``: instead of the two builds, this tree's ``--no-numba`` FMU against REV's (built by
+``--win64-numba``: a third build, the default with ``--win64-numba`` (its win64 half runs numba's loops,
+compiled under wine at build time).
+
+``--baseline REV``: instead of the builds, this tree's ``--no-numba`` FMU against REV's (built by
 REV's own build_fmu.py from a git worktree), both halves of each, alternating: what a change did to numpy's
 loops, the win64 half's. ``--busy N``: N processes that only spin run beside the timed runs (and end with
 them), as a user's pitch system shares the cores with its other FMUs.
 
 Run (root, with wine and mingw-w64: ``make`` installs them):
-    .venv/bin/python benchmarks/bench_win64.py [--steps 1000] [--runs 3] [--baseline REV] [--busy 2]
+    .venv/bin/python benchmarks/bench_win64.py [--steps 1000] [--runs 3] [--win64-numba] [--baseline REV] [--busy 2]
 """
 from __future__ import annotations
 
@@ -82,6 +85,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--baseline", help="git revision whose --no-numba FMU this tree's is compared with")
     parser.add_argument("--busy", type=int, default=0, help="processes that spin beside the timed runs")
+    parser.add_argument("--win64-numba", action="store_true", help="also the default FMU built with --win64-numba")
     args = parser.parse_args()
     if args.steps < WARM + 1 or args.runs < 1 or args.busy < 0:
         parser.error(f"--steps must be > {WARM}, --runs >= 1, --busy >= 0")
@@ -98,14 +102,16 @@ def main() -> None:
         inputs = tmp / "inputs.txt"
         np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
         built, size_rows = {}, []
-        variants = VARIANTS
+        variants = dict(VARIANTS)
+        if args.win64_numba:
+            variants["--win64-numba (numba on both)"] = {"numba": True, "win64_numba": True}
         if args.baseline:
             from bench_fmu import build_baseline
 
             variants = {"--no-numba, this tree": {"numba": False}, f"--no-numba, {args.baseline}": None}
             baseline_fmu = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",), options=("--no-numba",))
         for index, (name, variant) in enumerate(variants.items()):
-            fmu = tmp / f"pitch_{index}.fmu"
+            fmu = tmp / f"pitch_{index}.fmu"             # (one folder each: unpacked below)
             if variant is None:
                 baseline_fmu["pitch_bearing"].rename(fmu)
             else:
@@ -147,13 +153,14 @@ def main() -> None:
     print_table("The FMU's halves: zipped / unpacked", ["FMU", "zipped", "Linux half", "win64 half",
                                                        "model files", "zipped without win64"], size_rows)
     rows = []
-    last = list(variants)[-1]
+    last = list(variants)[-1] if args.baseline else list(variants)[0]      # the ratios' baseline
     for name in variants:
         for platform in hosts:
             t = np.concatenate(times[name, platform]) * 1e3
             against = np.median(t) / np.median(np.concatenate(times[last, platform]) * 1e3)
+            variant = variants[name] or {}
             rows.append([name, "Linux" if platform == "linux" else "win64 under wine", "numba" if
-                         (platform == "linux" and (variants[name] or {}).get("numba")) else "numpy",
+                         variant.get("win64_numba" if platform == "win64" else "numba") else "numpy",
                          f"{np.median(starts[name, platform]):.2f} s", f"{np.median(t):.2f} ms",
                          f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms", f"{against:.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",

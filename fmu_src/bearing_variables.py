@@ -174,7 +174,8 @@ def kernels_of(resources: str) -> str:
     CPU and for a generic x86-64 CPU. On another CPU, numba would not find this CPU's loops
     and compile them all at instantiation (about a minute, in every freshly unpacked copy):
     there ``NUMBA_CPU_NAME=generic`` is set before numba is imported, so that it takes the
-    generic ones (about 10-25 % slower steps), unless the user set it."""
+    generic ones (about 10-25 % slower steps), unless the user set it. On Windows (a win64 half built
+    with ``--win64-numba``) the cache holds the generic loops only: it is set there always."""
     import os
 
     path = os.path.join(resources, KERNELS_FILE)
@@ -183,7 +184,9 @@ def kernels_of(resources: str) -> str:
     with open(path) as fh:
         kernels = fh.read().strip() or "auto"
     target = os.path.join(resources, NUMBA_TARGET_FILE)
-    if kernels != "numpy" and os.path.exists(target) and "numba" not in sys.modules \
+    if kernels != "numpy" and os.name == "nt" and "numba" not in sys.modules and "NUMBA_CPU_NAME" not in os.environ:
+        os.environ["NUMBA_CPU_NAME"] = "generic"
+    elif kernels != "numpy" and os.path.exists(target) and "numba" not in sys.modules \
             and "NUMBA_CPU_NAME" not in os.environ:
         with open(target) as fh:
             built_for = fh.read().split()
@@ -202,8 +205,10 @@ def numba_target() -> str:
     """For the log: the CPU the compiled loops run for."""
     import os
 
-    return ("a generic x86-64 CPU (this CPU is not the building machine's)"
-            if os.environ.get("NUMBA_CPU_NAME") == "generic" else "this CPU")
+    if os.environ.get("NUMBA_CPU_NAME") == "generic":
+        return ("a generic x86-64 CPU (Windows)" if os.name == "nt"
+                else "a generic x86-64 CPU (this CPU is not the building machine's)")
+    return "this CPU"
 
 
 def build_simulator(slave, error) -> bool:

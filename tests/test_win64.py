@@ -28,6 +28,7 @@ import os
 import shutil
 import subprocess
 import sys
+import time
 import zipfile
 from pathlib import Path
 
@@ -175,6 +176,53 @@ def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(
         assert got.shape == expected.shape
         for k in range(STEPS):
             assert got[k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
+
+
+@pytest.fixture(scope="module")
+def numba_fmu(tmp_path_factory):
+    """table3_fmu's bearing built with ``--win64-numba``: both halves with numba's loops (the Windows ones
+    compiled under wine at build time, kept beside the tests' wine prefix once per version of the loops).
+    That compilation takes 3-4 minutes under wine: until it is kept, the test is skipped, saying so (run
+    tests/win64/run_all.sh, or set SLEWING_BUILD_WIN64_NUMBA=1)."""
+    sys.path.insert(0, str(ROOT))
+    import build_win64
+    from build_fmu import build_fmu, compiled_kernel_files
+
+    kept = {"SLEWING_WIN64_BUILD_DIR": str(w.WINE_DIR / "build"), "WINEPREFIX": str(w.PREFIX)}
+    with pytest.MonkeyPatch.context() as patch:
+        for name, value in kept.items():
+            patch.setenv(name, value)
+        if not (build_win64.kernels_folder(compiled_kernel_files()[0]) / "slewing_model").exists() \
+                and not os.environ.get("SLEWING_BUILD_WIN64_NUMBA"):
+            pytest.skip(f"SKIPPED: the loops for --win64-numba are not compiled under wine yet (3-4 minutes, kept "
+                        f"in {kept['SLEWING_WIN64_BUILD_DIR']}): run tests/win64/run_all.sh, or set "
+                        "SLEWING_BUILD_WIN64_NUMBA=1")
+        return build_fmu(ROOT / "examples" / "bearings" / "table3.toml",
+                         tmp_path_factory.mktemp("numba") / "t3.fmu", mesh="coarse", numba=True, win64_numba=True)
+
+
+def test_a_win64_half_with_numba_runs_the_compiled_loops_from_its_cache_under_wine(numba_fmu, hosts, tmp_path):
+    """``--win64-numba``: our C host under wine loads the FMU, whose log says the loops are compiled by
+    numba (for a generic x86-64 CPU, from the FMU's numba cache: an instantiation that compiled them would
+    take minutes under wine), and its outputs are the Linux half's (fmpy on Linux) within REL. The
+    second run of an unpacked copy is timed too: numba writes nothing it lacked."""
+    expected = reference("bearing2", numba_fmu)
+    folder = w.unpack(numba_fmu, tmp_path / "fmu")
+    with zipfile.ZipFile(numba_fmu) as z:
+        names = z.namelist()
+    assert any(n.startswith("binaries/win64/python/Lib/site-packages/numba/") for n in names)
+    assert any(n.endswith("llvmlite.dll") for n in names)
+    for run_index in range(2):
+        start = time.perf_counter()
+        run = run_c_host(hosts[2], numba_fmu, "bearing2", folder)
+        seconds = time.perf_counter() - start
+        assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), \
+            f"run {run_index}: exit {run.returncode}\n{run.stdout[-3000:]}{run.stderr[-3000:]}"
+        values, _, logs, _ = parse_host_output(run.stdout)
+        assert any("loops compiled by numba for a generic x86-64 CPU (Windows)" in m for _, _, m in logs), logs
+        assert seconds < 90, f"run {run_index}: {seconds:.0f} s (numba compiled the loops at instantiation?)"
+        for k in range(STEPS):
+            assert values["run"][k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
 
 
 BLAS_THREADS = r"""

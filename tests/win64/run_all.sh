@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The win64 tests in full (tests/test_win64.py): 5 runs per FMU and host, fmusim for mingw built first (about
-# 5 minutes the first time, kept in /var/cache/slewing-wine). As root, after `make .venv/.installed`; about
-# 10 minutes on 2 cores with fmusim built.
+# 5 minutes the first time, kept in /var/cache/slewing-wine), and the loops of --win64-numba compiled under
+# wine (3-4 minutes the first time per version of the loops, kept in /var/cache/slewing-wine/build). As
+# root, after `make .venv/.installed`; about 10 minutes on 2 cores with both built.
 #   bash tests/win64/run_all.sh [pytest options]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-SLEWING_WINE_RUNS=${SLEWING_WINE_RUNS:-5} SLEWING_BUILD_FMUSIM=1 nice -n 10 .venv/bin/python -m pytest -q tests/test_win64.py "$@"
+SLEWING_WINE_RUNS=${SLEWING_WINE_RUNS:-5} SLEWING_BUILD_FMUSIM=1 SLEWING_BUILD_WIN64_NUMBA=1 nice -n 10 .venv/bin/python -m pytest -q tests/test_win64.py "$@"
