@@ -89,14 +89,14 @@ _references = {}
 
 
 def reference(case, fmu) -> np.ndarray:
-    """Outputs of the first STEPS steps, fmpy on Linux (this machine's Python)."""
-    if case not in _references:
+    """Outputs of the first STEPS steps of ``fmu``, fmpy on Linux (this machine's Python); once per FMU."""
+    if (case, str(fmu)) not in _references:
         _, _, inputs, outputs = CASES[case]
         run = subprocess.run([sys.executable, str(FMPY_STEPS), str(fmu), str(STEPS), ",".join(inputs),
                               ",".join(outputs)], capture_output=True, text=True, timeout=300)
         assert run.returncode == 0, run.stderr[-3000:]
-        _references[case] = parse_steps(run.stdout)
-    return _references[case]
+        _references[case, str(fmu)] = parse_steps(run.stdout)
+    return _references[case, str(fmu)]
 
 
 def refs_of(fmu):
@@ -180,7 +180,7 @@ def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(
 
 @pytest.fixture(scope="module")
 def numba_fmu(tmp_path_factory):
-    """table3_fmu's bearing built with ``--win64-numba``: both halves with numba's loops (the Windows ones
+    """table3_fmu's bearing (with its ring errors) built with ``--win64-numba``: both halves with numba's loops (the Windows ones
     compiled under wine at build time, kept beside the tests' wine prefix once per version of the loops).
     That compilation takes 3-4 minutes under wine: until it is kept, the test is skipped, saying so (run
     tests/win64/run_all.sh, or set SLEWING_BUILD_WIN64_NUMBA=1)."""
@@ -197,7 +197,7 @@ def numba_fmu(tmp_path_factory):
             pytest.skip(f"SKIPPED: the loops for --win64-numba are not compiled under wine yet (3-4 minutes, kept "
                         f"in {kept['SLEWING_WIN64_BUILD_DIR']}): run tests/win64/run_all.sh, or set "
                         "SLEWING_BUILD_WIN64_NUMBA=1")
-        return build_fmu(ROOT / "examples" / "bearings" / "table3.toml",
+        return build_fmu(ROOT / "examples" / "bearings" / "table3_errors.toml",
                          tmp_path_factory.mktemp("numba") / "t3.fmu", mesh="coarse", numba=True, win64_numba=True)
 
 
