@@ -238,6 +238,24 @@ def wine_prefix() -> Path:
     return Path(os.environ.get("WINEPREFIX") or _build_base() / "wine-prefix")
 
 
+def wine_env(prefix) -> dict:
+    """The environment wine programs run in: this machine's PATH, the wine ``prefix``, no debug output."""
+    return {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/root"), "WINEPREFIX": str(prefix),
+            "WINEDEBUG": "-all", "WINEDLLOVERRIDES": "mscoree,mshtml=", "LANG": "C.UTF-8"}
+
+
+def wine(command, prefix=None, timeout=600, env=None) -> subprocess.CompletedProcess:
+    """Run a Windows program (``command``: the program and its arguments) under wine in ``prefix`` (default
+    :func:`wine_prefix`, made with ``wineboot`` when missing), with ``env`` added; its output piped (text:
+    CPython's stdio breaks under wine when it writes to a file directly)."""
+    prefix = Path(prefix) if prefix else wine_prefix()
+    if not (prefix / "system.reg").exists():
+        prefix.parent.mkdir(parents=True, exist_ok=True)
+        subprocess.run(["wineboot", "-i"], env=wine_env(prefix), capture_output=True, timeout=600)
+    return subprocess.run(["wine", *map(str, command)], env={**wine_env(prefix), **(env or {})}, capture_output=True,
+                          text=True, timeout=timeout, errors="replace")
+
+
 def windows_path(path) -> str:
     """``path`` under wine's Z: drive (the Linux root)."""
     return "Z:" + str(Path(path)).replace("/", "\\")
@@ -280,7 +298,6 @@ def compile_kernels(package: Path, cache_dir=None) -> Path:
     overwritten with ``\\``. RuntimeError, with wine's output, when the compilation fails or wine is
     missing."""
     package = Path(package)
-    sources = sorted(package.rglob("*.py"))
     done = kernels_folder(package, cache_dir)
     cache = done.parent
     if (done / "slewing_model").exists():
@@ -292,19 +309,11 @@ def compile_kernels(package: Path, cache_dir=None) -> Path:
     cache.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="slewing_winkernels_", dir=cache) as tmp:
         copy = Path(tmp) / "slewing_model"
-        for f in sources:
+        for f in sorted(package.rglob("*.py")):
             target = copy / f.relative_to(package)
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(f, target)
-        prefix = wine_prefix()
-        env = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/root"), "WINEPREFIX": str(prefix),
-               "WINEDEBUG": "-all", "WINEDLLOVERRIDES": "mscoree,mshtml=", "LANG": "C.UTF-8",
-               "NUMBA_CPU_NAME": "generic"}
-        if not (prefix / "system.reg").exists():
-            prefix.parent.mkdir(parents=True, exist_ok=True)
-            subprocess.run(["wineboot", "-i"], env=env, capture_output=True, timeout=600)
-        run = subprocess.run(["wine", str(python), "-c", _COMPILE, windows_path(tmp)], env=env, capture_output=True,
-                             text=True, errors="replace", timeout=3600)
+        run = wine([python, "-c", _COMPILE, windows_path(tmp)], timeout=3600, env={"NUMBA_CPU_NAME": "generic"})
         if run.returncode != 0 or "compiled" not in run.stdout:
             raise RuntimeError(f"compiling the loops for win64 under wine failed (exit {run.returncode}):\n"
                                f"{run.stdout[-2000:]}\n{run.stderr[-3000:]}")

@@ -89,6 +89,8 @@ def main() -> None:
     args = parser.parse_args()
     if args.steps < WARM + 1 or args.runs < 1 or args.busy < 0:
         parser.error(f"--steps must be > {WARM}, --runs >= 1, --busy >= 0")
+    if args.baseline and args.win64_numba:
+        parser.error("--baseline compares the --no-numba FMUs: not with --win64-numba")
     if w.missing_tools():
         sys.exit(w.missing_tools())
     from fmpy import read_model_description
@@ -153,11 +155,11 @@ def main() -> None:
     print_table("The FMU's halves: zipped / unpacked", ["FMU", "zipped", "Linux half", "win64 half",
                                                        "model files", "zipped without win64"], size_rows)
     rows = []
-    last = list(variants)[-1] if args.baseline else list(variants)[0]      # the ratios' baseline
+    reference = list(variants)[-1] if args.baseline else list(variants)[0]      # the ratios' baseline
     for name in variants:
         for platform in hosts:
             t = np.concatenate(times[name, platform]) * 1e3
-            against = np.median(t) / np.median(np.concatenate(times[last, platform]) * 1e3)
+            against = np.median(t) / np.median(np.concatenate(times[reference, platform]) * 1e3)
             variant = variants[name] or {}
             rows.append([name, "Linux" if platform == "linux" else "win64 under wine", "numba" if
                          variant.get("win64_numba" if platform == "win64" else "numba") else "numpy",
@@ -165,7 +167,7 @@ def main() -> None:
                          f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms", f"{against:.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",
                 ["FMU", "platform", "loops", "instantiation", "median", "95th pct", "99th pct",
-                 f"median / {last}'s on that platform"], rows)
+                 f"median / {reference}'s on that platform"], rows)
     for name in variants:
         a, b = np.array(finals[name, "linux"]), np.array(finals[name, "win64"])
         print(f"{name}: final outputs, win64 under wine against Linux: largest relative difference "

