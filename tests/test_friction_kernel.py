@@ -416,3 +416,47 @@ def test_the_per_ball_sums_of_numpys_loops_add_each_balls_contacts(owner, n_ball
         got = ContactPoints._per_ball(points, values)
         assert got.shape == (9, n_balls) and np.allclose(got, want, rtol=1e-15, atol=1e-15)
     assert np.allclose(ContactPoints._per_ball(points, values[0]), want[0], rtol=1e-15, atol=1e-15)
+
+
+@pytest.mark.parametrize("case", range(3))
+def test_a_small_last_newton_step_taken_unchecked_changes_the_torque_by_round_off_only(case, monkeypatch):
+    """A converged ball's last Newton step is taken without evaluating the power at it where it is small
+    (``UNCHECKED_STEP``, which spares an evaluation of every ball a co-simulation step): cold, warm and
+    perturbed starts, and balls that run out of iterations, give the torque, power and ball states of the
+    loop that checks every such step, to round-off (the check refuses only steps of round-off)."""
+    from slewing_model.friction import ball_kinematics
+
+    bearing, distribution = _distributions()[case]
+    cold = friction_torque(bearing, distribution, kernel="numpy")
+    default = ball_kinematics.UNCHECKED_STEP
+    for start, most in ((None, 60), (cold.state * 1.01, 60), (cold.state * 1.3, 60), (cold.state * 1.3, 2)):
+        found = {}
+        for share in (default, 0.0):           # 0: every last step checked
+            monkeypatch.setattr(ball_kinematics, "UNCHECKED_STEP", share)
+            found[share] = friction_torque(bearing, distribution, kernel="numpy", initial=start,
+                                           max_iterations=most)
+        small, checked = found.values()
+        assert small.magnitude == pytest.approx(checked.magnitude, rel=1e-13)
+        assert small.power == pytest.approx(checked.power, rel=1e-13)
+        assert (small.iterations, small.converged) == (checked.iterations, checked.converged)
+        assert np.allclose(small.state, checked.state, rtol=1e-12, atol=1e-15 * np.abs(checked.state).max())
+
+
+@needs_numba
+def test_both_paths_take_the_last_newton_step_unchecked_alike():
+    """``_step_unchecked`` (the compiled loop's test of a small last step) decides as ``minimise_power``'s
+    numpy test does, also at its bound and with a NaN in the step or the unknowns."""
+    from slewing_model.friction import kernel
+
+    kernel.compile_all()                                 # the helper compiled in place
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal((400, 3))
+    step = x * np.exp(rng.uniform(-12.0, 2.0, (400, 1))) * rng.standard_normal((400, 3))
+    step[0] = kernel.UNCHECKED_STEP * np.abs(x[0]).max()            # at the bound: unchecked
+    step[1, 2], x[2, 0], x[3] = np.nan, np.nan, 0.0
+    step[3] = 0.0
+    numpy_test = np.abs(step).max(axis=1) <= kernel.UNCHECKED_STEP * np.abs(x).max(axis=1)
+    compiled = np.array([kernel._step_unchecked(s, u) for s, u in zip(step, x)])
+    assert np.array_equal(compiled, numpy_test)
+    assert compiled[0] and not compiled[1] and not compiled[2] and compiled[3]
+    assert 50 < compiled.sum() < 350                    # both outcomes met

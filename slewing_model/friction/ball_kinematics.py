@@ -27,7 +27,7 @@ from ..distribution.assembly import ball_diameters
 from .contact import conformity_radius
 from .ellipse_quadrature import EllipseQuadrature
 from .kernel import (
-    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, SINE_SERIES_LIMIT, WARM_ROLLING, _sine_series,
+    COLD_STEPS, GENERAL_PATH, NEGATIVE_LOAD, NO_ELLIPSE, SINE_SERIES_LIMIT, UNCHECKED_STEP, WARM_ROLLING, _sine_series,
     compiled_ball_results, compiled_contact_set,
     compiled_evaluate_points, compiled_friction_step, compiled_minimise_balls, compiled_point_coefficients,
     compiled_tractions,
@@ -615,9 +615,11 @@ def minimise_power(contacts: ContactPoints, u: np.ndarray, tol: float, max_itera
     a ball that carries almost nothing is not iterated to a relative accuracy
     that cannot show in the torque. That last Newton step is taken where it
     lowers the power (also by the converged balls when others run out of
-    iterations). When at most a quarter of the balls are left after
-    :data:`_STRAGGLERS_AFTER` iterations, they go on alone
-    (:meth:`ContactPoints.subset`), the others take that last step.
+    iterations), unchecked where it is small
+    (:data:`~slewing_model.friction.kernel.UNCHECKED_STEP`). When at most a
+    quarter of the balls are left after :data:`_STRAGGLERS_AFTER` iterations,
+    they go on alone (:meth:`ContactPoints.subset`), the others take that last
+    step.
 
     The floor fixed, every ball's iterates depend on its own contacts only: the
     compiled loop (``contacts.compiled``) solves ball after ball
@@ -640,9 +642,11 @@ def minimise_power(contacts: ContactPoints, u: np.ndarray, tol: float, max_itera
     def residual():
         return float(np.max(np.abs(g).max(axis=1) / scale))
 
-    def last_newton_step(done):                             # where it lowers the power
+    def last_newton_step(done):              # where it lowers the power, checked unless small (UNCHECKED_STEP)
         trial = np.where(done[:, None], u + newton, u)
-        keep = done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
+        keep = done & (np.abs(newton).max(axis=1) <= UNCHECKED_STEP * np.abs(u).max(axis=1))
+        if np.any(done & ~keep):
+            keep |= done & (contacts.evaluate(trial, eps2, derivatives=False)[0] <= f * (1.0 + 1e-12))
         return np.where(keep[:, None], trial, u)
 
     while True:
