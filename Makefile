@@ -38,13 +38,13 @@ demo: $(STAMP)
 
 # the test files run on TEST_WORKERS processes (pytest-xdist), a file's tests on one of them (its module
 # fixtures built once). numba's loops are compiled first, once, into its cache, which the tests then load:
-# for this CPU and, beside it, for a generic x86-64 one (what build_fmu.py adds to the FMU)
+# for this CPU and, side by side, for the CPUs build_fmu.py adds to the FMU (an x86-64-v3 one and any
+# x86-64: slewing_model/numerics/targets.py)
 TEST_WORKERS ?= 2
-COMPILE_LOOPS := from slewing_model.friction.kernel import compile_all; compile_all()
+COMPILE_LOOPS := import build_fmu; build_fmu.compiled_kernel_files()
 
 test: $(STAMP)
-	NUMBA_CPU_NAME=generic $(PY) -c "$(COMPILE_LOOPS)" & generic=$$!; \
-	$(PY) -c "$(COMPILE_LOOPS)" && wait $$generic
+	$(PY) -c "$(COMPILE_LOOPS)"
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
 # speed figures of the README (several minutes: the FMU memory run takes 100 000 steps)

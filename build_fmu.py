@@ -186,17 +186,22 @@ def resolve_numba(runtime: str, numba=None) -> bool:
 
 
 def compiled_kernel_files() -> tuple[Path, list[Path]]:
-    """The loops compiled (or loaded from numba's cache) for this CPU and, in a child process, for a
-    generic x86-64 CPU: (the ``slewing_model`` folder, the cache files of its loops beside their
-    sources). What :func:`ship_compiled_kernels` ships; numba must be installed."""
+    """The loops compiled (or loaded from numba's cache) for this CPU and, in child processes side by
+    side, for each of :data:`slewing_model.numerics.targets.PORTABLE_TARGETS` (an x86-64-v3 CPU, any
+    x86-64): (the ``slewing_model`` folder, the cache files of its loops beside their sources). What
+    :func:`ship_compiled_kernels` ships; numba must be installed."""
     from slewing_model.friction import kernel as friction_kernel
+    from slewing_model.numerics.targets import PORTABLE_TARGETS, target_environment
 
+    children = {name: subprocess.Popen([sys.executable, "-c", "from slewing_model.friction import kernel; "
+                                        "kernel.compile_all()"], env={**os.environ, **target_environment(name)},
+                                       cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                for name, _ in PORTABLE_TARGETS}
     friction_kernel.compile_all()
-    generic = subprocess.run([sys.executable, "-c", "from slewing_model.friction import kernel; "
-                              "kernel.compile_all()"], env={**os.environ, "NUMBA_CPU_NAME": "generic"},
-                             cwd=ROOT, capture_output=True, text=True)
-    if generic.returncode != 0:
-        raise RuntimeError(f"compiling the loops for a generic x86-64 CPU failed:\n{generic.stderr[-3000:]}")
+    for name, child in children.items():
+        _, error = child.communicate()
+        if child.returncode != 0:
+            raise RuntimeError(f"compiling the loops for the CPU {name} failed:\n{error[-3000:]}")
     tag = f"py{sys.version_info.major}{sys.version_info.minor}"      # numba adds the ABI flags (py311t)
     package = Path(friction_kernel.__file__).parents[1]                # slewing_model/
     caches = sorted({Path(function.__code__.co_filename).parent / "__pycache__"
@@ -217,10 +222,11 @@ def ship_compiled_kernels(fmu, win64: bool = False) -> list[Path]:
     An instance compiles the loops when it starts (:func:`slewing_model.friction.kernel.compile_all`),
     about a minute, unless numba's cache beside the source holds them for this CPU: numba keys
     that cache by the source's content (not its path or time), numba's version and the CPU. The
-    loops are compiled (or loaded) here twice, in the ``__pycache__`` beside each kernel: for this machine's
-    CPU, and in a child process with ``NUMBA_CPU_NAME=generic`` for any x86-64 CPU; the FMU takes
-    the generic ones on another CPU (``fmu_src/bearing_variables.kernels_of``, which reads this
-    CPU's name and features from ``resources/numba_target.txt``, written here). The entry points'
+    loops are compiled (or loaded) here, in the ``__pycache__`` beside each kernel, for this machine's
+    CPU and, in child processes, for an x86-64-v3 CPU and any x86-64 one
+    (:data:`slewing_model.numerics.targets.PORTABLE_TARGETS`); on another CPU the FMU takes the first of
+    those this CPU can run (``fmu_src/bearing_variables.kernels_of``, which reads the building CPU's name
+    and features from ``resources/numba_target.txt``, written here). The entry points'
     files are added to the same folders below ``resources/slewing_model`` (pythonfmu leaves ``__pycache__``
     folders out), with this machine's paths in their error texts overwritten. With ``win64``
     (``--win64-numba``) the same files also hold the loops compiled for Windows

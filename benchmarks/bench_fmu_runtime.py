@@ -1,12 +1,12 @@
 """The standalone FMU against the host FMU: zipped size, build time, instantiation, doStep.
 
-Three builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0),
+Four builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0),
 all made in this run by this checkout's ``build_fmu.py``:
 
 - ``host + numba``: ``--runtime host``, the FMU as it was before the standalone runtime (issue
   23): it runs in this machine's Python and venv, with numba and its shipped cache. The baseline.
-- ``standalone``: the default; it carries its Python and numpy, and runs the numpy loops.
-- ``standalone + numba``: ``--numba``; it also carries numba and llvmlite, and the compiled loops' cache.
+- ``standalone``: ``--no-numba``; it carries its Python and numpy, and runs the numpy loops.
+- ``standalone + numba``: the default; it also carries numba and llvmlite, and the compiled loops' cache.
 - ``standalone + aot``: ``--aot``; it carries the loops compiled ahead of time (``build_aot.py``)
   instead of numba: its cold build includes that compilation (the module's cache emptied).
 

@@ -170,14 +170,17 @@ def kernels_of(resources: str) -> str:
     without numba, so that the FMU computes the same numbers in every host, also in a Python
     host that has numba; "auto" where the file is missing.
 
-    For compiled loops, numba's cache in the FMU holds them twice: for the building machine's
-    CPU and for a generic x86-64 CPU. On another CPU, numba would not find this CPU's loops
-    and compile them all at instantiation (about a minute, in every freshly unpacked copy):
-    there ``NUMBA_CPU_NAME=generic`` is set before numba is imported, so that it takes the
-    generic ones (about 10-25 % slower steps), unless the user set it. On Windows, where the runtime
-    carries numba (a win64 half built with ``--win64-numba``), it is set always: the cache holds the
-    generic loops only."""
+    For compiled loops, numba's cache in the FMU holds them for the building machine's CPU and for
+    each of :data:`slewing_model.numerics.targets.PORTABLE_TARGETS` (an x86-64-v3 CPU: AVX2 and FMA;
+    any x86-64). On another CPU, numba would not find the building CPU's loops and compile them all
+    at instantiation (about a minute, in every freshly unpacked copy): there the first portable target
+    whose features this CPU has is set (``NUMBA_CPU_NAME``, ``NUMBA_CPU_FEATURES``) before numba is
+    imported, so that numba takes those loops (the generic ones: about 10-25 % slower steps), unless
+    the user set ``NUMBA_CPU_NAME``. On Windows, where the runtime carries numba (a win64 half built
+    with ``--win64-numba``), the generic loops are set always: its cache holds those only."""
     import os
+
+    from slewing_model.numerics.targets import portable_target, target_environment
 
     path = os.path.join(resources, KERNELS_FILE)
     if not os.path.exists(path):
@@ -191,18 +194,19 @@ def kernels_of(resources: str) -> str:
         import importlib.util
 
         if importlib.util.find_spec("numba") is not None:      # only a --win64-numba half carries it
-            os.environ["NUMBA_CPU_NAME"] = "generic"
+            os.environ.update(target_environment("generic"))
     elif os.path.exists(target):
         with open(target) as fh:
             built_for = fh.read().split()
         try:
             import llvmlite.binding as llvm
 
-            this_cpu = [llvm.get_host_cpu_name(), llvm.get_host_cpu_features().flatten()]
+            features = llvm.get_host_cpu_features()
+            this_cpu = [llvm.get_host_cpu_name(), features.flatten()]
         except Exception:       # no llvmlite (a host without numba): the numpy loops run anyway
             this_cpu = built_for
         if this_cpu != built_for:
-            os.environ["NUMBA_CPU_NAME"] = "generic"
+            os.environ.update(target_environment(portable_target(features)))
     return kernels
 
 
@@ -210,10 +214,11 @@ def numba_target() -> str:
     """For the log: the CPU the compiled loops run for."""
     import os
 
-    if os.environ.get("NUMBA_CPU_NAME") == "generic":
-        return ("a generic x86-64 CPU (Windows)" if os.name == "nt"
-                else "a generic x86-64 CPU (this CPU is not the building machine's)")
-    return "this CPU"
+    name = os.environ.get("NUMBA_CPU_NAME")
+    if name is None:
+        return "this CPU"
+    cpu = {"generic": "a generic x86-64 CPU", "x86-64-v3": "an x86-64-v3 CPU"}.get(name, f"the CPU {name}")
+    return cpu + (" (Windows)" if os.name == "nt" else " (this CPU is not the building machine's)")
 
 
 def build_simulator(slave, error) -> bool:

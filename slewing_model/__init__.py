@@ -28,7 +28,7 @@ RUNTIME_MODULES = ("__init__",
                    "distribution/bime",
                    "friction/__init__", "friction/ellipse_quadrature", "friction/contact", "friction/ball_kinematics",
                    "friction/kernel", "friction/catalogue", "friction/torque", "friction/studies",
-                   "numerics/__init__", "numerics/compiled", "numerics/blas",
+                   "numerics/__init__", "numerics/compiled", "numerics/blas", "numerics/targets",
                    "simulation/__init__", "simulation/simulator",
                    # rainflow is imported only by the life post-processing
                    "life/__init__", "life/rating", "life/oscillation", "life/raceway_map", "life/kernel", "life/wear",

@@ -125,7 +125,7 @@ def table3_fmu3(tmp_path_factory):
 @pytest.fixture(scope="session")
 def table3_numba_fmu(tmp_path_factory):
     """table3_fmu's bearing as build_fmu.py builds it by default where numba is installed: standalone,
-    with numba and its compiled loops (for this CPU and a generic x86-64)."""
+    with numba and its compiled loops (for this CPU, an x86-64-v3 one and a generic x86-64)."""
     from slewing_model.numerics import compiled
 
     if not compiled.AVAILABLE:
@@ -174,3 +174,15 @@ def symmetric_block_circulant(balls: int, seed: int = 0) -> np.ndarray:
     blocks = 0.5 * (blocks + blocks[(-np.arange(balls)) % balls].transpose(0, 2, 1))
     k = (np.arange(balls)[None, :] - np.arange(balls)[:, None]) % balls
     return blocks[k].transpose(0, 2, 1, 3).reshape(4 * balls, 4 * balls)
+
+
+def has_x86_64_v3() -> bool:
+    """Whether this CPU has the x86-64 psABI's level 3, read from the kernel's /proc/cpuinfo flags (not
+    from LLVM, which the FMU asks): AVX, AVX2, BMI1/2, F16C, FMA, LZCNT (abm), MOVBE, XSAVE and level 2's."""
+    flags = set()
+    for line in Path("/proc/cpuinfo").read_text().splitlines():
+        if line.startswith("flags"):
+            flags = set(line.split(":", 1)[1].split())
+            break
+    return {"avx", "avx2", "bmi1", "bmi2", "f16c", "fma", "abm", "movbe", "xsave", "cx16", "lahf_lm", "popcnt",
+            "pni", "sse4_1", "sse4_2", "ssse3"} <= flags

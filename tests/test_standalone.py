@@ -32,6 +32,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
+from conftest import has_x86_64_v3
 from host_output import parse_host_output
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -433,23 +434,28 @@ def test_the_default_build_carries_numba_and_runs_its_compiled_loops_in_a_bare_s
         assert values["replay"][k] == values["run"][k]
 
 
-def test_on_another_cpu_the_fmu_takes_its_generic_loops_instead_of_compiling(hosts, numba_fmu):
-    # another machine, simulated: the CPU the FMU names as its building one is not this one
+@pytest.mark.parametrize("user_cpu", [None, "generic"])
+def test_on_another_cpu_the_fmu_takes_its_portable_loops_instead_of_compiling(hosts, numba_fmu, user_cpu):
+    # another machine, simulated: the CPU the FMU names as its building one is not this one. The FMU takes
+    # its x86-64-v3 loops where this CPU has that level's features, else (or where the user set
+    # NUMBA_CPU_NAME=generic) its generic ones
     system = bare_system("trixie")
     shutil.copy2(hosts[2], system / "tmp" / hosts[2].name)
-    inside, token, vrs = place(numba_fmu, system, "fmu_other_cpu")
+    inside, token, vrs = place(numba_fmu, system, f"fmu_other_cpu_{user_cpu}")
     (system / inside.lstrip("/") / "resources" / "numba_target.txt").write_text("someothercpu +sse2\n")
     before = _cache_files(system, inside)
+    environment = [] if user_cpu is None else [f"NUMBA_CPU_NAME={user_cpu}"]
     started = __import__("time").perf_counter()
-    run = in_system(system, f"/tmp/{hosts[2].name}", inside, MODEL[2], token, "basic", *vrs)
+    run = in_system(system, *environment, f"/tmp/{hosts[2].name}", inside, MODEL[2], token, "basic", *vrs)
     elapsed = __import__("time").perf_counter() - started
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
-    assert "loops compiled by numba for a generic x86-64 CPU" in run.stdout
-    assert _cache_files(system, inside) == before        # numba compiled nothing: it found the generic loops
+    cpu = "an x86-64-v3 CPU" if user_cpu is None and has_x86_64_v3() else "a generic x86-64 CPU"
+    assert f"loops compiled by numba for {cpu}" in run.stdout
+    assert _cache_files(system, inside) == before        # numba compiled nothing: it found those loops
     reference = fmpy_steps(numba_fmu, 2, 6)
     rows = {int(line.split()[1]): [float(x) for x in line.split()[2:]] for line in run.stdout.splitlines()
             if line.startswith("run ")}
-    for k in range(6):  # other machine code (no AVX, no FMA): the same numbers to the solver's round-off
+    for k in range(6):  # other machine code (generic: no AVX, no FMA): the same numbers to the solver's round-off
         assert rows[k] == pytest.approx(reference[k], rel=1e-9, abs=1e-300), k
     assert elapsed < 30, f"{elapsed:.0f} s: compiling the loops takes about a minute"
 
