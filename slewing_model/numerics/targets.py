@@ -17,9 +17,9 @@ Run-time module: the standard library only (it runs before numba is imported).
 """
 from __future__ import annotations
 
-#: the features (LLVM's names) of the x86-64 psABI's level 3, beside those of its levels 1 and 2 that every
-#: CPU with these has: AVX, AVX2, BMI1, BMI2, F16C, FMA, LZCNT, MOVBE, XSAVE; and level 2's CMPXCHG16B,
-#: LAHF/SAHF, POPCNT, SSE3, SSE4.1, SSE4.2, SSSE3
+#: what the x86-64 psABI's level 3 adds to level 1 (every x86-64 CPU's), by LLVM's names: level 2's CMPXCHG16B,
+#: LAHF/SAHF, POPCNT, SSE3, SSE4.1, SSE4.2, SSSE3, and level 3's AVX, AVX2, BMI1, BMI2, F16C, FMA, LZCNT, MOVBE,
+#: XSAVE
 X86_64_V3_FEATURES = ("cx16", "sahf", "popcnt", "sse3", "sse4.1", "sse4.2", "ssse3",
                       "avx", "avx2", "bmi", "bmi2", "f16c", "fma", "lzcnt", "movbe", "xsave")
 
