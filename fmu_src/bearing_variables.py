@@ -177,7 +177,7 @@ def kernels_of(resources: str) -> str:
     whose features this CPU has is set (``NUMBA_CPU_NAME``, ``NUMBA_CPU_FEATURES``) before numba is
     imported, so that numba takes those loops (the generic ones: about 10-25 % slower steps), unless
     the user set ``NUMBA_CPU_NAME``. On Windows, where the runtime carries numba (a win64 half built
-    with ``--win64-numba``), the generic loops are set always: its cache holds those only."""
+    with ``--win64-numba``), the portable ones are chosen so always: its cache holds those only."""
     import os
 
     from slewing_model.numerics.targets import portable_target, target_environment
@@ -191,10 +191,13 @@ def kernels_of(resources: str) -> str:
     if kernels == "numpy" or "numba" in sys.modules or "NUMBA_CPU_NAME" in os.environ:
         return kernels
     if os.name == "nt":
-        import importlib.util
+        try:                    # only a --win64-numba half carries numba (and llvmlite)
+            import llvmlite.binding as llvm
 
-        if importlib.util.find_spec("numba") is not None:      # only a --win64-numba half carries it
-            os.environ.update(target_environment("generic"))
+            features = llvm.get_host_cpu_features()
+        except Exception:       # numpy's loops run
+            return kernels
+        os.environ.update(target_environment(portable_target(features)))
     elif os.path.exists(target):
         with open(target) as fh:
             built_for = fh.read().split()
