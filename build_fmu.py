@@ -154,8 +154,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                         win64_numba=win64_numba, stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
                         export_library=export_library)
     if numba:
-        say("compiling the loops with numba for this CPU and for any x86-64 CPU (about two minutes the "
-            "first time on a machine, then read from numba's cache) ...")
+        say("compiling the loops with numba for this CPU, an x86-64-v3 CPU and any x86-64 CPU (about two "
+            "minutes the first time on a machine, then read from numba's cache) ...")
         if win64_numba:
             say("... and for x86-64-v3 and generic x86-64 Windows CPUs under wine (about six minutes the first "
                 "time, then read from its cache) ...")

@@ -188,28 +188,22 @@ def kernels_of(resources: str) -> str:
     with open(path) as fh:
         kernels = fh.read().strip() or "auto"
     target = os.path.join(resources, NUMBA_TARGET_FILE)
-    if kernels == "numpy" or "numba" in sys.modules or "NUMBA_CPU_NAME" in os.environ:
+    windows = os.name == "nt"
+    if kernels == "numpy" or "numba" in sys.modules or "NUMBA_CPU_NAME" in os.environ \
+            or not (windows or os.path.exists(target)):
         return kernels
-    if os.name == "nt":
-        try:                    # only a --win64-numba half carries numba (and llvmlite)
-            import llvmlite.binding as llvm
+    try:                        # llvmlite comes with numba (on Windows: a --win64-numba half only)
+        import llvmlite.binding as llvm
 
-            features = llvm.get_host_cpu_features()
-        except Exception:       # numpy's loops run
-            return kernels
-        os.environ.update(target_environment(portable_target(features)))
-    elif os.path.exists(target):
+        features = llvm.get_host_cpu_features()
+        this_cpu = [llvm.get_host_cpu_name(), features.flatten()]
+    except Exception:           # no llvmlite: numpy's loops run anyway
+        return kernels
+    if not windows:
         with open(target) as fh:
-            built_for = fh.read().split()
-        try:
-            import llvmlite.binding as llvm
-
-            features = llvm.get_host_cpu_features()
-            this_cpu = [llvm.get_host_cpu_name(), features.flatten()]
-        except Exception:       # no llvmlite (a host without numba): the numpy loops run anyway
-            this_cpu = built_for
-        if this_cpu != built_for:
-            os.environ.update(target_environment(portable_target(features)))
+            if fh.read().split() == this_cpu:        # the building machine's CPU: its own loops
+                return kernels
+    os.environ.update(target_environment(portable_target(features)))
     return kernels
 
 

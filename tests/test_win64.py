@@ -181,10 +181,10 @@ def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(
 
 @pytest.fixture(scope="module")
 def numba_fmu(tmp_path_factory):
-    """table3_fmu's bearing (with its ring errors) built with ``--win64-numba``: both halves with numba's loops (the Windows ones
-    compiled under wine at build time, kept beside the tests' wine prefix once per version of the loops).
-    That compilation takes 3-4 minutes under wine: until it is kept, the test is skipped, saying so (run
-    tests/win64/run_all.sh, or set SLEWING_BUILD_WIN64_NUMBA=1)."""
+    """table3_fmu's bearing (with its ring errors) built with ``--win64-numba``: both halves with numba's
+    loops (the Windows ones compiled under wine at build time, kept beside the tests' wine prefix once per
+    version of the loops). That compilation takes about five minutes under wine (two CPUs): until it is
+    kept, the test is skipped, saying so (run tests/win64/run_all.sh, or set SLEWING_BUILD_WIN64_NUMBA=1)."""
     sys.path.insert(0, str(ROOT))
     import build_win64
     from build_fmu import build_fmu, compiled_kernel_files
@@ -195,7 +195,7 @@ def numba_fmu(tmp_path_factory):
             patch.setenv(name, value)
         if not (build_win64.kernels_folder(compiled_kernel_files()[0]) / "slewing_model").exists() \
                 and not os.environ.get("SLEWING_BUILD_WIN64_NUMBA"):
-            pytest.skip(f"SKIPPED: the loops for --win64-numba are not compiled under wine yet (3-4 minutes, kept "
+            pytest.skip(f"SKIPPED: the loops for --win64-numba are not compiled under wine yet (about 5 minutes, kept "
                         f"in {kept['SLEWING_WIN64_BUILD_DIR']}): run tests/win64/run_all.sh, or set "
                         "SLEWING_BUILD_WIN64_NUMBA=1")
         return build_fmu(ROOT / "examples" / "bearings" / "table3_errors.toml",
