@@ -215,6 +215,9 @@ class BearingSimulator:
         self._friction_previous: np.ndarray | None = None   # ... and of the step before (both equilibria)
         self._friction_converged = True                # _friction_warm an equilibrium (not capped)
         self._psi = 0.0
+        #: (loads, psi, StepResult) of the last step where it ended at an equilibrium: a step with the same
+        #: inputs answers it again (:meth:`step`); None where there is none
+        self._held: tuple | None = None
         self._warm_friction = None
         self._prepare_friction()
         self.last: StepResult | None = None
@@ -232,6 +235,7 @@ class BearingSimulator:
                 raise ValueError(f"{name} is not tunable: build a new simulator")
         self.settings = replace(self.settings, **changes)
         self._prepare_friction()
+        self._held = None                 # the last torque was of the settings before
 
     def _prepare_friction(self) -> None:
         """The friction torque's one compiled call prepared for the settings (:func:`prepare_warm_torque`),
@@ -246,6 +250,16 @@ class BearingSimulator:
         """Solve the step: load distribution at rotation ``psi`` (warm-started
         from the previous step), then the friction torque at speed ``omega``.
 
+        A step whose loads and ``psi`` equal the last step's, where that one ended at an equilibrium
+        (its load distribution and friction torque converged), answers that equilibrium again at once:
+        the same load distribution (its arrays, ``iterations`` 0) and friction torque magnitude, the signed torque at this ``omega`` (the magnitude is that of a unit speed,
+        whatever ``omega``). Solving it again would start at that equilibrium, take no Newton iteration
+        and give the same numbers to round-off (the friction's balls take their last small Newton step
+        again: within ``friction_tolerance``); the life accumulator adds nothing in such a step (no ball
+        crosses a slice, ``psi`` does not move), so it is not called. Held inputs are what a parked or
+        idling drive, a master's repeated step and the held stretches of step-wise load cases send
+        (``benchmarks/bench_realtime.py``'s reversal, jump and feather scenarios).
+
         Raises
         ------
         ValueError
@@ -258,14 +272,37 @@ class BearingSimulator:
         for name, value in (("psi", psi), ("omega", omega)):
             if not math.isfinite(value):
                 raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
+        held = self._held
+        if held is not None and held[1] == psi and held[0] == loads:
+            return self._repeat(held, omega)
+        given = loads
         if self.settings.load_frame == "rotating":
             loads = loads.rotated(psi)
         before = self._checkpoint()
         try:
-            return self._step(loads, psi, omega)
+            result = self._step(loads, psi, omega)
         except Exception:
             self._restore(before)
             raise
+        self._held = (given, psi, result) if self._warm_converged and self._friction_converged else None
+        return result
+
+    def _repeat(self, held: tuple, omega: float) -> StepResult:
+        """A step with the inputs of the last one, which ended at an equilibrium (``held``, :meth:`step`): its
+        answer, with no Newton iteration (``iterations`` 0, as a solve started there reports), the signed torque
+        at ``omega``; the warm starts kept as :meth:`_step` keeps those of a step that found the same state (the
+        loads held in it: the next step's start goes on from this state along ``psi``)."""
+        last = held[2]
+        if last.distribution.iterations:           # made once for a run of held steps
+            last = replace(last, distribution=replace(last.distribution, iterations=0))
+            self._held = (held[0], held[1], last)
+        self._previous, self._loads = self._warm, (self._loads[0], self._loads[0])
+        if self.settings.friction_coefficient > 0.0:
+            self._friction_previous = self._friction_warm
+        magnitude = last.friction_torque_magnitude
+        signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
+        self.last = StepResult(last.distribution, signed, magnitude)
+        return self.last
 
     def _step(self, loads: Loads, psi: float, omega: float) -> StepResult:
         if psi != self._psi or self._warm is None:
@@ -313,26 +350,32 @@ class BearingSimulator:
         (its checkpoint made the raceway map copy itself at every step's update: docs/speed.md, "Issue 31,
         eighteenth turn")."""
         return (self._warm, self._previous, self._loads, self._warm_converged, self._psi, self.solver.operator,
-                self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged)
+                self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged,
+                self._held)
 
     def _restore(self, checkpoint: tuple) -> None:
         """Back to a :meth:`_checkpoint`, as :meth:`set_state` restores a state."""
         (self._warm, self._previous, self._loads, self._warm_converged, self._psi, operator, pending,
-         self._friction_warm, self._friction_previous, self._friction_converged) = checkpoint
+         self._friction_warm, self._friction_previous, self._friction_converged, self._held) = checkpoint
         self.solver.set_rotation(self._psi)
         self.solver.operator, self.solver.pending_operator = operator, pending
 
     def get_state(self) -> dict:
         """Everything that affects the next step: the warm start, the rotation and
         the solver's reused Newton operator (numpy arrays, not copied: they are
-        never changed in place). :func:`encode_state` makes it JSON data."""
+        never changed in place). :func:`encode_state` makes it JSON data.
+
+        ``held`` is the last step's inputs and result where it ended at an equilibrium (:meth:`step`):
+        objects, kept only as long as the state is in memory (an FMU's ``fmi2GetFMUstate``), so that a
+        step repeated from the state repeats exactly; :func:`encode_state` leaves it out, and a state
+        through JSON solves its first held step again (the same equilibrium, to round-off)."""
         operator, pending = self.solver.operator, self.solver.pending_operator
         return {"warm": self._warm, "previous": self._previous, "loads": list(self._loads),
                 "warm_converged": self._warm_converged, "psi": self._psi,
                 "operator": None if operator is None else operator.as_tuple(),
                 "pending": None if pending is None else pending.as_tuple(), "friction": self._friction_warm,
                 "friction_previous": self._friction_previous, "friction_converged": self._friction_converged,
-                "life": None if self.life is None else self.life.get_state()}
+                "life": None if self.life is None else self.life.get_state(), "held": self._held}
 
     def set_state(self, state: dict) -> None:
         """Restore :meth:`get_state` (or its :func:`decode_state`)."""
@@ -352,6 +395,7 @@ class BearingSimulator:
         self._friction_converged = bool(state.get("friction_converged", True))
         if self.life is not None and state.get("life") is not None:
             self.life.set_state(state["life"])
+        self._held = state.get("held")
 
 
 def load_share(load, last_load, load_before) -> float:
@@ -405,13 +449,17 @@ def extrapolated_motion(warm, previous, share: float = 1.0):
     return extrapolated_start(warm, previous, (share * rolled)[:, None])
 
 
+#: the entries of :meth:`BearingSimulator.get_state` kept in memory only: :func:`encode_state` leaves them out
+MEMORY_ONLY = ("held",)
+
+
 def encode_state(value):
     """JSON-ready copy of a state: numpy arrays become ``{"__array__": dtype, "shape", "data": hex}``
-    (exact, unlike decimal text)."""
+    (exact, unlike decimal text); the entries :data:`MEMORY_ONLY` are left out."""
     if isinstance(value, np.ndarray):
         return {"__array__": value.dtype.str, "shape": list(value.shape), "data": value.tobytes().hex()}
     if isinstance(value, dict):
-        return {k: encode_state(v) for k, v in value.items()}
+        return {k: encode_state(v) for k, v in value.items() if k not in MEMORY_ONLY}
     if isinstance(value, (list, tuple)):
         return [encode_state(v) for v in value]
     return value
