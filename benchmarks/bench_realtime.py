@@ -215,8 +215,10 @@ def main() -> None:
         nrel_median = medians.get(("nrel", "complete"), math.nan)
         for row in rows:
             name, v = row[0], row[1]
-            ratio = medians[name, v] / medians[name, "baseline"] if "baseline" in fmus else math.nan
-            moving = medians[name, v, "moving"] / medians[name, "baseline", "moving"] if "baseline" in fmus else math.nan
+            ratio = moving = math.nan
+            if "baseline" in fmus:
+                ratio = medians[name, v] / medians[name, "baseline"]
+                moving = medians[name, v, "moving"] / medians[name, "baseline", "moving"]
             over = int(np.count_nonzero(all_times[name, v] > 4.0 * nrel_median))
             row += [f"{ratio:.2f}", f"{moving:.2f}", f"{float(row[5]) / nrel_median:.1f}",
                     f"{float(row[2]) / nrel_median:.1f}", str(over)]

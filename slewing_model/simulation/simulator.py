@@ -6,8 +6,8 @@ friction torque for the loads, the rotation ``psi`` and the speed ``omega`` of
 the moving ring. It knows nothing of FMI: the FMU in ``fmu_src/`` maps its
 variables onto this class, and scripts can use it directly.
 
-Its whole state is :meth:`BearingSimulator.get_state` (plain JSON data), so a
-step can be rolled back and repeated exactly.
+Its whole state is :meth:`BearingSimulator.get_state` (plain data, JSON by :func:`encode_state`
+but for the last held answer, kept in memory only), so a step can be rolled back and repeated exactly.
 """
 from __future__ import annotations
 
@@ -252,12 +252,13 @@ class BearingSimulator:
 
         A step whose loads and ``psi`` equal the last step's, where that one ended at an equilibrium
         (its load distribution and friction torque converged), answers that equilibrium again at once:
-        the same load distribution (its arrays, ``iterations`` 0) and friction torque magnitude, the signed torque at this ``omega`` (the magnitude is that of a unit speed,
-        whatever ``omega``). Solving it again would start at that equilibrium, take no Newton iteration
-        and give the same numbers to round-off (the friction's balls take their last small Newton step
-        again: within ``friction_tolerance``); the life accumulator adds nothing in such a step (no ball
-        crosses a slice, ``psi`` does not move), so it is not called. Held inputs are what a parked or
-        idling drive, a master's repeated step and the held stretches of step-wise load cases send
+        the same load distribution (its arrays, ``iterations`` 0) and friction torque magnitude, and the
+        signed torque at this ``omega`` (the magnitude is that of a unit speed, whatever ``omega``).
+        Solving it again would start at that equilibrium, take no Newton iteration and give the same
+        numbers to round-off (the friction's balls take their last small Newton step again: within
+        ``friction_tolerance``); the life accumulator adds nothing in such a step (no ball crosses a
+        slice, ``psi`` does not move), so it is not called. Held inputs are what a parked or idling
+        drive, a master's repeated step and the held stretches of step-wise load cases send
         (``benchmarks/bench_realtime.py``'s reversal, jump and feather scenarios).
 
         Raises
