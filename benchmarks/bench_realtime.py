@@ -210,7 +210,7 @@ def main() -> None:
                              f"{t.max():.1f}", f"{first[v] * 1e3 / np.median(t):.0f}",
                              f"{initialization:.2f}", f"{early[0]:.2f}", f"{early.max():.2f}",
                              f"{early.max() / np.median(t):.1f}", "–" if v == "baseline" else str(flagged[v]),
-                             str(int(np.count_nonzero(~moved))), f"{np.median(t[moved]):.2f}"])
+                             str(int(np.count_nonzero(~moved))), f"{medians[name, v, 'moving']:.2f}"])
             print(f"  {name}: {case.description} ({case.steps} steps)", flush=True)
         nrel_median = medians.get(("nrel", "complete"), math.nan)
         for row in rows:

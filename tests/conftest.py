@@ -166,6 +166,16 @@ def simulators_per_kernel(name: str, steps: int, setting: str):
         ring_model="flexible", load_frame=frame, **{setting: k})) for k in ("numpy", "compiled")}
 
 
+def through_json(value):
+    """A state (or part of one) serialised as a master's FMU state is: through :func:`encode_state`, JSON
+    text and :func:`decode_state` (what is kept in memory only, the held answer, is left out)."""
+    import json
+
+    from slewing_model.simulation.simulator import decode_state, encode_state
+
+    return decode_state(json.loads(json.dumps(encode_state(value))))
+
+
 def symmetric_block_circulant(balls: int, seed: int = 0) -> np.ndarray:
     """A random symmetric block-circulant matrix (4 balls x 4 balls) as the rings' compliance is:
     block (b, c) = C_(c-b mod B), C_(-k) = C_k^T."""

@@ -5,8 +5,6 @@ The case is the one that made the slowest steps: a tilting moment reversed in on
 flips the loaded diagonal of most balls (table1, 100 balls, rings of a known stiffness,
 :mod:`synthetic_rings`; its reduced operator has about 240 rows, so its inverse is spread over
 stages as on the pitch bearing)."""
-import json
-
 import numpy as np
 import pytest
 
@@ -19,6 +17,7 @@ from slewing_model.rings.reduced_operator import (
     BORDER_BLOCK, LEAF, STAGES, bordered_inverse, bordering_work, stage_work,
 )
 from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+from conftest import through_json
 from statics import load_on_moving_ring
 from synthetic_rings import synthetic_superelement
 
@@ -221,8 +220,6 @@ def test_the_step_after_a_bounded_solve_arrives_starts_at_its_equilibrium(table1
     iterate -> equilibrium (which took it off again). Such a step is answered at once
     (BearingSimulator.step: the inputs of the last step, an equilibrium); its state through JSON leaves
     that answer out, so the same step from it is solved, and starts there too."""
-    from slewing_model.simulation.simulator import decode_state, encode_state
-
     sim = BearingSimulator(table1, rings, SimulatorSettings(tolerance=TOLERANCE, friction_coefficient=0.0,
                                                            step_work="bounded"))
     sim.step(FORWARD, 0.0, 0.0)
@@ -231,7 +228,7 @@ def test_the_step_after_a_bounded_solve_arrives_starts_at_its_equilibrium(table1
         results.append(sim.step(REVERSED, 0.0, 0.0).distribution)
     assert len(results) >= 2 and results[-1].converged and not results[-2].converged
     arrived = results[-1]
-    state = decode_state(json.loads(json.dumps(encode_state(sim.get_state()))))
+    state = through_json(sim.get_state())
     repeated = sim.step(REVERSED, 0.0, 0.0).distribution
     assert repeated.iterations == 0 and np.array_equal(repeated.state, arrived.state)
     sim.set_state(state)

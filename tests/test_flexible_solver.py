@@ -1,7 +1,6 @@
 """The structured Flexible-BIME Newton solver (paper eq 20) on a ring model with a known
 stiffness matrix: against the dense Newton on all 5 + 8B unknowns, statics, limits."""
 import dataclasses
-import json
 import math
 
 import numpy as np
@@ -11,7 +10,7 @@ from slewing_model import BimeSolver, Loads, solve
 import slewing_model.distribution.bime as bime
 from slewing_model.distribution.bime import solve_dense_newton
 from slewing_model.numerics.compiled import AVAILABLE
-from conftest import symmetric_block_circulant
+from conftest import symmetric_block_circulant, through_json
 from synthetic_rings import synthetic_superelement
 
 LOADS = [Loads(), Loads(Fx=2e4, Fz=5e4, My=1e4), Loads(Fy=-3e4, Mx=-2e4, My=1.5e4)]
@@ -157,14 +156,14 @@ def test_a_step_that_holds_the_loads_after_a_jump_starts_at_its_equilibrium(bear
     # reversed equilibrium itself (the extrapolation would repeat the reversal): no iteration,
     # the same state bit for bit. The simulator answers such a step at once (the last step's inputs,
     # an equilibrium); from its state through JSON, which leaves that answer out, the step is solved
-    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings, decode_state, encode_state
+    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 
     sim = BearingSimulator(bearing, synthetic_superelement(bearing.ball_count),
                            SimulatorSettings(ring_model="flexible", friction_coefficient=0.0))
     for k in range(3):
         sim.step(Loads(Fz=5e4, Mx=2e3 + 1e2 * k), psi=0.01 * k, omega=0.1)
     reversed_ = sim.step(Loads(Fz=5e4, Mx=-2.2e3), psi=0.02, omega=0.1).distribution
-    state = decode_state(json.loads(json.dumps(encode_state(sim.get_state()))))
+    state = through_json(sim.get_state())
     repeated = sim.step(Loads(Fz=5e4, Mx=-2.2e3), psi=0.02, omega=0.1).distribution
     sim.set_state(state)
     held = sim.step(Loads(Fz=5e4, Mx=-2.2e3), psi=0.02, omega=0.1).distribution
@@ -534,15 +533,12 @@ def test_inverse_spread_over_two_steps_equals_the_inverse_at_once(double_operato
     time (a bounded solve's), its state serialised between them (a co-simulation's rollback), is
     :func:`spd_inverse`'s bit for bit; through the Cholesky factor (a pending operator of method 1 or
     2), :func:`cholesky_inverse`'s."""
-    import json
-
     from conftest import BEARINGS
     from slewing_model import load_bearing
     from slewing_model.rings.reduced_operator import (
         STAGES, PendingOperator, advance_operator, cholesky_inverse, method_precision, spd_inverse,
     )
     from slewing_model.rings.compliance import contact_compliance, ring_compliances
-    from slewing_model.simulation.simulator import decode_state, encode_state
     from slewing_model.rings.superelement import build_superelement
 
     bearing = load_bearing(BEARINGS / "pitch_bearing.toml")
@@ -552,15 +548,14 @@ def test_inverse_spread_over_two_steps_equals_the_inverse_at_once(double_operato
         w = rings[:rows, :rows] + np.diag(rng.uniform(0.2, 2.0, rows) * 1e-3 * np.abs(rings).max())
         pending = advance_operator(PendingOperator(np.arange(rows), np.ones(rows // 2, bool), np.zeros((rows // 2, 2, 2)),
                                                    w, 0, ()), None, None)
-        saved = json.loads(json.dumps(encode_state(pending.as_tuple())))
-        pending = advance_operator(PendingOperator.from_tuple(decode_state(saved)), None, None)
+        pending = advance_operator(PendingOperator.from_tuple(through_json(pending.as_tuple())), None, None)
         assert pending.stage == len(STAGES)
         assert np.array_equal(pending.parts[0], spd_inverse(w))
         # a bounded step's way: one stage at a time, serialised after each
         pending = PendingOperator(np.arange(rows), np.ones(rows // 2, bool), np.zeros((rows // 2, 2, 2)), w, 0, ())
         while pending.stage < len(STAGES):
             pending = advance_operator(pending, None, None, until=pending.stage + 1)
-            pending = PendingOperator.from_tuple(decode_state(json.loads(json.dumps(encode_state(pending.as_tuple())))))
+            pending = PendingOperator.from_tuple(through_json(pending.as_tuple()))
         assert np.array_equal(pending.parts[0], spd_inverse(w))
         # the inverse through the Cholesky factor (methods 1 and 2: an inverse made again) the same way
         for method in (1, 2):
@@ -568,8 +563,7 @@ def test_inverse_spread_over_two_steps_equals_the_inverse_at_once(double_operato
                                       method)
             while pending.stage < len(STAGES):
                 pending = advance_operator(pending, None, None, until=pending.stage + 1)
-                pending = PendingOperator.from_tuple(
-                    decode_state(json.loads(json.dumps(encode_state(pending.as_tuple())))))
+                pending = PendingOperator.from_tuple(through_json(pending.as_tuple()))
             assert pending.method == method
             assert np.array_equal(pending.parts[0], cholesky_inverse(w, method_precision(method)))
 
