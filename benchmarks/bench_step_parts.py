@@ -26,7 +26,14 @@ data and code in the cache, no Python around it): the sum of the hot calls is wh
 the step and the same call hot is what the step's cold caches cost it (the other parts' data and
 code ran in between).
 
-Run: .venv/bin/python benchmarks/bench_step_parts.py [--scenarios nrel turbulence] [--steps 3000]
+``--scenarios`` takes ``bench_realtime.py``'s scenarios and ``yaw`` (``bench_fmu.py``'s yaw case: the
+180-ball yaw bearing under the tower-top series, yawing in bursts). With a pitch scenario and ``yaw``
+the last lines weigh them as issue 31's whole turbine does (3 pitch + 1 yaw bearing at a 10 ms step):
+the four usual steps' medians and the four steps' compiled calls hot, each as a real-time factor. The
+hot calls are a floor no formulation of the step around these loops goes below; the real-time factor of
+the whole turbine's mean steps, with the ring operators' work, is ``bench_fmu.py``'s.
+
+Run: .venv/bin/python benchmarks/bench_step_parts.py [--scenarios nrel turbulence yaw] [--steps 3000]
 """
 from __future__ import annotations
 
@@ -39,7 +46,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_realtime import scenario  # noqa: E402
+from bench_realtime import SCENARIOS, scenario  # noqa: E402
+from cases import DT, yaw  # noqa: E402
 from timing import print_table  # noqa: E402
 
 from slewing_model import Loads, load_bearing  # noqa: E402
@@ -134,7 +142,7 @@ def recorder(label, calls):
 
 
 def run(name: str, steps: int) -> dict:
-    case = scenario(name)
+    case = yaw(steps) if name == "yaw" else scenario(name)
     bearing = load_bearing(case.bearing)
     superelement = build_superelement(bearing, mesh="fine", progress=False)
     sim = simulator.BearingSimulator(bearing, superelement, simulator.SimulatorSettings(
@@ -184,9 +192,10 @@ def run(name: str, steps: int) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenarios", nargs="+", default=["nrel", "turbulence"])
+    parser.add_argument("--scenarios", nargs="+", default=["nrel", "turbulence"], choices=(*SCENARIOS, "yaw"))
     parser.add_argument("--steps", type=int, default=3000)
     args = parser.parse_args()
+    medians, floors = {}, {}
     for name in args.scenarios:
         found = run(name, args.steps)
         usual, hot = found["usual"], found["hot"]
@@ -207,6 +216,13 @@ def main() -> None:
                                                                                    "share of the mean", "hot"], rows)
         floor = float(np.median(np.sum([hot[label] for label in hot], axis=0)))
         print(f"the compiled calls hot: {floor:.0f} us, {floor / step:.2f} of the median step ({step:.0f} us)")
+        medians[name], floors[name] = step, floor
+    pitch = next((name for name in args.scenarios if name != "yaw"), None)
+    if pitch is not None and "yaw" in args.scenarios:
+        for what, values in (("usual steps' medians", medians), ("compiled calls hot", floors)):
+            turbine = 3.0 * values[pitch] + values["yaw"]
+            print(f"whole turbine (3 x {pitch} + yaw), {what}: {turbine:.0f} us a 10 ms step, "
+                  f"{1e6 * DT / turbine:.1f} times real time")
 
 
 if __name__ == "__main__":
