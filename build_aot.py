@@ -2,23 +2,25 @@
 
 The load distribution's, the friction's and the life map's loops (``slewing_model/distribution/kernel.py``,
 ``slewing_model/friction/kernel.py``, ``slewing_model/life/kernel.py``: every entry of their ``KERNELS``) are compiled once here, by
-numba's ahead-of-time compiler (``numba.pycc``), into one CPython extension module,
-:data:`slewing_model.numerics.compiled.AOT_MODULE`, for a generic x86-64 CPU. That module needs
+numba's ahead-of-time compiler (``numba.pycc``), into CPython extension modules, one for each target of
+:data:`slewing_model.numerics.compiled.AOT_MODULES` (a CPU of the x86-64 psABI's level 3, AVX2 and FMA; any
+x86-64 CPU), of which the FMU takes the first its CPU can run (``aot_kernels``). Each module needs
 numpy only, not numba or llvmlite (LLVM, 179 of a numba FMU's 270 MB unpacked), and starts
 without compiling or reading a cache. Each loop is exported under
 :func:`~slewing_model.numerics.compiled.aot_name` with its eager signature and its module's
 error model; ``source_hash()`` returns the hash of the sources it was compiled from, which the
 registry checks before it takes the module (:func:`slewing_model.numerics.compiled.aot_kernels`).
 
-The compilation (about a minute) runs in a child process, since it compiles the kernels'
+The compilation (about a minute a target) runs in a child process, since it compiles the kernels'
 helpers in place in their modules; its product is cached under
-``$SLEWING_CACHE_DIR/aot/<key>/`` (key: the sources' hash, numba's version, the Python ABI).
+``$SLEWING_CACHE_DIR/aot/<key>/`` (key: the sources' hash, numba's version, the Python ABI; the file name
+says the target).
 
 numba's ``pycc`` is pending deprecation ("replacement technology is being developed"); it is in
 the pinned numba 0.68.1 and gives the same numbers as numba's JIT, bit for bit, on the benchmark
 cases (docs/speed.md, "Ahead of time"). Linux only: the win64 half of an FMU runs numpy's loops.
 
-Run: .venv/bin/python build_aot.py [-o FOLDER]    (prints the module's path)
+Run: .venv/bin/python build_aot.py [-o FOLDER] [--target x86-64-v3|generic]    (prints the modules' paths)
 """
 from __future__ import annotations
 
@@ -38,11 +40,12 @@ ROOT = Path(__file__).resolve().parent
 KERNEL_MODULES = ("slewing_model.distribution.kernel", "slewing_model.friction.kernel", "slewing_model.life.kernel")
 
 
-def module_file_name() -> str:
-    """The extension module's file name for this Python (``slewing_kernels.cpython-311-x86_64-linux-gnu.so``)."""
-    from slewing_model.numerics.compiled import AOT_MODULE
+def module_file_name(target: str = "generic") -> str:
+    """The extension module's file name for ``target`` and this Python
+    (``slewing_kernels.cpython-311-x86_64-linux-gnu.so``; :data:`~slewing_model.numerics.compiled.AOT_MODULES`)."""
+    from slewing_model.numerics.compiled import AOT_MODULES
 
-    return AOT_MODULE + sysconfig.get_config_var("EXT_SUFFIX")
+    return AOT_MODULES[target] + sysconfig.get_config_var("EXT_SUFFIX")
 
 
 def cache_key() -> str:
@@ -60,20 +63,30 @@ def aot_cache_dir() -> Path:
     return Path(default_cache_dir()) / "aot"
 
 
-def build_kernels(output_dir=None, stage=None) -> Path:
-    """The ahead-of-time module of this tree's loops (compiled, or taken from the cache); copied
-    into ``output_dir`` where given. Returns its path."""
+def build_all_kernels(output_dir=None, stage=None) -> list:
+    """:func:`build_kernels` for every target (:data:`~slewing_model.numerics.compiled.AOT_MODULES`): the
+    modules an ``--aot`` FMU carries. Returns their paths."""
+    from slewing_model.numerics.compiled import AOT_MODULES
+
+    return [build_kernels(output_dir, stage, target) for target in AOT_MODULES]
+
+
+def build_kernels(output_dir=None, stage=None, target: str = "generic") -> Path:
+    """The ahead-of-time module of this tree's loops for ``target`` (an LLVM CPU name of
+    :data:`~slewing_model.numerics.compiled.AOT_MODULES`: the CPU's own features, none of the building
+    machine's), compiled, or taken from the cache; copied into ``output_dir`` where given. Returns its path."""
     say = stage or (lambda line: None)
-    cached = aot_cache_dir() / cache_key() / module_file_name()
+    cached = aot_cache_dir() / cache_key() / module_file_name(target)
     if not cached.exists():
-        say("compiling the loops ahead of time with numba's pycc (about a minute, once per change of the "
-            "kernels) ...")
+        say(f"compiling the loops ahead of time for {target} with numba's pycc (about a minute, once per change "
+            "of the kernels) ...")
         with tempfile.TemporaryDirectory(prefix="slewing_aot_") as tmp:
             # TMPDIR: numba's check of the C compiler leaves a folder in the temporary directory
             # (numba.pycc.platform._gentmpfile removes neither file nor folder); here it goes with ``tmp``
-            run = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--compile", tmp], cwd=ROOT,
-                                 capture_output=True, text=True, env={**os.environ, "TMPDIR": tmp})
-            built = Path(tmp) / module_file_name()
+            run = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--compile", tmp,
+                                  "--target", target], cwd=ROOT, capture_output=True, text=True,
+                                 env={**os.environ, "TMPDIR": tmp})
+            built = Path(tmp) / module_file_name(target)
             if run.returncode != 0 or not built.exists():
                 raise RuntimeError(f"compiling the loops ahead of time failed (exit {run.returncode}):\n"
                                    f"{run.stdout[-3000:]}\n{run.stderr[-3000:]}")
@@ -89,16 +102,17 @@ def build_kernels(output_dir=None, stage=None) -> Path:
     return target
 
 
-def _compile(output_dir: str) -> None:
-    """In the child process: export every loop of :data:`KERNEL_MODULES` and ``source_hash``."""
+def _compile(output_dir: str, target: str = "generic") -> None:
+    """In the child process: export every loop of :data:`KERNEL_MODULES` and ``source_hash``, for ``target``."""
     warnings.simplefilter("ignore")                      # pycc's pending deprecation
     import numba
     import numba.pycc.compiler as pycc_compiler
     from numba.pycc import CC
 
-    from slewing_model.numerics.compiled import AOT_MODULE, aot_name, compile_helpers, kernel_source_hash
+    from slewing_model.numerics.compiled import AOT_MODULES, aot_name, compile_helpers, kernel_source_hash
 
-    cc = CC(AOT_MODULE)
+    cc = CC(AOT_MODULES[target])
+    cc.target_cpu = "" if target == "generic" else target       # pycc's default: a generic x86-64 CPU
     cc.output_dir = output_dir
     cc.verbose = False
     error_models, fastmath = {}, {}
@@ -113,8 +127,8 @@ def _compile(output_dir: str) -> None:
     cc.export("source_hash", "i8()")(lambda: source_hash)
 
     # pycc compiles every export with one set of flags: give each loop its module's error model and fast-math
-    # flags (pycc compiles for a generic x86-64 CPU, which has no fused multiply-add: the friction's
-    # ``contract`` then changes nothing)
+    # flags (a generic x86-64 CPU has no fused multiply-add: the friction's ``contract`` then changes nothing;
+    # an x86-64-v3 CPU has, and fuses them as numba's JIT does on the building machine)
     original = pycc_compiler.compile_extra
 
     def compile_extra(typingctx, targetctx, func, args, return_type, flags, locals, **kwargs):
@@ -131,12 +145,14 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("-o", "--output", help="copy the module into this folder")
     parser.add_argument("--compile", help=argparse.SUPPRESS)
+    parser.add_argument("--target", default=None, help="one target (x86-64-v3 or generic); default: both")
     args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT))
     if args.compile:
-        _compile(args.compile)
+        _compile(args.compile, args.target or "generic")
         return 0
-    print(build_kernels(args.output, stage=print))
+    paths = [build_kernels(args.output, print, args.target)] if args.target else build_all_kernels(args.output, print)
+    print("\n".join(map(str, paths)))
     return 0
 
 

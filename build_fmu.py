@@ -66,8 +66,9 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         Carry numba and the compiled loops (steps about 4 times faster, the FMU about 4 times
         larger: 87 MB against 22 MB for the pitch bearing). Default: where numba is installed here.
     aot : bool
-        Carry the loops compiled ahead of time (:mod:`build_aot`: one extension module of 1.5 MB that
-        needs numpy only) instead of numba: the same numbers and step time as numba's, without
+        Carry the loops compiled ahead of time (:mod:`build_aot`: an extension module of 1.5 MB that
+        needs numpy only, for an x86-64-v3 CPU and for any x86-64 CPU; the FMU takes the first its CPU
+        runs) instead of numba: the same numbers and step time as numba's, without
         numba and llvmlite in the runtime (about a quarter of the size) and without loading
         numba's cache at instantiation. Default False; not with ``numba=True``.
     win64 : bool
@@ -140,8 +141,9 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
             import build_aot
             from build_runtime import version_needs
 
-            files.append(build_aot.build_kernels(tmp, stage=say))
-            extra_needs.append(version_needs(files[-1]))
+            modules = build_aot.build_all_kernels(tmp, stage=say)
+            files.extend(modules)
+            extra_needs.extend(version_needs(module) for module in modules)
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
             built = _build_fmi3(output, files)
         else:

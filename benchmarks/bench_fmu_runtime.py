@@ -8,7 +8,11 @@ all made in this run by this checkout's ``build_fmu.py``:
 - ``standalone``: ``--no-numba``; it carries its Python and numpy, and runs the numpy loops.
 - ``standalone + numba``: the default; it also carries numba and llvmlite, and the compiled loops' cache.
 - ``standalone + aot``: ``--aot``; it carries the loops compiled ahead of time (``build_aot.py``)
-  instead of numba: its cold build includes that compilation (the module's cache emptied).
+  instead of numba, a module for an x86-64-v3 CPU and one for any x86-64, and takes the first this CPU
+  runs: its cold build includes their compilation (the modules' cache emptied);
+- ``standalone + aot, generic``: the same FMU without its x86-64-v3 module (removed from the unpacked
+  folder), as a CPU without AVX2 or FMA runs it: the generic loops, which were the ``--aot`` FMU's only ones
+  before issue 31's twenty-ninth turn.
 
 Each FMU is run by our C host (``tests/c_host/host.c``, scenario ``bench``) in the environment of
 a desktop session (``PATH=/usr/bin:/bin``, nothing else), as a user's C host would run it: a fresh
@@ -49,7 +53,10 @@ OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 VARIANTS = {"host + numba": {"runtime": "host", "numba": True},
             "standalone": {"runtime": "standalone", "numba": False},
             "standalone + numba": {"runtime": "standalone", "numba": True},
-            "standalone + aot": {"runtime": "standalone", "numba": False, "aot": True}}
+            "standalone + aot": {"runtime": "standalone", "numba": False, "aot": True},
+            "standalone + aot, generic": {"runtime": "standalone", "numba": False, "aot": True}}
+#: a variant's modules removed from its unpacked folder after the build
+DROPPED = {"standalone + aot, generic": "resources/slewing_kernels_v3.*"}
 BASELINE = "host + numba"
 WARM = 20
 
@@ -125,19 +132,22 @@ def main() -> None:
         np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
         built, rows_build = {}, []
         for name, variant in VARIANTS.items():
-            fmu = tmp / f"{name.replace(' + ', '_')}.fmu"
-            cold = build(variant, fmu, cold=True)
+            fmu = tmp / f"{name.replace(' + ', '_').replace(', ', '_')}.fmu"
+            cold = build(variant, fmu, cold=name not in DROPPED)
             warm = build(variant, fmu, cold=False)
             folder = tmp / fmu.stem
             with zipfile.ZipFile(fmu) as z:
                 z.extractall(folder)
                 raw = sum(i.file_size for i in z.infolist())
+            for dropped in folder.glob(DROPPED.get(name, "-")):
+                dropped.unlink()
             md = read_model_description(str(fmu))
             refs = {v.name: v.valueReference for v in md.modelVariables}
             refs["guid"] = md.guid
             built[name] = (folder, refs)
             rows_build.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB", f"{raw / 1e6:.0f} MB",
-                               f"{cold:.1f} s" if variant["runtime"] == "standalone" else "—", f"{warm:.1f} s"])
+                               f"{cold:.1f} s" if variant["runtime"] == "standalone" and name not in DROPPED else "—",
+                               f"{warm:.1f} s"])
         times = {name: [] for name in VARIANTS}
         starts = {name: [] for name in VARIANTS}
         finals = {}

@@ -234,9 +234,10 @@ def build_simulator(slave, error) -> bool:
         if settings.ring_model == "flexible":
             superelement = Superelement.load(slave.superelement_path, slave.bearing)
         slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
-        from slewing_model.numerics.compiled import aot_kernels, use_compiled
+        from slewing_model.numerics.compiled import aot_target, use_compiled
 
-        compiled = ("compiled ahead of time (generic x86-64)" if aot_kernels() is not None
+        target = aot_target()
+        compiled = (f"compiled ahead of time for {target}" if target is not None
                     else f"compiled by numba for {numba_target()}")
         slave.log(f"{slave.instance_name}: loops " + (compiled if use_compiled(kernels) else "run by numpy"))
         return True

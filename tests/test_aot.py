@@ -1,6 +1,7 @@
-"""The loops compiled ahead of time (``build_aot.py``, issue 31): a module that needs numpy only,
-equal to numba's JIT, used only where it was compiled from these sources, and an FMU that
-carries it instead of numba and runs in a C host."""
+"""The loops compiled ahead of time (``build_aot.py``, issue 31): modules that need numpy only, one for
+an x86-64-v3 CPU and one for any x86-64, each equal to numba's JIT, the first the CPU runs taken, used only
+where they were compiled from these sources, and an FMU that carries them instead of numba and runs in a C
+host."""
 import json
 import os
 import subprocess
@@ -12,6 +13,9 @@ import numpy as np
 import pytest
 
 from slewing_model.numerics import compiled
+from slewing_model.numerics.targets import CPUINFO_FLAGS, PORTABLE_TARGETS
+
+from conftest import has_x86_64_v3
 
 ROOT = Path(__file__).resolve().parents[1]
 BEARING = ROOT / "examples" / "bearings" / "table3_errors.toml"
@@ -20,12 +24,15 @@ STEPS = 60
 pytestmark = pytest.mark.skipif(not compiled._numba_installed(), reason="numba (its pycc) is not installed here")
 
 #: a step series of table3 with errors, flexible rings, friction and life on, printed as JSON; with
-#: "aot", numba and llvmlite cannot be imported and the module's folder comes first on the path
+#: "aot", numba and llvmlite cannot be imported and the modules' folder comes first on the path; with
+#: "generic", the x86-64-v3 module cannot be imported either
 SERIES = r'''
 import json, sys
-if sys.argv[1] == "aot":
+if sys.argv[1] in ("aot", "generic"):
     sys.modules["numba"] = sys.modules["llvmlite"] = None
     sys.path.insert(0, sys.argv[2])
+if sys.argv[1] == "generic":
+    sys.modules["slewing_kernels_v3"] = None
 sys.path.insert(0, sys.argv[3])
 from slewing_model import Loads, load_bearing
 from slewing_model.numerics import compiled
@@ -40,7 +47,7 @@ for k in range(int(sys.argv[5])):
     d = r.distribution
     out.append([*d.displacement, d.max_ball_load, r.friction_torque, d.contact_load[19, 1], sim.life.worst_damage])
 print(json.dumps({"aot": compiled.aot_kernels() is not None, "numba": sys.modules.get("numba") is not None,
-                  "out": out}))
+                  "target": compiled.aot_target(), "out": out}))
 '''
 
 
@@ -49,7 +56,9 @@ def aot_folder(tmp_path_factory):
     sys.path.insert(0, str(ROOT))
     import build_aot
 
-    return build_aot.build_kernels(tmp_path_factory.mktemp("aot")).parent
+    folder = tmp_path_factory.mktemp("aot")
+    build_aot.build_all_kernels(folder)
+    return folder
 
 
 def _series(mode, folder):
@@ -60,11 +69,26 @@ def _series(mode, folder):
 
 
 def test_loops_compiled_ahead_of_time_equal_numbas_without_numba(aot_folder):
-    jit, aot = _series("jit", aot_folder), _series("aot", aot_folder)
-    assert not jit["aot"] and jit["numba"]
-    assert aot["aot"] and not aot["numba"]            # numba could not be imported, nor was it needed
-    # the same LLVM code for another CPU target: equal, observed bit for bit
-    assert np.allclose(aot["out"], jit["out"], rtol=1e-12, atol=0)
+    jit, aot, generic = (_series(mode, aot_folder) for mode in ("jit", "aot", "generic"))
+    assert not jit["aot"] and jit["numba"] and jit["target"] is None
+    for found in (aot, generic):
+        assert found["aot"] and not found["numba"]       # numba could not be imported, nor was it needed
+    # the module this CPU runs (its features read by the kernel's flags here, by another reader than the FMU's),
+    # and the generic one where that cannot be imported
+    assert aot["target"] == ("x86-64-v3" if has_x86_64_v3() else "generic")
+    assert generic["target"] == "generic"
+    # the same LLVM code for other CPU targets: equal, observed bit for bit
+    for found in (aot, generic):
+        assert np.allclose(found["out"], jit["out"], rtol=1e-12, atol=0)
+
+
+def test_a_cpu_takes_the_first_module_its_features_allow():
+    v3 = "flags : fpu sse2 " + " ".join(CPUINFO_FLAGS.values())
+    assert compiled.aot_targets(v3) == ["x86-64-v3", "generic"]
+    for missing in CPUINFO_FLAGS.values():            # one flag short: the generic module only
+        assert compiled.aot_targets(v3.replace(f" {missing}", "")) == ["generic"], missing
+    assert compiled.aot_targets("") == ["generic"]    # no /proc/cpuinfo: another system
+    assert set(compiled.AOT_MODULES) == {name for name, _ in PORTABLE_TARGETS}
 
 
 def test_a_module_of_other_sources_is_not_used(aot_folder, monkeypatch):
@@ -77,7 +101,8 @@ def test_a_module_of_other_sources_is_not_used(aot_folder, monkeypatch):
         assert compiled.aot_kernels() is None
     finally:                                              # the other tests run numba's loops
         monkeypatch.undo()
-        sys.modules.pop(compiled.AOT_MODULE, None)
+        for module in compiled.AOT_MODULES.values():
+            sys.modules.pop(module, None)
         compiled.aot_kernels.cache_clear()
     assert compiled.aot_kernels() is None                 # the tests' own path has no such module
 
@@ -92,7 +117,8 @@ def test_fmu_with_loops_compiled_ahead_of_time_runs_in_a_c_host_without_numba(ao
 
     fmu = build_fmu(BEARING, tmp_path / "aot.fmu", mesh="coarse", bc="free", aot=True, win64=False)
     names = zipfile.ZipFile(fmu).namelist()
-    assert any(n.startswith("resources/slewing_kernels") for n in names)
+    for module in compiled.AOT_MODULES.values():      # a module for each target
+        assert any(n.startswith(f"resources/{module}.") for n in names), module
     assert not any("/site-packages/numba/" in n or "/site-packages/llvmlite/" in n for n in names)
     assert fmu.stat().st_size < 1.15 * table3_fmu.stat().st_size     # numpy's FMU and a 1.5 MB module
     host = tmp_path / "host"
@@ -112,7 +138,8 @@ def test_fmu_with_loops_compiled_ahead_of_time_runs_in_a_c_host_without_numba(ao
         values[name], _, log_lines, errors = parse_host_output(run.stdout)
         assert not errors, errors
         logs[name] = " ".join(message for _, _, message in log_lines)
-    assert "loops compiled ahead of time" in logs["aot"] and "run by numpy" in logs["numpy"]
+    target = "x86-64-v3" if has_x86_64_v3() else "generic"
+    assert f"loops compiled ahead of time for {target}" in logs["aot"] and "run by numpy" in logs["numpy"]
     assert values["aot"].keys() == values["numpy"].keys() and values["aot"]
     for label, steps in values["aot"].items():           # compiled loops against numpy's: round-off
         for k, outputs in steps.items():

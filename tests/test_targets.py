@@ -2,7 +2,9 @@
 (:mod:`slewing_model.numerics.targets`): which one another machine takes, and how numba is told."""
 import pytest
 
-from slewing_model.numerics.targets import PORTABLE_TARGETS, X86_64_V3_FEATURES, portable_target, target_environment
+from slewing_model.numerics.targets import (
+    CPUINFO_FLAGS, PORTABLE_TARGETS, X86_64_V3_FEATURES, cpuinfo_features, portable_target, target_environment,
+)
 
 from conftest import has_x86_64_v3
 
@@ -30,3 +32,14 @@ def test_numba_is_told_the_targets_cpu_and_none_of_the_hosts_features():
         assert target_environment(name) == {"NUMBA_CPU_NAME": name, "NUMBA_CPU_FEATURES": ""}
     with pytest.raises(ValueError, match=r"target = 'skylake': must be one of x86-64-v3, generic"):
         target_environment("skylake")
+
+
+def test_the_kernels_flags_name_every_x86_64_v3_feature_and_say_what_llvm_says_of_this_cpu():
+    # the ahead-of-time FMU has no LLVM to ask: it reads /proc/cpuinfo (cpuinfo_features); here LLVM is the
+    # other reader
+    assert set(CPUINFO_FLAGS) == set(X86_64_V3_FEATURES)
+    llvm = pytest.importorskip("llvmlite.binding")
+    llvm.initialize_native_target()
+    assert portable_target(cpuinfo_features()) == portable_target(llvm.get_host_cpu_features())
+    assert cpuinfo_features("no flags here") == {name: False for name in X86_64_V3_FEATURES}
+

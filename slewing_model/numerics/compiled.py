@@ -19,8 +19,11 @@ import importlib
 import importlib.util
 from pathlib import Path
 
-#: the extension module of the loops compiled ahead of time (build_aot.py)
+#: the extension module of the loops compiled ahead of time (build_aot.py) for any x86-64 CPU
 AOT_MODULE = "slewing_kernels"
+#: ... and the modules by target (:data:`slewing_model.numerics.targets.PORTABLE_TARGETS`): an ``--aot`` FMU
+#: carries one for each and takes the first its CPU can run (:func:`aot_targets`)
+AOT_MODULES = {"x86-64-v3": "slewing_kernels_v3", "generic": AOT_MODULE}
 #: the sources the loops are compiled from: the kernels, what they take from other modules, this registry
 KERNEL_SOURCES = ("distribution/kernel.py", "friction/kernel.py", "life/kernel.py", "bearing/contact.py",
                   "numerics/compiled.py")
@@ -41,15 +44,35 @@ def aot_name(function) -> str:
     return f"{function.__module__.split('.')[-2]}_{function.__name__}"
 
 
+def aot_targets(cpuinfo: str | None = None) -> list:
+    """The targets (:data:`AOT_MODULES`) whose ahead-of-time module this CPU may run, the fastest first: from
+    the one its features allow (:func:`~slewing_model.numerics.targets.portable_target` of
+    :func:`~slewing_model.numerics.targets.cpuinfo_features`, ``cpuinfo`` the text of ``/proc/cpuinfo``, read
+    by default) down to the generic one."""
+    from .targets import PORTABLE_TARGETS, cpuinfo_features, portable_target
+
+    names = [name for name, _ in PORTABLE_TARGETS]
+    return names[names.index(portable_target(cpuinfo_features(cpuinfo))):]
+
+
 @functools.lru_cache(maxsize=1)
 def aot_kernels():
-    """The ahead-of-time module where it can be imported and its ``source_hash()`` is
-    :func:`kernel_source_hash`; None otherwise."""
-    try:
-        module = importlib.import_module(AOT_MODULE)
-        return module if module.source_hash() == kernel_source_hash() else None
-    except (ImportError, AttributeError, OSError):
-        return None
+    """The ahead-of-time module of the first of :func:`aot_targets` that can be imported and whose
+    ``source_hash()`` is :func:`kernel_source_hash`; None where there is none (its target: :func:`aot_target`)."""
+    for target in aot_targets():
+        try:
+            module = importlib.import_module(AOT_MODULES[target])
+            if module.source_hash() == kernel_source_hash():
+                return module
+        except (ImportError, AttributeError, OSError):
+            continue
+    return None
+
+
+def aot_target() -> str | None:
+    """The target (:data:`AOT_MODULES`) of the ahead-of-time module in use (:func:`aot_kernels`), or None."""
+    module = aot_kernels()
+    return None if module is None else {v: k for k, v in AOT_MODULES.items()}.get(module.__name__)
 
 
 def _numba_installed() -> bool:

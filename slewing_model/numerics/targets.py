@@ -14,6 +14,10 @@ first whose features that CPU has (:func:`portable_target`):
   both fuse multiply-adds);
 - ``generic``: any x86-64 CPU (SSE2 only).
 
+The loops compiled ahead of time (``build_aot.py``, an FMU built with ``--aot``) are compiled for the same
+targets, one extension module each; that FMU has no LLVM to ask, so it reads the CPU's features from the
+Linux kernel (:func:`cpuinfo_features`).
+
 Run-time module: the standard library only (it runs before numba is imported).
 """
 from __future__ import annotations
@@ -65,3 +69,36 @@ def target_environment(name: str) -> dict:
     if name not in names:
         raise ValueError(f"target = {name!r}: must be one of {', '.join(names)}")
     return {"NUMBA_CPU_NAME": name, "NUMBA_CPU_FEATURES": ""}
+
+
+#: the Linux kernel's names (``/proc/cpuinfo``'s flags) of :data:`X86_64_V3_FEATURES`, by LLVM's names
+CPUINFO_FLAGS = {"cx16": "cx16", "sahf": "lahf_lm", "popcnt": "popcnt", "sse3": "pni", "sse4.1": "sse4_1",
+                 "sse4.2": "sse4_2", "ssse3": "ssse3", "avx": "avx", "avx2": "avx2", "bmi": "bmi1", "bmi2": "bmi2",
+                 "f16c": "f16c", "fma": "fma", "lzcnt": "abm", "movbe": "movbe", "xsave": "xsave"}
+
+
+def cpuinfo_features(cpuinfo: str | None = None) -> dict:
+    """The CPU's features among :data:`X86_64_V3_FEATURES`, by LLVM's names (as :func:`portable_target`
+    takes them), from the Linux kernel's flags of its first processor.
+
+    Parameters
+    ----------
+    cpuinfo : str, optional
+        The text of ``/proc/cpuinfo``; read from there by default. Where it cannot be read (another system),
+        no feature: the generic loops.
+
+    Examples
+    --------
+    >>> cpuinfo_features("flags : fpu sse2 avx avx2 fma")["avx2"], cpuinfo_features("flags : fpu sse2")["avx2"]
+    (True, False)
+    """
+    if cpuinfo is None:
+        try:
+            with open("/proc/cpuinfo") as fh:
+                cpuinfo = fh.read()
+        except OSError:
+            cpuinfo = ""
+    flags = next((set(line.split(":", 1)[1].split()) for line in cpuinfo.splitlines()
+                  if line.startswith("flags") and ":" in line), set())
+    return {name: flag in flags for name, flag in CPUINFO_FLAGS.items()}
+
