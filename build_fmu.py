@@ -66,9 +66,9 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         Carry numba and the compiled loops (steps about 4 times faster, the FMU about 4 times
         larger: 87 MB against 22 MB for the pitch bearing). Default: where numba is installed here.
     aot : bool
-        Carry the loops compiled ahead of time (:mod:`build_aot`: an extension module of 1.5 MB that
-        needs numpy only, for an x86-64-v3 CPU and for any x86-64 CPU; the FMU takes the first its CPU
-        runs) instead of numba: the same numbers and step time as numba's, without
+        Carry the loops compiled ahead of time (:mod:`build_aot`: two extension modules of 1.9 MB that
+        need numpy only, one for an x86-64-v3 CPU and one for any x86-64 CPU; the FMU takes the first its
+        CPU runs) instead of numba: the same numbers and step time as numba's, without
         numba and llvmlite in the runtime (about a quarter of the size) and without loading
         numba's cache at instantiation. Default False; not with ``numba=True``.
     win64 : bool

@@ -42,4 +42,3 @@ def test_the_kernels_flags_name_every_x86_64_v3_feature_and_say_what_llvm_says_o
     llvm.initialize_native_target()
     assert portable_target(cpuinfo_features()) == portable_target(llvm.get_host_cpu_features())
     assert cpuinfo_features("no flags here") == {name: False for name in X86_64_V3_FEATURES}
-

@@ -101,4 +101,3 @@ def cpuinfo_features(cpuinfo: str | None = None) -> dict:
     flags = next((set(line.split(":", 1)[1].split()) for line in cpuinfo.splitlines()
                   if line.startswith("flags") and ":" in line), set())
     return {name: flag in flags for name, flag in CPUINFO_FLAGS.items()}
-
