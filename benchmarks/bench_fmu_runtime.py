@@ -139,8 +139,9 @@ def main() -> None:
             with zipfile.ZipFile(fmu) as z:
                 z.extractall(folder)
                 raw = sum(i.file_size for i in z.infolist())
-            for dropped in folder.glob(DROPPED.get(name, "-")):
-                dropped.unlink()
+            if name in DROPPED:
+                for dropped in folder.glob(DROPPED[name]):
+                    dropped.unlink()
             md = read_model_description(str(fmu))
             refs = {v.name: v.valueReference for v in md.modelVariables}
             refs["guid"] = md.guid

@@ -349,15 +349,14 @@ class BearingSimulator:
         bearing's NREL steps; docs/speed.md, "Issue 31, sixteenth turn"). Not the life accumulator's: its
         step is the step's last that can fail (:meth:`_step`), so a step that raises has not touched it
         (its checkpoint made the raceway map copy itself at every step's update: docs/speed.md, "Issue 31,
-        eighteenth turn")."""
+        eighteenth turn"). Nor the held answer: :meth:`step` sets it only after the step succeeded."""
         return (self._warm, self._previous, self._loads, self._warm_converged, self._psi, self.solver.operator,
-                self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged,
-                self._held)
+                self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged)
 
     def _restore(self, checkpoint: tuple) -> None:
         """Back to a :meth:`_checkpoint`, as :meth:`set_state` restores a state."""
         (self._warm, self._previous, self._loads, self._warm_converged, self._psi, operator, pending,
-         self._friction_warm, self._friction_previous, self._friction_converged, self._held) = checkpoint
+         self._friction_warm, self._friction_previous, self._friction_converged) = checkpoint
         self.solver.set_rotation(self._psi)
         self.solver.operator, self.solver.pending_operator = operator, pending
 
