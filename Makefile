@@ -5,20 +5,20 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test docs screenshots bench clean
 
-# Debian packages the build and the tests need:
-#   gcc, libc6-dev, binutils: build_fmu.py compiles the FMU's Linux binary (fmu_src/shim); readelf checks its glibc floor
-#   libtbb12: the ecos C++ co-simulation host of the FMU tests
-#   debootstrap: bare Debian systems without Python, where the tests run the standalone FMUs
-#   libxml2-dev libminizip-dev libsundials-dev zlib1g-dev: fmusim (built from ../shared/vendor), an independent FMI host
-#   gcc-mingw-w64-x86-64: build_fmu.py cross-compiles the FMU's standalone Windows binary (build_win64.py)
-#   wine wine64: tests/test_win64.py runs the win64 binary in Windows hosts (our C host, fmpy, fmusim)
-DEBIAN_PACKAGES := gcc libc6-dev binutils libtbb12 debootstrap libxml2-dev libminizip-dev libsundials-dev zlib1g-dev \
-                   gcc-mingw-w64-x86-64 wine wine64
-
-$(STAMP): pyproject.toml
-	@missing=$$(for p in $(DEBIAN_PACKAGES); do \
+# Debian packages, each target its own (installed with apt-get when run as root, else named):
+#   the demo builds an FMU: gcc, libc6-dev, binutils compile its Linux binary (fmu_src/shim; readelf checks
+#   its glibc floor), gcc-mingw-w64-x86-64 cross-compiles its standalone Windows binary (fmu_build/win64.py)
+#   the tests also use: libtbb12 (the ecos C++ co-simulation host), debootstrap (bare Debian systems without
+#   Python, where the standalone FMUs run), libxml2-dev libminizip-dev libsundials-dev zlib1g-dev (fmusim, built
+#   from ../shared/vendor: an independent FMI host), wine wine64 (the win64 binary in Windows hosts),
+#   calculix-ccx (the CalculiX reference tests)
+DEMO_PACKAGES := gcc libc6-dev binutils gcc-mingw-w64-x86-64
+TEST_PACKAGES := $(DEMO_PACKAGES) libtbb12 debootstrap libxml2-dev libminizip-dev libsundials-dev zlib1g-dev \
+                 wine wine64 calculix-ccx
+define debian_packages
+	@missing=$$(for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	  if command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
@@ -28,12 +28,16 @@ $(STAMP): pyproject.toml
 	    echo "      (without gcc building the FMU fails, without gcc-mingw-w64-x86-64 it needs --no-win64;"; \
 	    echo "       the tests that need the others are skipped, saying why)"; fi; \
 	fi
+endef
+
+$(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[all]"
 	touch $(STAMP)
 
 demo: $(STAMP)
+	$(call debian_packages,$(DEMO_PACKAGES))
 	$(PY) examples/demo.py
 
 # the test files run on TEST_WORKERS processes (pytest-xdist), a file's tests on one of them (its module
@@ -44,6 +48,7 @@ TEST_WORKERS ?= 2
 COMPILE_LOOPS := import build_fmu; build_fmu.compiled_kernel_files()
 
 test: $(STAMP)
+	$(call debian_packages,$(TEST_PACKAGES))
 	$(PY) -c "$(COMPILE_LOOPS)"
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
@@ -59,5 +64,28 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_realtime.py
 	$(PY) benchmarks/bench_flagged.py
 
+# the documentation site (Sphinx, warnings as errors) into docs/_build/html; its tools pinned in the docs extra
+DOCS_STAMP := $(VENV)/.docs-installed
+$(DOCS_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet -e ".[docs]"
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	rm -rf docs/_build
+	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	@echo "the site: docs/_build/html/index.html"
+
+# screenshots of the built site with headless Chromium (Debian's chromium), to look at it as a reader does
+SHOTS := index guide/bearing-files validation/calculix-bolted
+screenshots: docs
+	@command -v chromium >/dev/null 2>&1 || { [ "$$(id -u)" = 0 ] && apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; }
+	mkdir -p results/screenshots
+	for page in $(SHOTS); do \
+	  chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1400,1800 \
+	    --screenshot=results/screenshots/$$(echo $$page | tr / -).png "file://$(CURDIR)/docs/_build/html/$$page.html" 2>/dev/null; \
+	done
+	@ls results/screenshots
+
 clean:
-	rm -rf $(VENV) build *.egg-info results
+	rm -rf $(VENV) build *.egg-info results docs/_build
