@@ -17,7 +17,7 @@ import os
 import sys
 
 
-#: names the Python installation or virtual environment the FMU runs in (see README, "The FMU")
+#: names the Python installation or virtual environment the FMU runs in (documentation: the FMU, hosts)
 PYTHON_HOME_VARIABLE = "SLEWING_FMU_PYTHONHOME"
 
 

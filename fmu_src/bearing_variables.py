@@ -50,7 +50,7 @@ OUTPUTS = [  # name, unit, description
 #: life and wear outputs (slewing_model.life), 0 while the parameter life is 0 (off)
 LIFE_OUTPUTS = [
     ("life_damage", "1", "rolling contact fatigue damage of the worst raceway track so far, from the raceway map "
-                         "(1: its L10 is used up; ISO/TS 16281 capacities, docs/life.md)"),
+                         "(1: its L10 is used up; ISO/TS 16281 capacities; documentation: life and wear)"),
     ("life_travel_ratio", "1", "x/2b of the last completed half-cycle of psi: rolling travel of the contacts over "
                                "the Hertz patch width (smallest over the loaded tracks; < 1: the patch is never "
                                "uncovered; 0 until the first half-cycle is completed)"),
@@ -92,7 +92,7 @@ INTEGER_PARAMETERS = [
     ("life", LIFE, "life and wear accumulators (outputs life_damage, life_travel_ratio)"),
     ("step_work", STEP_WORK, "work of a step: complete solves every step to the tolerance, however long a sudden "
                              "load change makes it; bounded (real time) caps a step's Newton iterations and ring "
-                             "operator work (README, Speed) and carries the rest over to the next steps, flagged by "
+                             "operator work (documentation: performance) and carries the rest over to the next steps, flagged by "
                              "equilibrium_residual above tolerance"),
 ]
 
