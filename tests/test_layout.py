@@ -1,5 +1,5 @@
 """The package drawn by its imports: no import cycle, at most four modules of its own beside
-the subpackages, the run-time part importing numpy only, and the README's code map naming what
+the subpackages, the run-time part importing numpy only, and the code map (docs/theory/code-map.md) naming what
 is there (and nothing that is not).
 
 The import graph is read from the source with ast, lazy imports inside functions included, as
@@ -119,24 +119,24 @@ def test_the_runtime_list_names_every_run_time_module_that_exists():
     assert {f"{f}/__init__" for f in folders} <= set(RUNTIME_MODULES)
 
 
-def _readme_code_map() -> str:
-    text = (ROOT / "README.md").read_text()
+def _code_map() -> str:
+    text = (ROOT / "docs" / "theory" / "code-map.md").read_text()
     start = text.index("```\nslewing_model/")
     return text[start:text.index("```", start + 3)]
 
 
-def test_the_readme_code_map_names_every_subpackage_and_module_of_its_own():
-    code_map = _readme_code_map()
+def test_the_code_map_names_every_subpackage_and_module_of_its_own():
+    code_map = _code_map()
     for sub in sorted(p.parent.name for p in PACKAGE.glob("*/__init__.py")):
-        assert re.search(rf"^\s+{sub}/", code_map, re.M), f"{sub}/ is not in the README's code map"
+        assert re.search(rf"^\s+{sub}/", code_map, re.M), f"{sub}/ is not in the code map (docs/theory/code-map.md)"
     for own in sorted(p.name for p in PACKAGE.glob("*.py") if p.name != "__init__.py"):
-        assert own in code_map, f"{own} is not in the README's code map"
+        assert own in code_map, f"{own} is not in the code map (docs/theory/code-map.md)"
 
 
-def test_every_file_the_readme_code_map_names_exists():
+def test_every_file_the_code_map_names_exists():
     """Each ``name.py`` or ``name/`` indented under a folder of the map is there."""
     folders = [ROOT]
-    for line in _readme_code_map().splitlines()[1:]:
+    for line in _code_map().splitlines()[1:]:
         entry = line.split()[0] if line.strip() else ""
         if not entry or not re.fullmatch(r"[\w./]+", entry) or not entry.endswith(("/", ".py,", ".py")):
             continue
@@ -145,6 +145,6 @@ def test_every_file_the_readme_code_map_names_exists():
             continue
         parent = folders[depth] if depth < len(folders) else folders[-1]
         path = (ROOT if depth == 0 else parent) / entry.rstrip(",")
-        assert path.exists(), f"the README's code map names {path.relative_to(ROOT)}, which is not there"
+        assert path.exists(), f"the code map names {path.relative_to(ROOT)}, which is not there"
         if entry.endswith("/"):
             folders[depth + 1:] = [path]
