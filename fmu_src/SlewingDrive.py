@@ -3,7 +3,7 @@
 A thin wrapper over :class:`slewing_drives.drive.ElectricDrive`: the same
 discrete model (cascaded position and speed PI, torque lag, gear, ring
 inertia) and the same Coulomb friction with stick-slip, stepped once per
-communication step with the inputs held over it. ``build_drive_fmu.py``
+communication step with the inputs held over it. ``fmu_build/drive.py``
 packages it with ``slewing_drives/drive.py`` and the drive definition
 (``drive.json``, SI units) in the FMU's resources; the definition's values
 are the start values of the FMU's parameters.

@@ -1,4 +1,4 @@
-"""The loops compiled ahead of time (``build_aot.py``, issue 31): modules that need numpy only, one for
+"""The loops compiled ahead of time (``fmu_build/aot.py``, issue 31): modules that need numpy only, one for
 an x86-64-v3 CPU and one for any x86-64, each equal to numba's JIT, the first the CPU runs taken, used only
 where they were compiled from these sources, and an FMU that carries them instead of numba and runs in a C
 host."""
@@ -54,10 +54,10 @@ print(json.dumps({"aot": compiled.aot_kernels() is not None, "numba": sys.module
 @pytest.fixture(scope="module")
 def aot_folder(tmp_path_factory):
     sys.path.insert(0, str(ROOT))
-    import build_aot
+    import fmu_build.aot
 
     folder = tmp_path_factory.mktemp("aot")
-    build_aot.build_all_kernels(folder)
+    fmu_build.aot.build_all_kernels(folder)
     return folder
 
 

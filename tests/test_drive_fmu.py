@@ -1,4 +1,4 @@
-"""The drive FMU (build_drive_fmu.py) alone: the checks of test_drives.py run through it, and its
+"""The drive FMU (fmu_build/drive.py) alone: the checks of test_drives.py run through it, and its
 outputs against slewing_drives' ElectricDrive step for step."""
 import math
 import shutil
@@ -22,7 +22,7 @@ DRIVES = test_drives.DRIVES
 def drive_fmus(tmp_path_factory):
     """The FMU of each drive definition, by drive name."""
     sys.path.insert(0, str(ROOT))
-    from build_drive_fmu import build_drive_fmu
+    from fmu_build.drive import build_drive_fmu
 
     folder = tmp_path_factory.mktemp("drive_fmu")
     return {DriveParameters.from_toml(ROOT / path).name: build_drive_fmu(ROOT / path, folder / f"{Path(path).stem}.fmu")

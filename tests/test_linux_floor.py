@@ -56,9 +56,9 @@ def floor_dir():
         pytest.skip(f"SKIPPED: the floor-lowered runtime is not built in {FLOOR_DIR} (CPython in a Debian 11 "
                     "chroot, 2 to 4 minutes): run tests/linux_floor/run_all.sh, or set SLEWING_BUILD_LINUX_FLOOR=1")
     from importlib.metadata import version
-    import build_runtime
+    import fmu_build.runtime
 
-    theirs = build_runtime.interpreter(found["runtime_python"])["packages"]
+    theirs = fmu_build.runtime.interpreter(found["runtime_python"])["packages"]
     ours = {name: version(name) for name in theirs}
     if theirs != ours:
         pytest.skip(f"SKIPPED: the floor-lowered runtime in {FLOOR_DIR} has {theirs}, this venv {ours}: "

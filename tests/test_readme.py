@@ -25,12 +25,12 @@ OPENFAST = ROOT.parent / "shared" / "data" / "openfast"
 SKIPPED = (
     (r"make ", "installs the environment / runs the whole suite: what `make test` is"),
     (r"\.venv/bin/python build_fmu\.py", "builds an FMU (half a minute or more); tests/test_fmu*.py build and run it"),
-    (r"\.venv/bin/python build_drive_fmu\.py", "builds an FMU; tests/test_drive_fmu.py runs it"),
+    (r"\.venv/bin/python -m fmu_build\.drive", "builds an FMU; tests/test_drive_fmu.py runs it"),
     (r"bash tests/linux_floor/", "builds CPython in a Debian 11 chroot (minutes, as root); tests/linux_floor/run_all.sh "
                                  "runs it, tests/test_linux_floor.py uses what it built"),
     (r"\.venv/bin/python examples/ssp/", "builds and runs the SSP's four FMUs (minutes); tests/test_ssp.py runs it"),
     (r"\.venv/bin/python examples/", "a full example (seconds to a minute); examples/timings.py times each"),
-    (r"\.venv/bin/python benchmarks/", "a benchmark (minutes)"),
+    (r"\.venv/bin/python (-m )?benchmarks", "a benchmark (minutes)"),
     (r"\.venv/bin/slewing batch examples/studies/", "a study of minutes (2,000 or 10 long cases); tests/test_study.py"),
     (r"ECOS=|chmod \+x \"\$ECOS\"|mkdir -p results && cd results", "ecos needs the SSP built (minutes)"),
     (r"export |dask ", "environment or cluster set-up for another machine"),

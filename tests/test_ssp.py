@@ -41,8 +41,8 @@ def _command(t):
 def system(table3_fmu, tmp_path_factory):
     """The SSP, its inputs and run_manoeuvre's results for each coupling."""
     sys.path.insert(0, str(ROOT))
-    from build_drive_fmu import build_drive_fmu
     from build_ssp import build_ssp, step_command
+    from fmu_build.drive import build_drive_fmu
     from slewing_drives import DriveParameters, LoadSeries
     from slewing_drives.cosimulation import run_manoeuvre
 
@@ -148,7 +148,7 @@ def test_parallel_coupling_stays_close_to_the_sequential_one(system):
 def test_ecos_program_runs_the_ssp_in_a_minimal_environment(system, tmp_path):
     # ecos's own executable (C++), started with only PATH=/usr/bin:/bin and HOME and no LD_PRELOAD:
     # every FMU of the SSP (bearing, drive, tables) carries the Linux layer that loads its Python
-    # (build_fmu.install_python_shim); its last values equal run_manoeuvre's to ecos's six decimals
+    # (fmu_build.shim.install_python_shim); its last values equal run_manoeuvre's to ecos's six decimals
     _host("ecos")
     import ecospy
 

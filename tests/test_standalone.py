@@ -328,7 +328,7 @@ def test_a_runtime_staged_from_debians_python3_runs_in_a_bare_system(hosts, stan
                           f"numpy=={np.__version__}"], capture_output=True, text=True)
     if pip.returncode != 0:
         pytest.skip(f"cannot install numpy for Debian's python3: {pip.stderr[-300:]}")
-    staged = subprocess.run([str(debian), "-c", "import build_runtime, json, sys; r = build_runtime.runtime("
+    staged = subprocess.run([str(debian), "-c", "import fmu_build.runtime, json, sys; r = fmu_build.runtime.runtime("
                              f"'binaries/linux64', cache_dir={str(tmp_path / 'cache')!r}); "
                              "print(json.dumps([str(r.archive), r.python, r.glibc]))"],
                             env={"PATH": "/usr/bin:/bin", "PYTHONPATH": f"{packages}:{ROOT}"},
@@ -488,7 +488,7 @@ def assert_no_building_paths(fmu):
 @pytest.fixture(scope="module")
 def table_fmu(tmp_path_factory):
     sys.path.insert(0, str(ROOT))
-    from build_drive_fmu import build_table_fmu
+    from fmu_build.drive import build_table_fmu
 
     return build_table_fmu(tmp_path_factory.mktemp("table") / "command.fmu", "a command", [0.0, 1.0],
                            [("command", "rad", "pitch angle command")], [[0.0], [0.1]])
@@ -498,7 +498,7 @@ def test_no_file_inside_the_standalone_fmus_holds_a_path_of_the_building_machine
                                                                                  table_fmu):
     for fmu in (*standalone.values(), pitch_drive_fmu, table_fmu):
         assert runtime_of(fmu)["runtime"] == "standalone"
-        with zipfile.ZipFile(fmu) as z:  # the check covers the win64 binary and runtime too (build_win64.py)
+        with zipfile.ZipFile(fmu) as z:  # the check covers the win64 binary and runtime too (fmu_build/win64.py)
             assert any(n.startswith(("binaries/win64/python/", "binaries/x86_64-windows/python/")) for n in z.namelist())
         assert_no_building_paths(fmu)
 
@@ -514,7 +514,7 @@ def test_the_drive_and_table_fmus_of_the_ssp_are_standalone_and_valid(pitch_driv
 @pytest.fixture(scope="module")
 def pitch_drive_fmu(tmp_path_factory):
     sys.path.insert(0, str(ROOT))
-    from build_drive_fmu import build_drive_fmu
+    from fmu_build.drive import build_drive_fmu
 
     return build_drive_fmu(ROOT / "examples" / "drives" / "pitch_drive.toml",
                            tmp_path_factory.mktemp("drive") / "SlewingDrive_pitch.fmu")

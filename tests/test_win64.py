@@ -1,5 +1,5 @@
 """The standalone FMUs' Windows (win64) binary, under wine: no Windows machine, no Python on the "Windows" side
-but the FMU's own (build_win64.py).
+but the FMU's own (fmu_build/win64.py).
 
 Each FMU (the FMI 2.0 and 3.0 bearing FMUs and the drive FMU) runs in
 (a) our C host (tests/c_host/host.c) cross-compiled with mingw-w64: steps, state get/set/serialize,
@@ -66,7 +66,7 @@ pytestmark = [
 @pytest.fixture(scope="module")
 def drive_fmu(tmp_path_factory):
     sys.path.insert(0, str(ROOT))
-    from build_drive_fmu import build_drive_fmu
+    from fmu_build.drive import build_drive_fmu
 
     return build_drive_fmu(ROOT / "examples" / "drives" / "pitch_drive.toml",
                            tmp_path_factory.mktemp("drive") / "SlewingDrive_pitch.fmu")
@@ -186,14 +186,14 @@ def numba_fmu(tmp_path_factory):
     version of the loops). That compilation takes about five minutes under wine (two CPUs): until it is
     kept, the test is skipped, saying so (run tests/win64/run_all.sh, or set SLEWING_BUILD_WIN64_NUMBA=1)."""
     sys.path.insert(0, str(ROOT))
-    import build_win64
+    import fmu_build.win64
     from build_fmu import build_fmu, compiled_kernel_files
 
     kept = {"SLEWING_WIN64_BUILD_DIR": str(w.WINE_DIR / "build"), "WINEPREFIX": str(w.PREFIX)}
     with pytest.MonkeyPatch.context() as patch:
         for name, value in kept.items():
             patch.setenv(name, value)
-        if not (build_win64.kernels_folder(compiled_kernel_files()[0]) / "slewing_model").exists() \
+        if not (fmu_build.win64.kernels_folder(compiled_kernel_files()[0]) / "slewing_model").exists() \
                 and not os.environ.get("SLEWING_BUILD_WIN64_NUMBA"):
             pytest.skip(f"SKIPPED: the loops for --win64-numba are not compiled under wine yet (about 5 minutes, kept "
                         f"in {kept['SLEWING_WIN64_BUILD_DIR']}): run tests/win64/run_all.sh, or set "

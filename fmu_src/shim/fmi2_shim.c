@@ -1,7 +1,7 @@
 /* The FMI 2.0 binary of the slewing bearing FMU on Linux: a thin layer in front of pythonfmu's.
  *
  * build_fmu.py compiles this file as binaries/linux64/<modelIdentifier>.so and moves
- * pythonfmu's binary beside it as pythonfmu-export.so; build_win64.py compiles it with mingw-w64 as
+ * pythonfmu's binary beside it as pythonfmu-export.so; fmu_build/win64.py compiles it with mingw-w64 as
  * binaries/win64/<modelIdentifier>.dll, with python_runtime_win.c, beside pythonfmu-export.dll. Every fmi2 function is forwarded to
  * pythonfmu's; this layer adds three things:
  *

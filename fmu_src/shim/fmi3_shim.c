@@ -1,7 +1,7 @@
 /* The FMI 3.0 binary of our FMUs on Linux: a thin layer in front of pythonfmu3's.
  *
  * build_fmu.py compiles this file as binaries/x86_64-linux/<modelIdentifier>.so and moves
- * pythonfmu3's binary beside it as pythonfmu-export.so (build_win64.py: binaries/x86_64-windows/
+ * pythonfmu3's binary beside it as pythonfmu-export.so (fmu_build/win64.py: binaries/x86_64-windows/
  * <modelIdentifier>.dll with python_runtime_win.c, beside pythonfmu-export.dll). It adds what the FMI 2.0 layer
  * (fmi2_shim.c) adds for Python, and forwards every fmi3 function unchanged:
  *

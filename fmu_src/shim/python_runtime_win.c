@@ -1,6 +1,6 @@
 /* Loading the Python that an FMU runs its model in, on Windows (see python_runtime.h).
  *
- * The Windows analogue of python_runtime.c, cross-compiled with mingw-w64 by build_win64.py into
+ * The Windows analogue of python_runtime.c, cross-compiled with mingw-w64 by fmu_build/win64.py into
  * binaries/win64/<modelIdentifier>.dll (FMI 3.0: binaries/x86_64-windows) with fmi2_shim.c or
  * fmi3_shim.c. The FMU carries the official embeddable CPython in binaries/<platform>/python/
  * (python311.dll, python3.dll, python311.zip, the standard library's .pyd modules, the Visual C++

@@ -1,7 +1,7 @@
 /* What the FMI layers (fmi2_shim.c, fmi3_shim.c) need of the platform, for Linux and Windows.
  *
  * Linux: glibc's dlsym and pthread mutexes (glibc_compat.h first: the oldest symbol versions).
- * Windows (cross-compiled with mingw-w64, build_win64.py): GetProcAddress and slim reader/writer
+ * Windows (cross-compiled with mingw-w64, fmu_build/win64.py): GetProcAddress and slim reader/writer
  * locks, so that the DLL needs nothing but KERNEL32 and msvcrt (no winpthread DLL). Include
  * before any other header. */
 #ifndef SLEWING_SHIM_PLATFORM_H

@@ -6,7 +6,7 @@ round-off. A kernel module enters each loop with :func:`loop_factory` in its own
 the loop is compiled when first asked for (or loaded from numba's on-disk cache, ``__pycache__``
 beside the kernel's source, keyed by the source's content).
 
-The same loops compiled ahead of time (``build_aot.py``: numba's ``pycc``, an extension module
+The same loops compiled ahead of time (``fmu_build/aot.py``: numba's ``pycc``, an extension module
 named :data:`AOT_MODULE` that needs numpy only) take the place of numba where that module can be
 imported and was compiled from these sources (:func:`kernel_source_hash`): an FMU built with
 ``--aot`` carries it instead of numba and llvmlite. A module of other sources is not used.
@@ -19,7 +19,7 @@ import importlib
 import importlib.util
 from pathlib import Path
 
-#: the extension module of the loops compiled ahead of time (build_aot.py) for any x86-64 CPU
+#: the extension module of the loops compiled ahead of time (fmu_build/aot.py) for any x86-64 CPU
 AOT_MODULE = "slewing_kernels"
 #: ... and the modules by target (:data:`slewing_model.numerics.targets.PORTABLE_TARGETS`): an ``--aot`` FMU
 #: carries one for each and takes the first its CPU can run (:func:`aot_targets`)
@@ -98,7 +98,7 @@ def use_compiled(kernel: str, name: str = "kernel") -> bool:
         raise ValueError(f"{name} = {kernel!r}: must be 'auto', 'numpy' or 'compiled'")
     if kernel == "compiled" and not AVAILABLE:
         raise ValueError(f"{name} = 'compiled' needs numba, which is not installed in this Python, or the "
-                         f"loops compiled ahead of time ({AOT_MODULE}, build_aot.py) "
+                         f"loops compiled ahead of time ({AOT_MODULE}, fmu_build/aot.py) "
                          "(pip install numba, or use 'auto' or 'numpy')")
     return AVAILABLE and kernel != "numpy"
 
@@ -141,7 +141,7 @@ def compile_loop(function, signature: str, helpers: tuple = (), error_model: str
 def compile_helpers(module: dict, helpers: tuple, error_model: str = "python", inline: tuple = (),
                     fastmath: frozenset = frozenset()) -> None:
     """Each of ``helpers`` (names in the globals ``module``) compiled in place of its Python
-    definition, once (:func:`compile_loop`; ``build_aot.py`` before it exports the loops)."""
+    definition, once (:func:`compile_loop`; ``fmu_build/aot.py`` before it exports the loops)."""
     import numba
 
     for name in helpers:

@@ -14,7 +14,7 @@ first whose features that CPU has (:func:`portable_target`):
   both fuse multiply-adds);
 - ``generic``: any x86-64 CPU (SSE2 only).
 
-The loops compiled ahead of time (``build_aot.py``, an FMU built with ``--aot``) are compiled for the same
+The loops compiled ahead of time (``fmu_build/aot.py``, an FMU built with ``--aot``) are compiled for the same
 targets, one extension module each; that FMU has no LLVM to ask, so it reads the CPU's features from the
 Linux kernel (:func:`cpuinfo_features`).
 

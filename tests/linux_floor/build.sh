@@ -97,14 +97,14 @@ if [ ! -x "$PY_OUT/bin/python3.11" ]; then
   rm -rf "$PY_OUT.partial"
   cp -a "$BUILD$prefix" "$PY_OUT.partial"
   # the interpreter finds its libpython relative to itself, wherever the folder is (here, or inside the chroot)
-  "$VENV_PY" -c "import sys; sys.path.insert(0, '$root'); import build_runtime as b; b.set_runpath('$PY_OUT.partial/bin/python3.11', '\$ORIGIN/../lib')"
+  "$VENV_PY" -c "import sys; sys.path.insert(0, '$root'); import fmu_build.runtime as b; b.set_runpath('$PY_OUT.partial/bin/python3.11', '\$ORIGIN/../lib')"
   rm -rf "$PY_OUT"; mv "$PY_OUT.partial" "$PY_OUT"
   rm -rf "$BUILD/tmp/cpython" "$BUILD/tmp/wheels"
   log "CPython with $versions: $PY_OUT ($((SECONDS - t0)) s)"
 fi
 
 # ---- the libraries beyond glibc that CPython's modules and the wheels need, Debian 11's, beside libpython --------
-# (build_runtime.py takes them from there for an interpreter other than the running one, not from this machine)
+# (fmu_build/runtime.py takes them from there for an interpreter other than the running one, not from this machine)
 if [ ! -f "$PY_OUT/lib/.slewing-libraries" ]; then
   prefix=/opt/slewing-floor/cpython-$CPYTHON_VERSION-$key
   [ -x "$BUILD$prefix/bin/python3.11" ] || { rm -rf "$BUILD$prefix"; mkdir -p "$(dirname "$BUILD$prefix")"; cp -a "$PY_OUT" "$BUILD$prefix"; }

