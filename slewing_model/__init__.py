@@ -2,7 +2,7 @@
 
 The method is that of Heras et al., *Load distribution and friction torque in
 four-point contact slewing bearings considering manufacturing errors and ring
-flexibility* (``shared/reference``): Hertz contact springs between groove
+flexibility* (the theory section follows it equation by equation): Hertz contact springs between groove
 centres (Rigid-BIME), ring flexibility through a precomputed finite element
 superelement (Flexible-BIME), and an analytical friction torque fed by the load
 distribution.

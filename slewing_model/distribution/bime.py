@@ -162,44 +162,62 @@ class BimeSolver:
     Parameters
     ----------
     bearing : Bearing
+        The bearing definition (with its errors and preload).
     superelement : Superelement, optional
         Both rings' condensed stiffness (:mod:`slewing_model.rings.stiffness`);
-        None for rigid rings.
-    psi : float, rad
-        Rotation of the moving ring.
-    cage_angle : float, rad, optional
-        Rotation of the ball set; default: rolling without slip from ``psi``.
-    rtol : float
-        Relative tolerance of the stopping rule.
-    max_iterations : int
-    pressure_limit : float, Pa
-        Loads whose largest Hertz pressure exceeds this are refused
+        None (default) for rigid rings.
+    psi : float, optional
+        Rotation of the moving ring, rad. Default 0.
+    cage_angle : float, optional
+        Rotation of the ball set, rad; default (None): rolling without slip from ``psi``.
+    rtol : float, optional
+        Relative tolerance of the stopping rule (force residual relative to the load
+        scale). Default 1e-10.
+    max_iterations : int, optional
+        Most Newton iterations of a complete solve. Default 200.
+    pressure_limit : float, optional
+        Loads whose largest Hertz pressure exceeds this, Pa, are refused
         (:class:`LoadCapacityError`). Default ``2 x 4200 MPa``: twice the ISO 76
         permanent-deformation limit (static safety factor 0.125), gross plastic
         deformation where the elastic Hertz model no longer holds.
-    kernel : {"numpy", "auto", "compiled"}
-        How the solver's per-contact work is done (a new rotation's grooves and Jacobian, the
-        trial points, the reduced operator's steps, forming, turning and bordering, the
-        result's contacts): numpy array operations, or compiled loops
-        (:mod:`slewing_model.distribution.kernel`, needs numba), which also run the iterations that
-        keep the reduced operator one after the other in one loop, with the ring compliance's
-        product by a real DFT; "auto" takes the compiled loops where numba is installed. The
-        same iterations, and results to round-off. Default numpy: a
-        few solves do not repay numba's import (0.5 s); the co-simulation's simulator
-        takes "auto" (``SimulatorSettings.contact_kernel``).
-    step_work : {"complete", "bounded"}
-        How much a warm solve may do. "complete": Newton to ``rtol``, however many iterations
-        and ring operator inversions that takes (the pitch bearing's moment reversed in one step:
-        9 and 5, from the held-rings start of :meth:`_held_rings_start`). "bounded" (real time): at
-        most :data:`BOUNDED_ITERATIONS` iterations and :data:`BOUNDED_WORK` of work, the operator's
-        and the iterations' (a new operator's inverse spread over as many solves as that takes); a
-        solve that would need more returns its last iterate with ``converged=False`` and its ``residual``, keeps its operator
-        (and one being inverted), and the next warm solve goes on from there. A cold solve
-        (no ``initial``) is always complete.
-    blas_threads : int or None
-        Threads of numpy's BLAS while the solver iterates beyond the usual step's one compiled call
-        (:func:`slewing_model.numerics.blas.blas_threads`, restored after; the operator's inversions and
-        borderings are its BLAS work); None leaves them as the process has them.
+    kernel : {"numpy", "auto", "compiled"}, optional
+        How the solver's per-contact work is done: numpy array operations, or compiled
+        loops (:mod:`slewing_model.distribution.kernel`, needs numba), which also run the
+        flexible solver's iterations in one loop, with the ring compliance's product by a
+        real DFT; "auto" takes the compiled loops where numba is installed. The same
+        iterations, and results to round-off. Default "numpy": a few solves do not repay
+        numba's import (0.5 s); the co-simulation's simulator takes "auto"
+        (``SimulatorSettings.contact_kernel``).
+    step_work : {"complete", "bounded"}, optional
+        How much a warm solve may do. "complete" (default): Newton to ``rtol``, however
+        many iterations and ring operator inversions that takes. "bounded" (real time): at
+        most 12 Newton iterations and 1e8 of work (``BOUNDED_ITERATIONS``, ``BOUNDED_WORK``:
+        floating-point operations weighted to track time, about 1.8 ms on one core), the
+        operator's and the iterations' (a new operator's inverse spread over as many solves
+        as that takes);
+        a solve that would need more returns its last iterate with ``converged=False`` and
+        its ``residual``, keeps its operator (and one being inverted), and the next warm
+        solve goes on from there. A cold solve (no ``initial``) is always complete.
+    blas_threads : int or None, optional
+        Threads of numpy's BLAS while the solver iterates
+        (:func:`slewing_model.numerics.blas.blas_threads`, restored after; the ring
+        operator's inversions are its BLAS work); None (default) leaves them as the
+        process has them.
+
+    Raises
+    ------
+    ValueError
+        If ``step_work`` is unknown or the superelement was built for another ball count.
+
+    Examples
+    --------
+    >>> from slewing_model import BimeSolver, Loads, load_bearing
+    >>> solver = BimeSolver(load_bearing("examples/bearings/table1.toml"))
+    >>> first = solver.solve(Loads(Fz=500e3))
+    >>> solver.set_rotation(0.01)
+    >>> second = solver.solve(Loads(Fz=510e3), initial=first)
+    >>> second.contact_load.shape
+    (100, 4)
     """
 
     def __init__(self, bearing: Bearing, superelement=None, *, psi: float = 0.0, cage_angle: float | None = None,
@@ -235,7 +253,8 @@ class BimeSolver:
         self._loaded_from = 1e-15 * bearing.ball_diameter     # a spring stretched more than this is loaded
         self._reduced = None  # reduced Newton operator kept between iterations and solves (flexible)
         self._reduced_jacobian = None  # the Jacobian (its array) the kept operator's coupling was formed for
-        #: a new operator being inverted over solves (flexible, warm solves), or None: state too
+        #: a new ring operator being inverted over several warm solves (flexible rings), or None;
+        #: part of a co-simulation's state
         self.pending_operator: PendingOperator | None = None
         # a turn of the ring only turns the Jacobian's columns where the moving ring's grooves have no
         # errors; with errors, nearly (reduced_operator.APPROXIMATE_TURN)
@@ -248,8 +267,9 @@ class BimeSolver:
 
     @property
     def operator(self):
-        """The reduced Newton operator kept between solves (flexible rings; None before the first,
-        :mod:`slewing_model.rings.reduced_operator`): part of a co-simulation's state."""
+        """The reduced Newton operator kept between solves (flexible rings; None before the first
+        solve, :mod:`slewing_model.rings.reduced_operator`): part of a co-simulation's state.
+        Settable (to restore a state)."""
         return self._reduced
 
     @operator.setter
@@ -258,8 +278,18 @@ class BimeSolver:
 
     # ---- set-up -------------------------------------------------------------------
     def set_rotation(self, psi: float, cage_angle: float | None = None) -> None:
-        """Re-assemble at another rotation of the moving ring (errors move with
-        the rings; the ring matrices do not change: the rings are axisymmetric)."""
+        """Re-assemble at another rotation of the moving ring.
+
+        The manufacturing errors move with the rings; the ring matrices do not change
+        (the rings are axisymmetric).
+
+        Parameters
+        ----------
+        psi : float
+            Rotation of the moving ring, rad.
+        cage_angle : float, optional
+            Rotation of the ball set, rad; default (None): rolling without slip from ``psi``.
+        """
         previous = self.assembly
         self.assembly = a = assemble(self.bearing, psi, cage_angle, previous=previous, compiled=self._compiled)
         if previous is None or a.groove_centre is not previous.groove_centre:   # other grooves under the balls
@@ -285,8 +315,19 @@ class BimeSolver:
         self._jacobian_rows = self.jacobian.reshape(-1, 5)     # (4B, 5): one matrix-vector product
 
     def scaled_load(self, loads: Loads) -> np.ndarray:
-        """The loads as the solver's unknowns take them: ``(Fx, Fy, Fz, Mx / L, My / L)``, N (``L`` its
-        length scale, :attr:`length`), a new array."""
+        """The loads as the solver's unknowns take them.
+
+        Parameters
+        ----------
+        loads : Loads
+            External load on the moving ring.
+
+        Returns
+        -------
+        ndarray, shape (5,)
+            ``(Fx, Fy, Fz, Mx / L, My / L)``, N, with ``L`` the solver's length scale
+            (:attr:`length`, the pitch radius, m); a new array.
+        """
         f = loads.as_array()
         f[3:] /= self.length
         return f
@@ -319,14 +360,18 @@ class BimeSolver:
         ----------
         x : ndarray (5,) for rigid rings, (5 + 8B,) for flexible rings
             ``(X, Y, Z, rx, ry)``, then ``D_out`` and ``D_in`` (4B each, ordered
-            as paper eq 14: per ball ``R, z`` of the ring's two groove centres).
+            as paper eq 14: per ball ``R, z`` of the ring's two groove centres); m and rad.
         loads : Loads, optional
+            External load on the moving ring; None: no load.
 
         Returns
         -------
-        energy : float, J
+        energy : float
+            Total potential energy, J.
         gradient : ndarray like ``x``
+            Its derivative by ``x``: N for lengths, N m for angles.
         hessian : ndarray (len(x), len(x))
+            Its second derivative by ``x`` (N/m, N, N m by pairs of unknowns).
         """
         loads = Loads() if loads is None else loads
         n = self.bearing.ball_count
@@ -363,8 +408,22 @@ class BimeSolver:
         return energy, grad, hessian
 
     def potential_energy(self, x: np.ndarray, loads: Loads | None = None) -> float:
-        """Total potential energy (eq 20) of the rigid model at ``x = (X, Y, Z, rx, ry)``, J
-        (energy only: for comparisons with derivative-free minimisers)."""
+        """Total potential energy (eq 20) of the rigid model, energy only.
+
+        For comparisons with derivative-free minimisers.
+
+        Parameters
+        ----------
+        x : ndarray, shape (5,)
+            ``(X, Y, Z, rx, ry)`` of the moving ring, m and rad.
+        loads : Loads, optional
+            External load on the moving ring; None: no load.
+
+        Returns
+        -------
+        float
+            The energy, J.
+        """
         loads = Loads() if loads is None else loads
         x = np.asarray(x, dtype=float)
         e = self.assembly.separation + self.jacobian @ (x * [1.0, 1.0, 1.0, self.length, self.length])
@@ -381,6 +440,11 @@ class BimeSolver:
             None: idling (preload and errors only).
         initial : LoadDistribution or ndarray, optional
             Warm start: a previous result of this solver (or its ``state``).
+
+        Returns
+        -------
+        LoadDistribution
+            Ball loads, contact angles, ring displacement and solver figures.
 
         Raises
         ------
@@ -1008,36 +1072,50 @@ def solve(bearing: Bearing, loads: Loads | None = None, *, model: str = "rigid",
     Parameters
     ----------
     bearing : Bearing
+        The bearing definition (with its errors and preload).
     loads : Loads, optional
-        External load on the moving ring (fixed frame); None for idling.
-    model : {"rigid", "flexible"}
-        Rigid rings (Rigid-BIME) or flexible rings (Flexible-BIME).
+        External load on the moving ring (fixed frame), N and N m; None (default) for idling.
+    model : {"rigid", "flexible"}, optional
+        Rigid rings (Rigid-BIME, default) or flexible rings (Flexible-BIME).
     superelement : Superelement, optional
         For ``model="flexible"``; built (or read from the cache) with ``bc``
         and ``mesh`` when not given.
-    bc : {"free", "clamped", "frictionless"}
-        Ring support for a superelement built here.
-    mesh : {"coarse", "fine"}
-    psi : float, rad
-        Rotation of the moving ring.
-    cage_angle : float, rad, optional
-        Rotation of the ball set; default: rolling without slip from ``psi``.
+    bc : {"free", "clamped", "frictionless"}, optional
+        Ring support for a superelement built here. Default "free".
+    mesh : {"coarse", "fine"}, optional
+        Finite element mesh of a superelement built here. Default "coarse".
+    psi : float, optional
+        Rotation of the moving ring, rad. Default 0.
+    cage_angle : float, optional
+        Rotation of the ball set, rad; default (None): rolling without slip from ``psi``.
     initial : LoadDistribution, optional
         Warm start.
-    rtol : float
-        Relative tolerance of the force residuals.
+    rtol : float, optional
+        Relative tolerance of the force residuals. Default 1e-10.
 
     Returns
     -------
     LoadDistribution
+        Ball loads ``Q`` (N), contact angles (rad), ring displacement, Hertz
+        ellipses and pressures.
+
+    Raises
+    ------
+    NoEquilibriumError
+        The load has no equilibrium within the bearing.
+    LoadCapacityError
+        The load is beyond what the raceways can carry.
 
     Examples
     --------
     >>> from slewing_model import load_bearing, solve, Loads
     >>> b = load_bearing("examples/bearings/table1.toml")
-    >>> r = solve(b, Loads(Fz=500e3))
-    >>> bool(abs(r.contact_load[:, 0].sum() * 0 + r.contact_load[:, 0].std()) < 1e-6 * r.max_ball_load)
-    True
+    >>> r = solve(b, Loads(Fz=500e3))            # pure axial load: the 100 balls share it equally
+    >>> round(r.max_ball_load)                   # N
+    6898
+    >>> r = solve(b, Loads(Fz=500e3, My=1e6))
+    >>> round(r.max_ball_load), round(r.static_safety_factor, 2)
+    (40289, 2.33)
     """
     if model not in ("rigid", "flexible"):
         raise ValueError(f"model = {model!r}: must be 'rigid' or 'flexible'")

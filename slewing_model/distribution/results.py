@@ -22,7 +22,11 @@ DISPLACEMENT_FIELDS = ("x", "y", "z", "rx", "ry")
 
 
 class NoEquilibriumError(RuntimeError):
-    """No equilibrium exists for the load (or the solver could not find one)."""
+    """No equilibrium exists for the load (or the solver could not find one).
+
+    A :class:`RuntimeError`; :class:`LoadCapacityError` is the case of a load
+    beyond the raceways' capacity.
+    """
 
 
 class LoadCapacityError(NoEquilibriumError):
@@ -33,6 +37,8 @@ class LoadCapacityError(NoEquilibriumError):
 class Loads:
     """External load on the moving ring, fixed frame, SI units.
 
+    Every component defaults to 0; each must be a finite number.
+
     Attributes
     ----------
     Fx, Fy, Fz : float, N
@@ -40,6 +46,19 @@ class Loads:
         diagonal 1 (contacts 1 and 3).
     Mx, My : float, N m
         Tilting moment about the x and y axes (right hand).
+
+    Raises
+    ------
+    ValueError
+        If a component is not a finite number.
+
+    Examples
+    --------
+    >>> from slewing_model import Loads
+    >>> print(Loads(Fz=800e3, My=1.2e6))
+    Fz = 800 kN, My = 1200 kN m
+    >>> Loads.from_paper(axial=800e3, tilting_moment=1.2e6).as_array()
+    array([      0.,       0.,  800000.,      -0., 1200000.])
     """
 
     Fx: float = 0.0
@@ -66,22 +85,51 @@ class Loads:
     @classmethod
     def from_paper(cls, axial: float = 0.0, radial: float = 0.0, tilting_moment: float = 0.0,
                    direction: float = 0.0) -> "Loads":
-        """The paper's load set (eqs 19, 22): axial ``Fa`` (N, along +z), radial
-        ``Fr`` (N) in the direction ``phi_r`` (rad) and tilting moment ``Mt``
-        (N m) about the axis perpendicular to it, ``(-sin phi_r, cos phi_r)``."""
+        """The paper's load set (eqs 19, 22).
+
+        Parameters
+        ----------
+        axial : float, optional
+            Axial force ``Fa`` along +z, N. Default 0.
+        radial : float, optional
+            Radial force ``Fr``, N, in the direction ``direction``. Default 0.
+        tilting_moment : float, optional
+            Tilting moment ``Mt``, N m, about the axis perpendicular to the radial
+            force, ``(-sin phi_r, cos phi_r)``. Default 0.
+        direction : float, optional
+            Direction ``phi_r`` of the radial force from the x axis, rad. Default 0.
+
+        Returns
+        -------
+        Loads
+            ``Fx = Fr cos phi_r``, ``Fy = Fr sin phi_r``, ``Fz = Fa``,
+            ``Mx = -Mt sin phi_r``, ``My = Mt cos phi_r``.
+        """
         c, s = math.cos(direction), math.sin(direction)
         return cls(radial * c, radial * s, axial, -tilting_moment * s, tilting_moment * c)
 
     @classmethod
     def from_array(cls, values) -> "Loads":
+        """The load from its components ``(Fx, Fy, Fz, Mx, My)``, N and N m (inverse of :meth:`as_array`)."""
         return cls(*[float(v) for v in values])
 
     def as_array(self) -> np.ndarray:
+        """The components ``(Fx, Fy, Fz, Mx, My)`` as an array of shape (5,), N and N m."""
         return np.array([self.Fx, self.Fy, self.Fz, self.Mx, self.My])
 
     def rotated(self, angle: float) -> "Loads":
-        """The same load turned by ``angle`` (rad) about z (e.g. from the
-        moving ring's own frame to the fixed frame)."""
+        """The same load turned about z (e.g. from the moving ring's own frame to the fixed frame).
+
+        Parameters
+        ----------
+        angle : float
+            Rotation about +z, rad.
+
+        Returns
+        -------
+        Loads
+            Forces and moments turned by ``angle``; ``Fz`` unchanged.
+        """
         c, s = math.cos(angle), math.sin(angle)
         return Loads(c * self.Fx - s * self.Fy, s * self.Fx + c * self.Fy, self.Fz,
                      c * self.Mx - s * self.My, s * self.Mx + c * self.My)
@@ -94,12 +142,14 @@ class LoadDistribution:
 
     Attributes
     ----------
-    model : str
-        ``"rigid"`` or ``"flexible"``.
+    model : {"rigid", "flexible"}
+        Ring model of the solve.
     loads : Loads
+        The load solved for, fixed frame.
     displacement : ndarray (5,)
         Moving ring (X, Y, Z in m; rx, ry in rad).
     ball_angle : ndarray (B,), rad
+        Angular position of every ball.
     contact_load : ndarray (B, 4), N
         ``Q`` of contacts 1..4 (``Q1 = Q3``, ``Q2 = Q4``).
     contact_angle : ndarray (B, 4), rad
@@ -123,6 +173,7 @@ class LoadDistribution:
     energy : float, J
         Total potential energy (eq 20).
     iterations : int
+        Newton iterations of the solve.
     residual : float
         Largest force residual at the end, relative to the load scale.
     state : ndarray
@@ -130,7 +181,7 @@ class LoadDistribution:
     rings : dict, ndarray or None
         The rings' compliances at the groove centres (flexible model,
         :func:`slewing_model.rings.compliance.ring_compliances`), from which
-        ``ring_displacement`` follows; or those displacements, (B, 4, 2).
+        ``ring_displacement`` follows; or those displacements, (B, 4, 2), m.
     converged : bool
         True: ``residual`` is within the solver's tolerance. False only where a bounded solve
         (``step_work="bounded"`` of :class:`~slewing_model.distribution.bime.BimeSolver`) spent its
@@ -191,14 +242,20 @@ class LoadDistribution:
     def static_safety_factor(self) -> float:
         """ISO 76 static safety factor ``(4200 MPa / p_max)^3`` (load ratio, as
         ``C0 / P0``: Hertz pressure grows with the cube root of the load);
-        infinite for an unloaded bearing (largest pressure below :data:`NO_LOAD_PRESSURE`)."""
+        infinite for an unloaded bearing (largest pressure below ``NO_LOAD_PRESSURE``, 4.2 MPa:
+        1/1000 of the ISO 76 limit)."""
         p = self.max_contact_pressure
         return math.inf if p < NO_LOAD_PRESSURE else (ISO76_PRESSURE_LIMIT / p) ** 3
 
     def warnings(self) -> list[str]:
-        """What a user must know about this result although it is a valid solution, one
-        sentence each (empty when nothing): a static safety factor below 1 (ISO 76: the
-        raceways deform permanently) and contacts loaded over the groove edge.
+        """What a user must know about this result although it is a valid solution.
+
+        Returns
+        -------
+        list of str
+            One sentence each (empty when nothing): a bounded step that stopped short of
+            equilibrium, a static safety factor below 1 (ISO 76: the raceways deform
+            permanently) and contacts loaded over the groove edge.
 
         Examples
         --------
@@ -229,14 +286,23 @@ class LoadDistribution:
     @property
     def balls_in_four_point_contact(self) -> int:
         """Number of balls whose both diagonals carry load (a contact pressure of at least
-        :data:`NO_LOAD_PRESSURE` on all four contacts: the round-off interference of an unloaded
-        bearing is no contact)."""
+        ``NO_LOAD_PRESSURE``, 4.2 MPa, on all four contacts: the round-off interference of an
+        unloaded bearing is no contact)."""
         p = self.contact_pressure                  # column by column: np.all(axis=1) costs 5 us on (150, 4)
         least = np.minimum(np.minimum(p[:, 0], p[:, 1]), np.minimum(p[:, 2], p[:, 3]))
         return int(np.count_nonzero(least >= NO_LOAD_PRESSURE))
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready data (the ``slewing solve --json`` object)."""
+        """Plain JSON-ready data (the ``slewing solve --json`` object).
+
+        Returns
+        -------
+        dict
+            Loads, displacement, contact loads ``Q`` (N), contact angles (rad),
+            interference (m), ball angles (rad), pressures (Pa), the summary values
+            (largest ball load and pressure, safety factor, counts), energy (J),
+            iterations and, for flexible rings, ``ring_displacement`` (m).
+        """
         d = {
             "model": self.model,
             "loads": {k: getattr(self.loads, k) for k in LOAD_FIELDS},

@@ -25,10 +25,23 @@ def catalogue_torque(bearing: Bearing, loads, mu: float = CATALOGUE_MU) -> float
     Parameters
     ----------
     bearing : Bearing
+        The bearing; only its pitch diameter ``D`` (m) enters.
     loads : Loads or None
-        ``F_a = |Fz|``, ``F_r = hypot(Fx, Fy)``, ``M_k = hypot(Mx, My)``.
-    mu : float
-        About 0.006 for four-point contact bearings (scatter about +-25 %).
+        External load, N and N m: ``F_a = |Fz|``, ``F_r = hypot(Fx, Fy)``,
+        ``M_k = hypot(Mx, My)``; None: no load (torque 0).
+    mu : float, optional
+        Friction coefficient of the formula, about 0.006 for four-point contact
+        bearings (scatter about +-25 %). Default 0.006.
+
+    Returns
+    -------
+    float
+        Start-up friction torque, N m (no seal part).
+
+    Raises
+    ------
+    ValueError
+        If ``mu`` is not a finite number >= 0.
 
     Examples
     --------

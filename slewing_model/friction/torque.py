@@ -124,12 +124,14 @@ class FrictionTorque:
     power : float, W
         Total dissipated power at ``kinematics_speed``.
     mu : float
+        Coulomb coefficient of the ball-raceway contacts used.
     iterations : int
         Iterations of the ball equilibrium.
     residual : float
         Largest friction force or moment (over ``Dw/2``) left on a ball at the
         last evaluated iterate, relative to ``mu`` times its largest contact load.
     converged : bool
+        True when the ball equilibrium met its tolerance (else the torque is an upper bound).
     state : ndarray (B, 4)
         Ball unknowns per unit of speed: pass as ``initial`` for a warm start.
     """
@@ -156,10 +158,19 @@ class FrictionTorque:
 
     @property
     def balls_in_four_point_contact(self) -> int:
+        """Number of balls loaded on all four contacts."""
         return int(np.count_nonzero(self.contact_count == 4))
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready data (N m, rad/s)."""
+        """Plain JSON-ready data (N m, rad/s).
+
+        Returns
+        -------
+        dict
+            ``torque``, ``magnitude``, ``contact_part``, ``seal_part`` (N m), ``per_ball``
+            (list, N m), ``omega`` (rad/s), ``mu``, ``balls_in_four_point_contact`` and
+            ``converged``.
+        """
         return {
             "torque": self.torque,
             "magnitude": self.magnitude,
@@ -252,44 +263,48 @@ def friction_torque(bearing: Bearing, distribution, *, mu: float = DEFAULT_MU, o
     distribution : LoadDistribution
         Rigid or flexible BIME result: ``contact_load`` (B, 4) N,
         ``contact_angle`` (B, 4) rad, ``semi_axis_a``, ``semi_axis_b`` (B, 4) m.
-    mu : float
-        Coulomb coefficient of the ball-raceway contacts (default
-        :data:`DEFAULT_MU` = 0.1, boundary lubrication).
-    omega : float, rad/s
-        Speed of the moving ring about +z relative to the fixed ring.
-    seal_torque : float, N m
-        Load-independent torque (seals, lubricant).
-    seal_torque_per_length : float, N m per m of seal
-        Added as ``seal_torque_per_length * seal_length``.
-    seal_length : float, m, optional
-        Default: two seals on the pitch circle, ``2 pi dm``.
-    omega_regularisation : float, rad/s
-        Speed scale of :func:`regularised_torque` (0: discontinuous Coulomb law).
-    quadrature : int or (int, int)
+    mu : float, optional
+        Coulomb coefficient of the ball-raceway contacts (default 0.1, boundary lubrication).
+    omega : float, optional
+        Speed of the moving ring about +z relative to the fixed ring, rad/s. Default 1.
+    seal_torque : float, optional
+        Load-independent torque (seals, lubricant), N m. Default 0.
+    seal_torque_per_length : float, optional
+        Load-independent torque per length of seal, N m/m, added as
+        ``seal_torque_per_length * seal_length``. Default 0.
+    seal_length : float, optional
+        Length of seal, m. Default: two seals on the pitch circle, ``2 pi dm``.
+    omega_regularisation : float, optional
+        Speed scale of :func:`regularised_torque`, rad/s (0: discontinuous Coulomb law).
+        Default 1e-4.
+    quadrature : int or (int, int), optional
         Rule (points across x along each ellipse) on which the power, hence
-        the torque, is integrated (default :data:`DEFAULT_QUADRATURE`).
-    solve_quadrature : int, (int, int) or None
-        Rule on which the ball equilibrium is solved (default
-        :data:`DEFAULT_SOLVE_QUADRATURE`); None: ``quadrature`` itself.
-    sliding_regularisation : float
+        the torque, is integrated. Default (20, 4).
+    solve_quadrature : int, (int, int) or None, optional
+        Rule on which the ball equilibrium is solved. Default (12, 2); None:
+        ``quadrature`` itself.
+    sliding_regularisation : float, optional
         ``|v_s|`` becomes ``sqrt(|v_s|^2 + eps^2)`` with
-        ``eps = sliding_regularisation * |omega| * a`` per contact.
+        ``eps = sliding_regularisation * |omega| * a`` per contact (``a`` the ellipse's
+        semi-axis, m). Dimensionless, default 1e-3.
     initial : FrictionTorque or ndarray (B, 4), optional
         Warm start of the ball equilibrium: a previous result for this bearing.
-    tol : float
+    tol : float, optional
         Relative accuracy of the minimum dissipated power, hence of the torque
         (Newton decrement test): every ball's power is within ``tol`` of the
         mean of its own power and the average power per ball, so the total is
         within ``tol`` of its minimum. The torque error it leaves is one-sided
         (the torque is never below the converged one), below the quadrature
-        error (~1e-3).
-    max_iterations : int
-    kernel : {"auto", "numpy", "compiled"}
+        error (~1e-3). Default 1e-5.
+    max_iterations : int, optional
+        Most iterations of the ball equilibrium. Default 60.
+    kernel : {"auto", "numpy", "compiled"}, optional
         How the points are set up, the balls' equilibrium solved and the torque
         summed: numpy array operations, or compiled loops
         (:mod:`slewing_model.friction.kernel`, needs numba); "auto" takes the
         compiled loops where numba is installed. Both take the same steps and
         give the same results to round-off (torques to 1e-10 in the tests).
+        Default "auto".
 
     Returns
     -------

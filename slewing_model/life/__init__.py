@@ -1,4 +1,4 @@
-"""Life and wear of oscillating pitch and yaw bearings, from the load on every ball (issue 24).
+"""Life and wear of oscillating pitch and yaw bearings, from the load on every ball.
 
 * :mod:`.rating` -- ISO/TS 16281 raceway capacities ``Qc``, equivalent loads ``Qe`` and the
   combined L10 of any ball bearing's raceways; ISO 281's axial rating of the four-point bearing.
@@ -9,8 +9,8 @@
 * :mod:`.dg03` -- NREL DG03's catalogue life of the same run.
 * :mod:`.duty` -- the step-by-step accumulator (FMU, studies) and a run's analysis.
 
-See ``docs/life.md``. Run-time part: numpy only (``rainflow`` is imported by the cycle
-counting of a finished run).
+The method, its sources and its checks are on the user guide's life and wear page.
+Run-time part: numpy only (``rainflow`` is imported by the cycle counting of a finished run).
 """
 from .rating import (LifeInputError, Raceway, RacewayLife, axial_rating, combined_life, equivalent_load,
                      four_point_capacities, iso281_axial_rating, raceway_capacity, raceway_life,

@@ -5,11 +5,8 @@ NREL/TP-500-42362, 2009), from the same run, so that every result shows it besid
 * Equivalent load of a moment bearing: ``Pea = 0.75 Fr + Fa + 2 M / dm``.
 * Over a spectrum of bins (here: the rainflow cycles, count ``c_i``, full swing ``θ_i``):
   ``Pea_osc = [Σ Pea_i^3 c_i θ_i / Σ c_i θ_i]^(1/3)``, ``θe = Σ c_i θ_i / Σ c_i``.
-* Balls: ``Ca_osc = Ca (180°/θe)^(3/10) Z^0.033``, whatever θe. An earlier version switched to
-  ``(180°/θe)^(1/3)`` at or above the critical angle; that switch could not be found in DG03's text
-  (not reachable here) nor in the one public DG03 implementation found, so it was removed (issue 28):
-  above the critical angle the factor is applied as the formula stands, and :attr:`DG03Life.above_critical`
-  says so.
+* Balls: ``Ca_osc = Ca (180°/θe)^(3/10) Z^0.033``, whatever θe: above the critical angle the
+  factor is applied as the formula stands, and :attr:`DG03Life.above_critical` says so.
 * ``L10 = (Ca_osc / Pea_osc)^3`` 10^6 cycles.
 
 Run-time module: numpy and the standard library.
@@ -25,7 +22,20 @@ from .oscillation import dg03_rating_factor
 
 
 def equivalent_axial_load(loads, pitch_diameter):
-    """``Pea = 0.75 Fr + Fa + 2 M / dm``, N, of loads (n, >= 5) ``(Fx, Fy, Fz, Mx, My)`` (N, N m)."""
+    """DG03's equivalent axial load of a moment bearing, ``Pea = 0.75 Fr + Fa + 2 M / dm``.
+
+    Parameters
+    ----------
+    loads : array_like, shape (n, >= 5) or (>= 5,)
+        Loads ``(Fx, Fy, Fz, Mx, My)``, N and N m, one row a sample.
+    pitch_diameter : float
+        Pitch diameter ``dm``, m.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        ``Pea``, N.
+    """
     f = np.atleast_2d(np.asarray(loads, dtype=float))
     fr = np.hypot(f[:, 0], f[:, 1])
     m = np.hypot(f[:, 3], f[:, 4])
@@ -38,20 +48,21 @@ class DG03Life:
 
     Attributes
     ----------
-    pea_osc : float, N
-    theta_e : float, rad
-        Equivalent full swing.
-    rating : float, N
-        ``Ca``.
-    rating_osc : float, N
-        ``Ca_osc``.
+    pea_osc : float
+        Equivalent axial load of the oscillation ``Pea_osc``, N.
+    theta_e : float
+        Equivalent full swing ``θe``, rad.
+    rating : float
+        Axial rating ``Ca``, N.
+    rating_osc : float
+        Oscillating rating ``Ca_osc``, N.
     life_cycles : float
         L10, cycles.
     hours : float
         L10 in hours of the run's duty.
     above_critical : bool
-        θe at or above the critical angle: DG03's factor is used beyond the range it was stated for
-        (``DESIGN.md``: it does not return Ca at 180°).
+        θe at or above the critical angle: DG03's factor is used beyond the range it was
+        stated for (it does not return ``Ca`` at 180°).
     """
 
     pea_osc: float
@@ -64,9 +75,30 @@ class DG03Life:
 
 
 def dg03_life(pea_cycle, swing, count, rating, ball_count, critical, duration) -> DG03Life:
-    """DG03's L10 of a run from its cycles' equivalent loads ``pea_cycle`` (N), full swings ``swing``
-    (rad) and counts, the axial rating ``rating`` (N), ``Z``, the critical angle (rad; only to flag
-    :attr:`DG03Life.above_critical`) and the run's duration (s)."""
+    """DG03's L10 of a run from its rainflow cycles.
+
+    Parameters
+    ----------
+    pea_cycle : array_like, shape (n,)
+        Equivalent axial load ``Pea`` of each cycle, N.
+    swing : array_like, shape (n,)
+        Full swing of each cycle, rad.
+    count : array_like, shape (n,)
+        Count of each cycle (1 or 0.5).
+    rating : float
+        Axial rating ``Ca``, N.
+    ball_count : int
+        Number of balls ``Z``.
+    critical : float
+        Critical angle, rad; only to flag :attr:`DG03Life.above_critical`.
+    duration : float
+        Duration of the run, s.
+
+    Returns
+    -------
+    DG03Life
+        Infinite life where the run has no cycles.
+    """
     pea, th, c = (np.asarray(a, dtype=float) for a in (pea_cycle, swing, count))
     ct = float(np.sum(c * th))
     if c.size == 0 or ct <= 0:

@@ -57,22 +57,29 @@ class LifeSettings:
 
     Attributes
     ----------
-    rating : float or None, N
-        Basic dynamic axial rating ``Ca`` of the bearing (ISO 281, from the maker's catalogue);
-        None: from the raceway geometry (:func:`slewing_model.life.rating.axial_rating`).
+    rating : float or None
+        Basic dynamic axial rating ``Ca`` of the bearing, N (ISO 281, from the maker's catalogue);
+        None (default): from the raceway geometry (:func:`slewing_model.life.rating.axial_rating`).
     slices : int or None
-        Slices of each track in the raceway map; None: :func:`~.raceway_map.default_slices` of the
-        bearing's ball count (at least 1440, with no common divisor with Z: no aliasing).
-    reversal_tolerance : float, rad
+        Slices of each track in the raceway map (>= 4); None (default):
+        :func:`~slewing_model.life.raceway_map.default_slices` of the bearing's ball count
+        (at least 1440, with no common divisor with Z: no aliasing).
+    reversal_tolerance : float
         Smallest movement against the current direction that counts as a reversal of ``ψ``
-        (online half-cycles), and smallest rainflow swing kept.
-    relubrication_swing : float or None, rad
-        Movement that relubricates the raceway; None: the largest critical angle of the tracks
-        (a swing over which neighbouring balls' tracks overlap, so the balls spread the grease
-        over the whole raceway).
+        (online half-cycles), and smallest rainflow swing kept, rad. Default 1e-5, above the
+        16-bit quantisation of recorded pitch angles.
+    relubrication_swing : float or None
+        Movement that relubricates the raceway, rad; None (default): the largest critical
+        angle of the tracks (a swing over which neighbouring balls' tracks overlap, so the
+        balls spread the grease over the whole raceway).
     rating_factor : callable or None
-        ``f(theta, Z)`` raising the rating below the critical angle; None: DG03's
-        ``(180°/θ)^(3/10) Z^0.033``.
+        ``f(theta, Z)`` (``theta`` in rad) raising the rating below the critical angle;
+        None (default): DG03's ``(180°/θ)^(3/10) Z^0.033``.
+
+    Raises
+    ------
+    LifeInputError
+        If a value is out of its range.
     """
 
     rating: float | None = None
@@ -97,14 +104,41 @@ class LifeSettings:
 class LifeModel:
     """The run-independent part of a four-point bearing's life calculation.
 
+    The tracks' capacities, critical angles and which ring turns relative to the load:
+    loads given in the fixed ring's frame stand relative to the fixed ring, so the moving
+    ring turns relative to them; loads in the moving ring's frame (blade-root loads of a
+    pitch bearing) turn with it, so the fixed ring turns relative to them.
+
     Parameters
     ----------
     bearing : Bearing
+        The bearing definition.
     moving_ring : {"inner", "outer"}, optional
-        Default the bearing's.
-    load_frame : {"fixed", "rotating"}
-        Frame of the loads (see the module docstring).
-    settings : LifeSettings
+        The ring that turns by ``psi``; default the bearing's.
+    load_frame : {"fixed", "rotating"}, optional
+        Frame of the loads. Default "fixed".
+    settings : LifeSettings, optional
+        Default ``LifeSettings()``.
+
+    Attributes
+    ----------
+    capacity : ndarray, shape (4,)
+        ``Qc`` of contacts 1..4, N.
+    rating : float
+        Axial rating ``Ca``, N.
+    critical : ndarray, shape (4,)
+        Critical angle of each track, rad.
+    rotating : ndarray of bool, shape (4,)
+        Tracks whose ring turns relative to the load.
+    relubrication_swing : float
+        Swing that relubricates, rad.
+    slices : int
+        Slices of each track in the raceway map.
+
+    Raises
+    ------
+    LifeInputError
+        If ``load_frame`` is unknown.
     """
 
     def __init__(self, bearing, moving_ring: str | None = None, load_frame: str = "fixed",
@@ -127,14 +161,37 @@ class LifeModel:
         self.slices = self.settings.slices or default_slices(bearing.ball_count)
 
     def track_standing_loads(self, contact_load) -> np.ndarray:
-        """``Qe`` of the four tracks at one step with the exponent 10/3 of a ring standing relative
-        to the load, N (4,): what a swing below a track's critical angle makes of every track (each
-        point of the raceway meets only the balls next to it, see :func:`analyse_run`)."""
+        """``Qe`` of the four tracks at one step with the exponent 10/3 of a ring standing relative to the load.
+
+        What a swing below a track's critical angle makes of every track (each point of the
+        raceway meets only the balls next to it, see :func:`analyse_run`).
+
+        Parameters
+        ----------
+        contact_load : array_like, shape (B, 4)
+            Contact loads of contacts 1..4, N.
+
+        Returns
+        -------
+        ndarray, shape (4,)
+            ``Qe``, N.
+        """
         q = np.asarray(contact_load, dtype=float)
         return np.array([float(equivalent_load(q[:, k], False)) for k in range(4)])
 
     def track_equivalent_loads(self, contact_load) -> np.ndarray:
-        """ISO/TS 16281 ``Qe`` of the four tracks at one step from the ball loads (B, 4), N (4,)."""
+        """ISO/TS 16281 ``Qe`` of the four tracks at one step.
+
+        Parameters
+        ----------
+        contact_load : array_like, shape (B, 4)
+            Contact loads of contacts 1..4, N.
+
+        Returns
+        -------
+        ndarray, shape (4,)
+            ``Qe``, N, each with the exponent of its ring (turning or standing relative to the load).
+        """
         q = np.asarray(contact_load, dtype=float)
         return np.array([float(equivalent_load(q[:, k], bool(self.rotating[k]))) for k in range(4)])
 
@@ -160,19 +217,46 @@ class HalfCycles:
 class LifeAccumulator:
     """Step-by-step life and wear of one bearing (what the FMU carries; plain numpy state).
 
+    It adds the raceway map's passes (:class:`RacewayMap`), detects completed half-cycles
+    of the ring angle online (a reversal of ``ψ`` by more than a tolerance) and gives their
+    ``x/2b``; with ``record=True`` it also keeps a few numbers per step and track for
+    :func:`analyse_run`.
+
     Parameters
     ----------
     model : LifeModel
-    record : bool
-        Keep the per-step numbers :func:`analyse_run` needs (:data:`RECORD_FIELDS`).
-    kernel : {"numpy", "auto", "compiled"}
+        The bearing's capacities and settings.
+    record : bool, optional
+        Keep the per-step numbers :func:`analyse_run` needs (time, ``psi``, ``Qe`` per track,
+        widest patch, largest pressure, DG03's ``Pea``). Default False.
+    kernel : {"numpy", "auto", "compiled"}, optional
         How the raceway map adds a step's passes (``kernel`` of :class:`RacewayMap`).
+        Default "numpy".
+
+    Attributes
+    ----------
+    map : RacewayMap
+        The raceway damage map.
 
     Examples
     --------
-    >>> acc = LifeAccumulator(LifeModel(bearing))                       # doctest: +SKIP
-    >>> for t, psi, loads in series: acc.step(t, psi, sim.step(...).distribution, loads)  # doctest: +SKIP
-    >>> acc.worst_damage, acc.last_ratio                                # doctest: +SKIP
+    A rigid-ring run of 10 s, the ring swinging ±0.05 rad at 0.5 Hz under a constant load:
+
+    >>> import numpy as np
+    >>> from slewing_model import load_bearing, Loads
+    >>> from slewing_model.simulation import BearingSimulator, SimulatorSettings
+    >>> from slewing_model.life import LifeAccumulator, LifeModel, analyse_run
+    >>> bearing = load_bearing("examples/bearings/table3.toml")
+    >>> sim = BearingSimulator(bearing, settings=SimulatorSettings(ring_model="rigid",
+    ...                                                            friction_coefficient=0.0))
+    >>> acc = LifeAccumulator(LifeModel(bearing), record=True)
+    >>> loads = Loads(Fz=5e4, My=2e4)
+    >>> for t in np.arange(0.0, 10.0, 0.05):
+    ...     psi = 0.05 * np.sin(np.pi * t)
+    ...     acc.step(t, psi, sim.step(loads, psi, 0.0).distribution, loads.as_array())
+    >>> result = analyse_run(acc)
+    >>> result.worst_track, f"{result.life_hours:.3g} h"
+    (3, '1.08e+06 h')
     """
 
     def __init__(self, model: LifeModel, record: bool = False, kernel: str = "numpy"):
@@ -185,8 +269,20 @@ class LifeAccumulator:
 
     # ---- one step ------------------------------------------------------------------------
     def step(self, time: float, psi: float, distribution, loads=None) -> None:
-        """Add a step: its time (s), ring angle ``psi`` (rad), load distribution and (for DG03,
-        ``record`` only) loads ``(Fx, Fy, Fz, Mx, My)`` (N, N m)."""
+        """Add a step.
+
+        Parameters
+        ----------
+        time : float
+            Time of the step, s (used only when recording).
+        psi : float
+            Rotation of the moving ring, rad.
+        distribution : LoadDistribution
+            The step's load distribution.
+        loads : array_like, shape (>= 5,), optional
+            Loads ``(Fx, Fy, Fz, Mx, My)``, N and N m, for DG03's equivalent load
+            (``record`` only).
+        """
         d = distribution
         self.map.update(d.ball_angle, psi, d.contact_load)
         widest, widest_angle = self._widest_contacts(d.semi_axis_b, d.contact_angle)
@@ -244,7 +340,7 @@ class LifeAccumulator:
     # ---- outputs -------------------------------------------------------------------------
     @property
     def track_damage(self) -> np.ndarray:
-        """Raceway-map damage of contacts 1..4 so far (weakest link over the slices), (4,)."""
+        """Raceway-map damage of contacts 1..4 so far (weakest link over the slices), shape (4,)."""
         return self.map.track_damage()
 
     @property
@@ -259,6 +355,7 @@ class LifeAccumulator:
 
     # ---- state ---------------------------------------------------------------------------
     def get_state(self) -> dict:
+        """The accumulator's state: the raceway map's, the half-cycle detector's and the number of recorded rows."""
         h = self.half
         return {"map": self.map.get_state(),
                 "half": {"direction": h.direction, "turn": h.turn, "extreme": h.extreme, "b_max": h.b_max,
@@ -267,6 +364,7 @@ class LifeAccumulator:
                 "rows": len(self.rows)}
 
     def set_state(self, state: dict) -> None:
+        """Restore a state of :meth:`get_state`; recorded rows after it are dropped."""
         self.map.set_state(state["map"])
         s = state["half"]
         self.half = HalfCycles(float(s["direction"]), float(s["turn"]), float(s["extreme"]),
@@ -275,7 +373,20 @@ class LifeAccumulator:
         del self.rows[int(state.get("rows", len(self.rows))):]
 
     def records(self) -> dict:
-        """The recorded steps as arrays (:data:`RECORD_FIELDS`)."""
+        """The recorded steps as arrays.
+
+        Returns
+        -------
+        dict of ndarray
+            ``time`` (s), ``psi`` (rad), ``qe`` and ``qe_standing`` (N, per track),
+            ``b_max`` (m) and ``angle_at_b_max`` (rad) of the widest patch, ``p_max`` (Pa)
+            and ``pea`` (N), one row a step.
+
+        Raises
+        ------
+        LifeInputError
+            If no step was recorded.
+        """
         if not self.rows:
             raise LifeInputError("records: no steps were recorded (record=True and at least one step)")
         cols = list(zip(*self.rows))
@@ -289,6 +400,7 @@ class LifeResult:
     Attributes
     ----------
     duration : float, s
+        Duration of the run.
     track_damage : ndarray (4,)
         ISO/TS 16281 loads with the oscillation rule: damage of contacts 1..4 over the run.
     damage : float
@@ -297,10 +409,16 @@ class LifeResult:
         ``duration / damage`` (inf: no damage).
     worst_track : int or None
         Contact 1..4 with the largest damage; None when nothing was damaged (the ring never moved).
-    map_track_damage : ndarray (4,), map_damage : float, map_life_hours : float
-        The same from the raceway map.
+    map_track_damage : ndarray (4,)
+        Damage of contacts 1..4 from the raceway map.
+    map_damage : float
+        The bearing's damage from the raceway map.
+    map_life_hours : float, h
+        Life from the raceway map.
     damage_map : ndarray (4, slices)
+        Damage of every slice of the four tracks.
     dg03 : DG03Life
+        NREL DG03's catalogue life of the same run.
     swing, count : ndarray
         Rainflow cycles (rad; 1 or 0.5).
     below_critical : float
@@ -319,10 +437,11 @@ class LifeResult:
     relubrication_gap : float, s
         Longest time without a movement of ``relubrication_swing``.
     relubrication_swing : float, rad
+        The movement that counts as relubricating.
     cycle_damage : ndarray (cycles, 4)
         Damage of each cycle on contacts 1..4 (the terms of ``track_damage``).
     micro_swing : float, rad
-        Swing below which a cycle is a micro-cycle (:data:`MICRO_CYCLE_STEPS` steps of the series'
+        Swing below which a cycle is a micro-cycle (10 steps, ``MICRO_CYCLE_STEPS``, of the series'
         angle resolution, at least the reversal tolerance).
     micro_cycles : float
         Number of micro-cycles (by count).
@@ -368,8 +487,16 @@ class LifeResult:
         return self.dg03.hours / self.life_hours if self.life_hours > 0 else math.nan
 
     def summary(self) -> dict:
-        """The numbers of a study's summary row; None where a value does not exist (no worst track
-        without damage, no ratio or share without cycles); inf: no damage, an infinite life."""
+        """The numbers of a study's summary row.
+
+        Returns
+        -------
+        dict
+            ``life_L10_h``, ``life_map_L10_h``, ``life_dg03_L10_h`` (h), ``life_damage_per_h``
+            (1/h), the worst track, the DG03 ratio, the cycle count, shares and the
+            relubrication gap (s). None where a value does not exist (no worst track without
+            damage, no ratio or share without cycles); inf: no damage, an infinite life.
+        """
         def value(x):
             return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
 
@@ -439,8 +566,27 @@ def analyse_run(accumulator: LifeAccumulator) -> LifeResult:
     treated as standing (exponent 10/3): a point of its raceway is then rolled over only by the
     ball next to it, meeting the load at its own place again and again, never the others --
     exactly ISO's situation of a standing ring. ISO's exponent 3 would understate its damage by
-    ``(Qe,10/3 / Qe,3)^3`` (1.139 for the rigid-ring moment distribution ``Q ∝ cos^1.5 φ``,
-    ``docs/life.md``)."""
+    ``(Qe,10/3 / Qe,3)^3`` (1.139 for the rigid-ring moment distribution ``Q ∝ cos^1.5 φ``;
+    see the user guide's life and wear page).
+
+    Needs the ``rainflow`` package.
+
+    Parameters
+    ----------
+    accumulator : LifeAccumulator
+        Stepped through the run with ``record=True``.
+
+    Returns
+    -------
+    LifeResult
+        ISO/TS 16281 life with the oscillation rule, the raceway map's life, DG03's life and
+        the wear indicators; hours of the run's duty repeated.
+
+    Raises
+    ------
+    LifeInputError
+        If no step was recorded.
+    """
     m, r = accumulator.model, accumulator.records()
     t, psi = r["time"], r["psi"]
     duration = float(t[-1] - t[0])

@@ -36,6 +36,22 @@ def critical_angle(ball_count, ball_diameter, pitch_diameter, contact_angle, rin
     ``(1 - γ)/2`` of it (whichever ring turns): the tracks of neighbouring balls, ``360°/Z`` apart,
     begin to overlap when that reaches the ball pitch.
 
+    Parameters
+    ----------
+    ball_count : int
+        Number of balls ``Z``.
+    ball_diameter, pitch_diameter : float
+        Ball diameter ``Dw`` and pitch diameter ``dm``, m.
+    contact_angle : float or ndarray
+        Contact angle ``α``, rad (``γ = Dw cos α / dm``).
+    ring : {"inner", "outer"} or array_like of them
+        The raceway's ring.
+
+    Returns
+    -------
+    float or ndarray
+        ``θcrit``, rad (full swing, peak to valley).
+
     Examples
     --------
     >>> round(math.degrees(critical_angle(150, 0.0762, 4.5, math.radians(45), "inner")), 4)
@@ -47,14 +63,51 @@ def critical_angle(ball_count, ball_diameter, pitch_diameter, contact_angle, rin
 
 
 def dg03_rating_factor(theta, ball_count):
-    """DG03's oscillation factor of balls on the rating, ``(180°/θ)^(3/10) Z^0.033`` (θ in rad)."""
+    """DG03's oscillation factor of balls on the rating, ``(180°/θ)^(3/10) Z^0.033``.
+
+    Parameters
+    ----------
+    theta : float or array_like
+        Full swing ``θ``, rad.
+    ball_count : int
+        Number of balls ``Z``.
+
+    Returns
+    -------
+    float or ndarray
+        The factor ``Ca_osc / Ca``, dimensionless.
+    """
     return (math.pi / np.asarray(theta, dtype=float)) ** 0.3 * ball_count ** 0.033
 
 
 def equivalent_revolutions(theta, critical, ball_count, rating_factor=None):
-    """Revolutions a full cycle of swing ``theta`` (rad) counts for, on a raceway of critical angle
-    ``critical`` (rad): ``θ/π`` at or above it, ``f(θ)^-3`` below it, with ``f`` DG03's
-    :func:`dg03_rating_factor` or ``rating_factor(theta, ball_count)`` of the user. Arrays broadcast."""
+    """Revolutions a full cycle of swing ``theta`` counts for.
+
+    ``θ/π`` at or above the raceway's critical angle, ``f(θ)^-3`` below it, with ``f``
+    DG03's :func:`dg03_rating_factor` or the user's ``rating_factor``. Arrays broadcast.
+
+    Parameters
+    ----------
+    theta : float or array_like
+        Full swing of the cycle, rad (>= 0).
+    critical : float or array_like
+        Critical angle of the raceway, rad (:func:`critical_angle`).
+    ball_count : int
+        Number of balls ``Z``.
+    rating_factor : callable, optional
+        ``rating_factor(theta, ball_count)``, the factor on the rating below the critical
+        angle; default :func:`dg03_rating_factor`.
+
+    Returns
+    -------
+    float or ndarray
+        Equivalent revolutions per full cycle.
+
+    Raises
+    ------
+    LifeInputError
+        If a swing is negative or not finite.
+    """
     theta = np.asarray(theta, dtype=float)
     if np.any(theta < 0) or not np.all(np.isfinite(theta)):
         raise LifeInputError(f"theta = {theta!r}: swings must be finite and >= 0")
@@ -84,8 +137,28 @@ class Cycles:
 
 
 def rainflow_cycles(psi, min_swing: float = 0.0) -> Cycles:
-    """Rainflow cycles (ASTM E1049-85, ``rainflow.extract_cycles``) of the ring angle ``psi`` (rad),
-    cycles of swing below ``min_swing`` (rad) left out."""
+    """Rainflow cycles (ASTM E1049-85, ``rainflow.extract_cycles``) of the ring angle.
+
+    Needs the ``rainflow`` package (post-processing, not an FMU step).
+
+    Parameters
+    ----------
+    psi : array_like, shape (n,)
+        Ring angle series, rad.
+    min_swing : float, optional
+        Cycles of full swing not above this, rad, are left out. Default 0.
+
+    Returns
+    -------
+    Cycles
+        Arrays ``swing`` (full swing, rad), ``count`` (1 or 0.5) and ``start``, ``end``
+        (sample indices of the cycle's first and last reversal).
+
+    Raises
+    ------
+    LifeInputError
+        If ``psi`` is not a finite 1-D series.
+    """
     import rainflow   # post-processing only
 
     psi = np.asarray(psi, dtype=float)

@@ -58,11 +58,24 @@ def default_slices(ball_count: int, minimum: int = DEFAULT_SLICES) -> int:
     Why coprime: the balls sit ``360°/Z`` apart, so against a grid of ``N`` slices their tracks
     start at only ``Z / gcd(N, Z)`` different offsets (5 for 720 slices and 150 balls): each ball's
     short track then covers either k or k + 1 slice centres together with the others, and a swing
-    whose track is about a slice long is counted ±20 % wrong (the life review, issue 28). With
+    whose track is about a slice long is counted ±20 % wrong. With
     ``gcd(N, Z) = 1`` the Z balls fall at Z offsets ``1/Z`` of a slice apart: over the balls the
     track is sampled at ``1/Z`` of a slice, and the map's damage of a steady swing of 0.7-3° is
     within 2 % of its converged value (0.5°: 2.6 %, 0.3°: 4 %; 150 balls, 1441 slices; tested
-    against the closed form of ``docs/life.md``)."""
+    against the closed form of the user guide's life and wear page).
+
+    Parameters
+    ----------
+    ball_count : int
+        Number of balls ``Z``.
+    minimum : int, optional
+        Fewest slices. Default 1440 (0.25° each).
+
+    Returns
+    -------
+    int
+        The number of slices ``N``.
+    """
     n = int(minimum)
     while math.gcd(n, int(ball_count)) != 1:
         n += 1
@@ -95,18 +108,34 @@ def crossed_slices(start, end, slices):
 class RacewayMap:
     """Damage map of the four tracks, accumulated step by step.
 
+    Each track is cut into slices around its ring; a slice is damaged by the balls
+    that roll over it, with their loads (Miner's rule with exponent 3, slices combined
+    as weakest-link Weibull volumes). A damage of 1 is one L10 rating life.
+
     Parameters
     ----------
-    capacities : ndarray (4,), N
-        ``Qc`` of contacts 1..4 (:func:`slewing_model.life.rating.four_point_capacities`).
-    passes : ndarray (4,)
-        ``m`` of the tracks (:func:`passes_per_revolution`).
+    capacities : ndarray, shape (4,)
+        ``Qc`` of contacts 1..4, N (:func:`slewing_model.life.rating.four_point_capacities`).
+    passes : ndarray, shape (4,)
+        Ball passes ``m = Z (1 ± γ)/2`` a point of each track receives per revolution.
     moving_ring : {"inner", "outer"}
-    slices : int
-    kernel : {"numpy", "auto", "compiled"}
-        How a step's passes are added: numpy array operations, or one compiled loop
-        (:mod:`slewing_model.life.kernel`, needs numba; "auto" where it is installed). The same
-        map to round-off.
+        The ring that turns by ``psi``.
+    slices : int, optional
+        Slices of each track around its circumference (>= 4). Default 1440.
+    kernel : {"numpy", "auto", "compiled"}, optional
+        How a step's passes are added: numpy array operations (default), or one compiled
+        loop (:mod:`slewing_model.life.kernel`, needs numba; "auto" where it is installed).
+        The same map to round-off.
+
+    Attributes
+    ----------
+    damage_map : ndarray, shape (4, slices)
+        Damage ``d_j`` of every slice of contacts 1..4.
+
+    Raises
+    ------
+    LifeInputError
+        If ``slices`` or ``moving_ring`` is not valid.
     """
 
     def __init__(self, capacities, passes, moving_ring: str, slices: int = DEFAULT_SLICES, kernel: str = "numpy"):
@@ -123,6 +152,7 @@ class RacewayMap:
         self.reset()
 
     def reset(self) -> None:
+        """Clear the map: no damage, no step recorded."""
         self.damage_map = np.zeros((4, self.slices))    # d_j of every slice of contacts 1..4
         self._power = np.zeros(4)                       # Σ_j d_j^(10/9) of each track, kept as slices change
         self._shared = False                            # damage_map handed out by get_state: copy before a change
@@ -131,8 +161,20 @@ class RacewayMap:
         self._q3 = None                                 # Q^3 of the last step (B, 4)
 
     def update(self, ball_angle, psi: float, contact_load) -> None:
-        """Add the passes from the last step to this one (the first call only records). Only the
-        slices a ball crossed change, and each track's ``Σ d_j^(10/9)`` follows them."""
+        """Add the passes from the last step to this one (the first call only records).
+
+        Only the slices a ball crossed change, and each track's ``Σ d_j^(10/9)`` follows them.
+        A pass carries the mean of ``Q^3`` of the two steps.
+
+        Parameters
+        ----------
+        ball_angle : ndarray, shape (B,)
+            Angular position ``φ_b`` of every ball in the fixed frame, rad.
+        psi : float
+            Rotation of the moving ring, rad.
+        contact_load : ndarray, shape (B, 4)
+            Contact loads ``Q`` of contacts 1..4, N.
+        """
         if self._angle is not None and self._compiled:     # Q^3 and the passes in one compiled loop
             self._own_map()
             q3 = compiled_map_update()(self.damage_map, self._power, self.scale, self.moving, self._angle,
@@ -168,13 +210,26 @@ class RacewayMap:
             self._shared = False
 
     def track_damage(self) -> np.ndarray:
-        """``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)`` of contacts 1..4, (4,), from the sums kept step by
-        step (:func:`track_damage` sums the whole map again; they agree to round-off)."""
+        """Damage of each track, ``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)``.
+
+        From the sums kept step by step (:func:`track_damage` sums the whole map again; they
+        agree to round-off).
+
+        Returns
+        -------
+        ndarray, shape (4,)
+            ``D_k`` of contacts 1..4 (1: one L10 life used).
+        """
         return self._damage(self._power)
 
     def worst_track_damage(self) -> float:
-        """The largest of :meth:`track_damage`, taken from the largest sum (the damage grows with it): the
-        same number, without the arrays (the FMU's ``life_damage`` output, every step)."""
+        """The largest of :meth:`track_damage`, without the arrays.
+
+        Returns
+        -------
+        float
+            The worst track's damage (the FMU's ``life_damage`` output, every step).
+        """
         return float(self._damage(max(self._power.tolist())))
 
     def _damage(self, power):
@@ -182,13 +237,21 @@ class RacewayMap:
         return (np.maximum(power, 0.0) / self.slices) ** (1.0 / WEIBULL_SLOPE)
 
     def get_state(self) -> dict:
-        """The map, its sums, the last ball angles, ring angle and ``Q^3`` (the map is not copied: the next
-        update copies it before a change; the others are replaced, not changed, by an update)."""
+        """The map's state, for a checkpoint.
+
+        Returns
+        -------
+        dict
+            The map, its sums, the last ball angles (rad), ring angle (rad) and ``Q^3`` (N^3).
+            The map is not copied: the next update copies it before a change; the others are
+            replaced, not changed, by an update.
+        """
         self._shared = True
         return {"map": self.damage_map, "power": self._power.copy(), "angle": self._angle, "psi": self._psi,
                 "q3": self._q3}
 
     def set_state(self, state: dict) -> None:
+        """Restore a state of :meth:`get_state` (or its JSON form decoded)."""
         self.damage_map = np.array(state["map"], dtype=float).reshape(4, self.slices)
         self._shared = False
         power = state.get("power")
@@ -200,6 +263,19 @@ class RacewayMap:
 
 
 def track_damage(damage_map) -> np.ndarray:
-    """Weakest-link damage of each track from its slices' damages (see the module docstring)."""
+    """Weakest-link damage of each track from its slices' damages.
+
+    ``D_k = [(1/N) Σ_j d_j^(10/9)]^(9/10)``: the slices are independent Weibull volumes.
+
+    Parameters
+    ----------
+    damage_map : array_like, shape (..., N)
+        Damage ``d_j`` of every slice (last axis: the N slices of a track).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Damage of each track.
+    """
     d = np.asarray(damage_map, dtype=float)
     return np.mean(d ** WEIBULL_SLOPE, axis=-1) ** (1.0 / WEIBULL_SLOPE)

@@ -38,7 +38,10 @@ RINGS = ("inner", "outer")
 
 
 class LifeInputError(ValueError):
-    """A life input breaks a rule; the message names the field, the value and the rule."""
+    """A life input breaks a rule; the message names the field, the value and the rule.
+
+    A :class:`ValueError`.
+    """
 
 
 def _check_positive(name, value):
@@ -76,19 +79,28 @@ def radial_raceway_capacities(rating, ball_count, ball_diameter, pitch_diameter,
 
     Parameters
     ----------
-    rating : float, N
-        Basic dynamic radial load rating ``C``.
+    rating : float
+        Basic dynamic radial load rating ``C``, N.
     ball_count : int
-        ``Z`` (per row).
-    ball_diameter, pitch_diameter : float, m
-    contact_angle : float, rad
-    inner_groove_radius, outer_groove_radius : float, m
-    rows : int
-        ``i``.
+        Number of balls ``Z`` (per row).
+    ball_diameter, pitch_diameter : float
+        Ball diameter ``Dw`` and pitch diameter ``dm``, m.
+    contact_angle : float
+        Nominal contact angle ``α``, rad.
+    inner_groove_radius, outer_groove_radius : float
+        Groove radii of the inner and outer raceway, m.
+    rows : int, optional
+        Number of rows ``i``. Default 1.
 
     Returns
     -------
-    (float, float), N
+    Qci, Qce : float
+        Basic dynamic load ratings of the inner and the outer raceway, N.
+
+    Raises
+    ------
+    LifeInputError
+        If ``rating`` or ``ball_count`` is not finite and positive.
     """
     _check_positive("rating", rating)
     _check_positive("ball_count", ball_count)
@@ -119,10 +131,31 @@ def raceway_capacity(ring, ball_count, ball_diameter, pitch_diameter, contact_an
     Parameters
     ----------
     ring : {"inner", "outer"}
+        The ring of the raceway.
     ball_count : int
-    ball_diameter, pitch_diameter, groove_radius : float, m
-    contact_angle : float or ndarray, rad
-        Nominal contact angle (``0 <= α < 90°``).
+        Number of balls ``Z``.
+    ball_diameter, pitch_diameter : float
+        Ball diameter ``Dw`` and pitch diameter ``dm``, m.
+    contact_angle : float or ndarray
+        Nominal contact angle ``α``, rad (``0 <= α < pi/2``).
+    groove_radius : float or ndarray
+        Groove radius of the raceway, m (above ``Dw/2``).
+
+    Returns
+    -------
+    float or ndarray
+        ``Qc``, N.
+
+    Raises
+    ------
+    LifeInputError
+        If an input is out of its range.
+
+    Examples
+    --------
+    >>> from slewing_model.life import raceway_capacity
+    >>> round(float(raceway_capacity("inner", 100, 0.05, 1.5, 0.785, 0.02625)))   # N
+    28882
     """
     _check_ring("ring", ring)
     _check_positive("ball_count", ball_count)
@@ -148,11 +181,18 @@ def equivalent_load(loads, rotating: bool, ball_count: int | None = None):
 
     Parameters
     ----------
-    loads : array_like (..., Z), N
-        Ball loads on the raceway (last axis: the balls; negative values count 0).
+    loads : array_like, shape (..., Z)
+        Ball loads on the raceway, N (last axis: the balls; negative values count 0).
     rotating : bool
+        True: the ring turns relative to the load (exponent 3); False: it stands
+        relative to the load (exponent 10/3).
     ball_count : int, optional
         ``Z``; default the length of the last axis.
+
+    Returns
+    -------
+    float or ndarray, shape (...)
+        ``Qe``, N.
     """
     q = np.maximum(np.asarray(loads, dtype=float), 0.0)
     z = q.shape[-1] if ball_count is None else ball_count
@@ -161,9 +201,23 @@ def equivalent_load(loads, rotating: bool, ball_count: int | None = None):
 
 
 def combined_life(capacities, equivalent_loads):
-    """``L10r = [Σ_k (Qc_k/Qe_k)^(-10/3)]^(-9/10)``, 10^6 revolutions (ISO/TS 16281).
+    """Combined L10 life of several raceways (ISO/TS 16281).
 
-    A raceway with ``Qe = 0`` adds nothing; all unloaded gives ``inf``."""
+    ``L10r = [Σ_k (Qc_k/Qe_k)^(-10/3)]^(-9/10)``. A raceway with ``Qe = 0`` adds
+    nothing; all unloaded gives ``inf``.
+
+    Parameters
+    ----------
+    capacities : array_like, shape (..., K)
+        Basic dynamic load ratings ``Qc`` of the K raceways, N.
+    equivalent_loads : array_like, shape (..., K)
+        Equivalent ball loads ``Qe`` of the raceways, N.
+
+    Returns
+    -------
+    float or ndarray, shape (...)
+        ``L10r``, 10^6 revolutions.
+    """
     qc = np.asarray(capacities, dtype=float)
     qe = np.asarray(equivalent_loads, dtype=float)
     terms = (qe / qc) ** (LIFE_EXPONENT * WEIBULL_SLOPE)
@@ -186,15 +240,17 @@ class Raceway:
     Attributes
     ----------
     ring : {"inner", "outer"}
-    groove_radius : float, m
-    contact_angle : float, rad
-        Nominal angle, for the capacity.
-    loads : ndarray (Z,), N
-        Ball loads on the raceway.
+        The ring of the raceway.
+    groove_radius : float
+        Groove radius, m.
+    contact_angle : float
+        Nominal contact angle, rad, for the capacity.
+    loads : ndarray, shape (Z,)
+        Ball loads on the raceway, N.
     rotating : bool
         The ring turns relative to the load.
-    capacity : float or None, N
-        ``Qc`` when known (e.g. from ISO/TS 16281 and ``C``); else from the geometry.
+    capacity : float or None
+        ``Qc``, N, when known (e.g. from ISO/TS 16281 and ``C``); None (default): from the geometry.
     """
 
     ring: str
@@ -207,8 +263,17 @@ class Raceway:
 
 @dataclass(frozen=True)
 class RacewayLife:
-    """What :func:`raceway_life` returns: ``capacity`` and ``equivalent_load`` per raceway (N),
-    and the combined ``life`` (10^6 revolutions)."""
+    """What :func:`raceway_life` returns.
+
+    Attributes
+    ----------
+    capacity : ndarray, shape (K,)
+        Basic dynamic load rating ``Qc`` of each raceway, N.
+    equivalent_load : ndarray, shape (K,)
+        Equivalent ball load ``Qe`` of each raceway, N.
+    life : float
+        Combined L10 life, 10^6 revolutions.
+    """
 
     capacity: np.ndarray
     equivalent_load: np.ndarray
@@ -221,8 +286,21 @@ def raceway_life(raceways, ball_count: int, ball_diameter: float, pitch_diameter
     Parameters
     ----------
     raceways : sequence of Raceway
+        The raceways, each with its ``ball_count`` ball loads.
     ball_count : int
-    ball_diameter, pitch_diameter : float, m
+        Number of balls ``Z``.
+    ball_diameter, pitch_diameter : float
+        Ball diameter ``Dw`` and pitch diameter ``dm``, m (for capacities from the geometry).
+
+    Returns
+    -------
+    RacewayLife
+        ``Qc`` and ``Qe`` per raceway (N) and the combined L10 (10^6 revolutions).
+
+    Raises
+    ------
+    LifeInputError
+        If a raceway's ring or loads are not valid.
 
     Examples
     --------
@@ -256,25 +334,31 @@ def radial_bearing_life(ball_loads, ball_count, ball_diameter, pitch_diameter, c
 
     Parameters
     ----------
-    ball_loads : array_like (Z,), N
-        Ball loads on the inner raceway (and on the outer one unless ``outer_ball_loads``).
+    ball_loads : array_like, shape (Z,)
+        Ball loads on the inner raceway, N (and on the outer one unless ``outer_ball_loads``).
     ball_count : int
-    ball_diameter, pitch_diameter : float, m
-    contact_angle : float, rad
-        Nominal contact angle.
-    inner_groove_radius, outer_groove_radius : float, m
-    rotating_ring : {"inner", "outer"}
-        The ring that turns; under a load of fixed direction it turns relative to the load
-        (exponent 3), the other stands (exponent 10/3).
-    rating : float or None, N
-        Basic dynamic radial rating ``C``: capacities by :func:`radial_raceway_capacities`; None:
-        from the geometry (:func:`raceway_capacity`).
-    outer_ball_loads : array_like (Z,) or None, N
-    rows : int
+        Number of balls ``Z``.
+    ball_diameter, pitch_diameter : float
+        Ball diameter ``Dw`` and pitch diameter ``dm``, m.
+    contact_angle : float
+        Nominal contact angle, rad.
+    inner_groove_radius, outer_groove_radius : float
+        Groove radii of the inner and outer raceway, m.
+    rotating_ring : {"inner", "outer"}, optional
+        The ring that turns (default "inner"); under a load of fixed direction it turns
+        relative to the load (exponent 3), the other stands (exponent 10/3).
+    rating : float or None, optional
+        Basic dynamic radial rating ``C``, N: capacities by :func:`radial_raceway_capacities`;
+        None (default): from the geometry (:func:`raceway_capacity`).
+    outer_ball_loads : array_like, shape (Z,), optional
+        Ball loads on the outer raceway, N, where they differ from ``ball_loads``.
+    rows : int, optional
+        Number of rows ``i`` (for ``rating``). Default 1.
 
     Returns
     -------
     RacewayLife
+        Inner and outer raceway, in that order, and the combined L10 (10^6 revolutions).
     """
     _check_ring("rotating_ring", rotating_ring)
     q_in = np.asarray(ball_loads, dtype=float)
@@ -298,8 +382,21 @@ def four_point_capacities(bearing, rating: float | None = None) -> np.ndarray:
     """``Qc`` of the four tracks (contacts 1..4) of a four-point bearing, N.
 
     From the geometry (:func:`raceway_capacity` at the nominal contact angle), or scaled so
-    that the bearing's axial rating (:func:`axial_rating`) equals a given ``rating`` (N), the
+    that the bearing's axial rating (:func:`axial_rating`) equals a given ``rating``, the
     tracks keeping the ratios of their geometric capacities.
+
+    Parameters
+    ----------
+    bearing : Bearing
+        The bearing definition.
+    rating : float, optional
+        Basic dynamic axial rating ``Ca`` of the bearing, N (e.g. a catalogue's); None
+        (default): capacities from the geometry.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        ``Qc`` of contacts 1..4, N.
     """
     qc = np.array([float(raceway_capacity(TRACK_RINGS[j], bearing.ball_count, bearing.ball_diameter,
                                           bearing.pitch_diameter, bearing.contact_angle,
@@ -321,6 +418,25 @@ def axial_rating(bearing, capacities=None) -> float:
     has the structure of ``Z sin α Qc``, without the empirical reductions of the standard's ``fc``
     table (so it can differ from an ISO 281 or catalogue value); :func:`iso281_axial_rating`
     evaluates the standard's formula for a tabulated ``fc``.
+
+    Parameters
+    ----------
+    bearing : Bearing
+        The bearing definition.
+    capacities : array_like, shape (4,), optional
+        ``Qc`` of contacts 1..4, N; default :func:`four_point_capacities` from the geometry.
+
+    Returns
+    -------
+    float
+        ``Ca``, N.
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing
+    >>> from slewing_model.life import axial_rating
+    >>> round(axial_rating(load_bearing("examples/bearings/table1.toml")))   # N
+    873455
     """
     qc = four_point_capacities(bearing) if capacities is None else np.asarray(capacities, dtype=float)
     e = LIFE_EXPONENT * WEIBULL_SLOPE
@@ -335,6 +451,29 @@ def iso281_axial_rating(fc: float, ball_count: int, ball_diameter: float, contac
     ``Ca = bm fc (cos α)^0.7 tan α Z^(2/3) Dw^1.8`` for ``Dw ≤ 25.4 mm`` and
     ``3.647 bm fc (cos α)^0.7 tan α Z^(2/3) Dw^1.4`` above (N, mm); ``fc`` from the
     standard's table for ``Dw cos α / dm`` (the user reads it there).
+
+    Parameters
+    ----------
+    fc : float
+        ISO 281's factor ``fc`` for this bearing (from the standard's table).
+    ball_count : int
+        Number of balls ``Z``.
+    ball_diameter : float
+        Ball diameter ``Dw``, m (converted to mm inside).
+    contact_angle : float
+        Nominal contact angle ``α``, rad, in (0, pi/2).
+    bm : float, optional
+        Rating factor; default 1.3 (ball bearings).
+
+    Returns
+    -------
+    float
+        ``Ca``, N.
+
+    Raises
+    ------
+    LifeInputError
+        If ``fc`` or ``ball_diameter`` is not positive or ``contact_angle`` is out of range.
     """
     _check_positive("fc", fc)
     dw = float(_check_positive("ball_diameter", ball_diameter)) * 1e3

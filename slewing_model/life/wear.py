@@ -32,8 +32,23 @@ RELUBRICATION_TRAVEL_RATIO = 1.0
 
 
 def rolling_travel(swing, pitch_diameter, ball_diameter, contact_angle):
-    """Travel ``x = Δψ (dm/4)(1 - γ²)`` of a contact over its raceway for a full swing ``swing`` (rad)
-    of the ring, m. Arrays broadcast.
+    """Travel ``x = Δψ (dm/4)(1 - γ²)`` of a contact over its raceway for a full swing of the ring.
+
+    The same on both rings and whichever ring moves. Arrays broadcast.
+
+    Parameters
+    ----------
+    swing : float or array_like
+        Full swing ``Δψ`` of one ring relative to the other, rad.
+    pitch_diameter, ball_diameter : float
+        Pitch diameter ``dm`` and ball diameter ``Dw``, m.
+    contact_angle : float or array_like
+        Contact angle ``α_j`` of the contact, rad.
+
+    Returns
+    -------
+    float or ndarray
+        Rolling travel ``x``, m.
 
     Examples
     --------
@@ -61,9 +76,10 @@ def travel_by_ring_kinematics(swing, pitch_diameter, ball_diameter, contact_angl
 
 
 def relubrication_gap(time, psi, threshold):
-    """Longest time (s) during which the ring angle ``psi`` (rad) stays within a band narrower than
-    ``threshold`` (rad): the longest stretch of samples ``i..j`` with ``max(psi) - min(psi) <
-    threshold``, its length ``t_j - t_i``.
+    """Longest time during which the ring angle stays within a band narrower than ``threshold``.
+
+    The longest stretch of samples ``i..j`` with ``max(psi) - min(psi) < threshold``, its
+    length ``t_j - t_i``.
 
     No movement of ``threshold`` happens inside such a stretch (two angles ``threshold`` apart
     would make the band that wide), and slow drift counts as soon as it adds up to ``threshold``.
@@ -71,7 +87,22 @@ def relubrication_gap(time, psi, threshold):
     ``2A >= threshold`` gives, in every period ``T``, the stretch around a peak where the angle
     stays within ``threshold`` of it, ``T (π + 2 asin(threshold/A - 1)) / (2π)`` for a sine
     (tested at several starting phases). A ring that never moves by ``threshold`` gives the run.
-    Sliding window with monotone queues of the band's maximum and minimum: O(n)."""
+    Sliding window with monotone queues of the band's maximum and minimum: O(n).
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Sample times, s.
+    psi : array_like, shape (n,)
+        Ring angle at each sample, rad.
+    threshold : float
+        Width of band that counts as a relubricating movement, rad.
+
+    Returns
+    -------
+    float
+        The longest gap, s (0 for an empty series).
+    """
     from collections import deque
 
     t = np.asarray(time, dtype=float)

@@ -13,7 +13,7 @@ to the inputs of our bearing model, in SI units:
   yaw ``YawPzn`` / ``NacYaw``, ``omega`` from ``YawVzn`` / ``NacYawVel`` when
   the file has it, else the rate of ``psi``; ``Mz`` from ``YawBrMzp``.
 
-Axes and signs (derived in ``docs/openfast.md``): the moving ring is the ring
+Axes and signs (derived on the user guide's OpenFAST loads page): the moving ring is the ring
 bolted to the blade (pitch) or to the nacelle (yaw); the loads are those the
 blade or nacelle puts on it, which is what OpenFAST's root and yaw-bearing
 channels are. The bearing's +z axis points along the blade towards its tip
@@ -64,7 +64,7 @@ _KIND_EXAMPLES = {"force": "N, kN, MN", "moment": "N·m, kN·m, kN-m, kNm, MN·m
 
 
 class UnitError(ValueError):
-    """A channel's unit is not one of its kind (force, moment, angle, rate)."""
+    """A channel's unit is not one of its kind (force, moment, angle, rate); a :class:`ValueError`."""
 
 
 def _normalise_unit(unit: str) -> str:
@@ -83,13 +83,20 @@ def to_si(values, unit: str, kind: str, *, name: str = "channel", path: str = ""
     Parameters
     ----------
     values : array_like
+        Channel values in ``unit``.
     unit : str
         As the file spells it: ``kN``, ``kN·m`` (Latin-1 or UTF-8 middle dot),
         ``kN-m``, ``kNm``, ``N``, ``N·m``, ``MN``, ``deg``, ``rad``, ``rpm``,
         ``deg/s``, ``rad/s``, ``s``; parentheses allowed.
     kind : {"force", "moment", "angle", "rate", "time"}
-    name, path : str
-        For the error message.
+        The quantity, which sets the SI unit: N, N m, rad, rad/s, s.
+    name, path : str, optional
+        Channel and file, for the error message.
+
+    Returns
+    -------
+    ndarray
+        The values in SI units, float.
 
     Raises
     ------
@@ -164,6 +171,18 @@ def _as_output(output) -> OutputFile:
 def bearing_channels(output, bearing: str = "pitch", blade: int = 1, source: str = "auto") -> dict:
     """The channels :func:`bearing_loads` takes from ``output``.
 
+    Parameters
+    ----------
+    output : OutputFile or path
+        A file read by :func:`slewing_model.loads.openfast.read_output`, or its path.
+    bearing : {"pitch", "yaw"}, optional
+        Default "pitch".
+    blade : int, optional
+        The blade whose pitch bearing (pitch only). Default 1.
+    source : {"auto", "b", "c", "p", "n"}, optional
+        Channels to use: pitch ``"b"`` or ``"c"``, yaw ``"p"`` or ``"n"``; ``"auto"``
+        (default) takes the first complete set in that order.
+
     Returns
     -------
     dict
@@ -225,7 +244,8 @@ def bearing_loads(output, bearing: str = "pitch", blade: int = 1, mounting: str 
     ----------
     output : OutputFile or path
         A file read by :func:`slewing_model.loads.openfast.read_output`, or its path.
-    bearing : {"pitch", "yaw"}
+    bearing : {"pitch", "yaw"}, default "pitch"
+        The bearing whose loads are read.
     blade : int, default 1
         The blade whose pitch bearing (pitch only).
     mounting : str, optional
@@ -233,8 +253,8 @@ def bearing_loads(output, bearing: str = "pitch", blade: int = 1, mounting: str 
         along the blade towards its tip) or ``"hub"``; yaw ``"up"`` (default,
         towards the nacelle) or ``"down"``. Which ring carries the blade or
         nacelle (the moving ring) is the bearing's ``moving_ring``.
-    t_start, t_end : float, optional, s
-        Time window (file time; default: the whole file).
+    t_start, t_end : float, optional
+        Time window, s (file time; default: the whole file).
     frame : {"rotating", "fixed"}, default "rotating"
         Frame of ``Fx..My``: the moving ring's (blade ``b``; nacelle ``n``),
         or the fixed ring's (hub ``c``; tower top ``p``). Give the simulator
@@ -262,6 +282,12 @@ def bearing_loads(output, bearing: str = "pitch", blade: int = 1, mounting: str 
         A channel used is NaN or infinite.
     ValueError
         A bad option, or a time window with fewer than two rows.
+
+    Examples
+    --------
+    >>> from slewing_model.loads.aeroelastic import bearing_loads
+    >>> series = bearing_loads("5MW_Land_DLL_WTurb.outb", "pitch", blade=1)   # doctest: +SKIP
+    >>> series.write_csv("results/pitch_blade1.csv")                         # doctest: +SKIP
     """
     from slewing_drives.load_series import LoadSeries
 

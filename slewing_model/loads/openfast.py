@@ -59,13 +59,17 @@ _DEFAULT_NAME_LENGTH = 10
 
 
 class OpenFastFormatError(ValueError):
-    """A file is not a readable OpenFAST / FAST output file. The message names
-    the file and what is wrong with it."""
+    """A file is not a readable OpenFAST / FAST output file.
+
+    A :class:`ValueError`; the message names the file and what is wrong with it.
+    """
 
 
 class MissingChannelError(KeyError, ValueError):
-    """A channel asked for is not in the file. The message names the channel
-    and the file."""
+    """A channel asked for is not in the file.
+
+    A :class:`KeyError` and a :class:`ValueError`; the message names the channel and the file.
+    """
 
     def __str__(self) -> str:  # KeyError would quote the message
         return str(self.args[0]) if self.args else ""
@@ -80,6 +84,7 @@ class OutputFile:
     path : str
         The file read.
     time : ndarray (n,), s
+        Time of every row.
     channels : dict of str to ndarray (n,)
         Every channel by its name in the file, ``Time`` included, in the
         file's units.
@@ -105,8 +110,18 @@ class OutputFile:
         return list(self.channels)
 
     def find(self, *names: str) -> str | None:
-        """The file's spelling of the first of ``names`` it has (case-insensitive,
-        as OpenFAST reads its OutList), or None."""
+        """The file's spelling of the first of ``names`` it has.
+
+        Parameters
+        ----------
+        *names : str
+            Channel names, tried in turn (case-insensitive, as OpenFAST reads its OutList).
+
+        Returns
+        -------
+        str or None
+            The name as the file spells it, or None when none is in the file.
+        """
         lookup = {n.lower(): n for n in self.channels}
         for name in names:
             if name.lower() in lookup:
@@ -114,8 +129,21 @@ class OutputFile:
         return None
 
     def channel(self, *names: str) -> tuple:
-        """``(values, unit, name)`` of the first of ``names`` in the file
-        (case-insensitive).
+        """The first of ``names`` that is in the file.
+
+        Parameters
+        ----------
+        *names : str
+            Channel names, tried in turn (case-insensitive).
+
+        Returns
+        -------
+        values : ndarray (n,)
+            The channel, in the file's unit.
+        unit : str
+            Its unit as the file spells it.
+        name : str
+            Its name as the file spells it.
 
         Raises
         ------
@@ -161,8 +189,9 @@ def read_output(path) -> OutputFile:
     Examples
     --------
     >>> out = read_output("Test18.outb")                      # doctest: +SKIP
-    >>> out.channels["RootMyb1"], out.units["RootMyb1"]       # doctest: +SKIP
-    (array([...]), 'kN·m')
+    >>> values, unit, name = out.channel("RootMyb1")          # doctest: +SKIP
+    >>> unit                                                  # doctest: +SKIP
+    'kN·m'
     """
     path = Path(path)
     data = path.read_bytes()

@@ -40,71 +40,80 @@ ORBITAL = 3
 class SimulatorSettings:
     """Options of a :class:`BearingSimulator` (SI units).
 
+    Frozen; :meth:`BearingSimulator.tune` changes the tunable ones between steps.
+
     Attributes
     ----------
-    ring_model : {"rigid", "flexible"}
+    ring_model : {"flexible", "rigid"}
+        Flexible rings (Flexible-BIME, needs a superelement; default) or rigid rings.
     moving_ring : {"inner", "outer"}
+        The ring the loads act on and that turns by ``psi`` (overrides the bearing
+        definition's). Default "inner".
     load_frame : {"fixed", "rotating"}
-        Frame the loads are given in: the fixed ring's, or the moving ring's
+        Frame the loads are given in: the fixed ring's (default), or the moving ring's
         (turned by ``psi``; e.g. blade root loads of a pitch bearing).
-    preload : float or None, m
-        Ball preload overriding the bearing definition.
+    preload : float or None
+        Ball preload, m, overriding the bearing definition; None (default) keeps the definition's.
     friction_coefficient : float
         Coulomb coefficient ``mu`` of the raceway contacts; 0 switches the
-        contact friction off.
-    seal_torque : float, N m
-        Load-independent friction torque (seals, grease).
+        contact friction off. Default 0.1. Tunable.
+    seal_torque : float
+        Load-independent friction torque (seals, grease), N m. Default 0. Tunable.
     tolerance : float
-        Relative tolerance of the load distribution solver: the force and moment residuals on
-        the moving ring (and the contact forces the rings feel) below ``tolerance`` times the
-        load scale. 1e-7 is tied to what the outputs need: ten times below the 1e-6 balance
-        of forces the co-simulation promises, and it leaves ``z``, ``rx``, ``ry`` and the
-        ball loads within 2e-5 of a solve at the round-off floor in the benchmark cases
-        (``tests/test_step_accuracy.py``); each decade tighter costs about one Newton
+        Relative tolerance of the load distribution solver, in (0, 0.01): the force and
+        moment residuals on the moving ring (and the contact forces the rings feel) below
+        ``tolerance`` times the load scale. The default 1e-7 is tied to what the outputs
+        need: ten times below the 1e-6 balance of forces the co-simulation promises, and it
+        leaves ``z``, ``rx``, ``ry`` and the ball loads within 2e-5 of a solve at the
+        round-off floor in the benchmark cases; each decade tighter costs about one Newton
         iteration per step.
-    omega_regularisation : float, rad/s
+    omega_regularisation : float
         Speed over which the signed friction torque goes from 0 to its
-        full-sliding level (:func:`slewing_model.friction.regularised_torque`);
+        full-sliding level, rad/s (:func:`slewing_model.friction.regularised_torque`);
         choose at least ``magnitude * step / inertia`` for an explicit coupling
-        (:func:`slewing_model.friction.omega_regularisation_for_step`).
+        (:func:`slewing_model.friction.omega_regularisation_for_step`). Default 1e-4. Tunable.
     friction_tolerance : float
         Relative accuracy of the ball equilibrium behind each step's friction
-        torque (``tol`` of :func:`slewing_model.friction.friction_torque`; the
-        torque error it leaves is below it). The library's 1e-5: with 1e-4 (the
-        default before) the yaw bearing's torque was off by up to 1.8e-4 at some steps,
-        where a four-contact ball stopped on a flat stretch of its power
-        (``tests/test_step_accuracy.py``).
+        torque, in (0, 0.01) (``tol`` of :func:`slewing_model.friction.friction_torque`; the
+        torque error it leaves is below it). Default 1e-5: with 1e-4 the yaw bearing's
+        torque is off by up to 1.8e-4 at some steps, where a four-contact ball stops on a
+        flat stretch of its power.
     blas_threads : int or None
-        Threads of numpy's BLAS while a step does its BLAS work: the load distribution's, the ring
-        operator's inversions and borderings (``blas_threads`` of
-        :class:`~slewing_model.distribution.bime.BimeSolver`), and the friction torque's general path, whose
-        numpy loops sum every contact's points by BLAS products (:func:`slewing_model.numerics.blas.blas_threads`,
-        restored after; the usual step's two compiled calls use no BLAS and leave them be); None leaves them
-        as the process has them. Default 1: the step's matrices have a few hundred rows, and a second thread
-        that spins while other processes share the cores makes steps several times slower (numpy's loops,
-        pitch bearing, both cores busy with other work: the step 0.82-0.86 with one thread).
+        Threads of numpy's BLAS while a step does its BLAS work: the load distribution's and
+        the ring operator's (``blas_threads`` of
+        :class:`~slewing_model.distribution.bime.BimeSolver`), and the friction torque's
+        numpy path (:func:`slewing_model.numerics.blas.blas_threads`, restored after; the
+        usual step's compiled calls use no BLAS); None leaves them as the process has
+        them. Default 1: the step's matrices have a few hundred rows, and a second thread
+        that spins while other processes share the cores makes steps several times slower.
     friction_kernel : {"auto", "numpy", "compiled"}
         How the friction model runs its loops over points and balls (``kernel`` of
-        :func:`slewing_model.friction.friction_torque`): "auto" takes the compiled loops
-        where numba is installed, numpy otherwise; the results are the same to round-off.
+        :func:`slewing_model.friction.friction_torque`): "auto" (default) takes the compiled
+        loops where numba is installed, numpy otherwise; the results are the same to round-off.
     contact_kernel : {"auto", "numpy", "compiled"}
         The same for the load distribution's loops (its per-contact work and the reduced ring
         operator's: ``kernel`` of :class:`slewing_model.distribution.bime.BimeSolver`) and the
-        life map's (``kernel`` of :class:`slewing_model.life.RacewayMap`).
+        life map's (``kernel`` of :class:`slewing_model.life.RacewayMap`). Default "auto".
     step_work : {"complete", "bounded"}
         How much a step may do (``step_work`` of :class:`slewing_model.distribution.bime.BimeSolver`):
-        "complete" solves every step to ``tolerance``, however long a sudden change of the loads
-        makes it (a moment reversed in one step: tens of ms); "bounded" (real time) caps a step's
-        work, its Newton iterations and ring operator work together, at about 1.8 ms (``BOUNDED_WORK``;
-        a new operator's inverse spread over steps), and a step that
-        would need more answers with its last iterate, ``distribution.converged`` False and its
+        "complete" (default) solves every step to ``tolerance``, however long a sudden change
+        of the loads makes it (a moment reversed in one step: tens of ms); "bounded" (real
+        time) caps a step's work, its Newton iterations and ring operator work together, at
+        about 1.8 ms (a new operator's inverse spread over steps), and a step that would need
+        more answers with its last iterate, ``distribution.converged`` False and its
         ``distribution.residual``, and carries the rest over to the next steps; the friction
-        torque of such a step is an iterate too (:data:`BOUNDED_FRICTION_ITERATIONS`). The first
-        step is complete.
+        torque of such a step is an iterate too (at most 4 iterations of the ball
+        equilibrium). The first step is complete.
     life : bool
         Accumulate the raceway life and wear step by step (:class:`slewing_model.life.LifeAccumulator`
         as ``BearingSimulator.life``, default :class:`slewing_model.life.LifeSettings`): the
         raceway damage map and the half-cycles of ``psi``; part of the simulator's state.
+        Default False.
+
+    Raises
+    ------
+    ValueError
+        If a choice is unknown or a number is out of its range.
     """
 
     ring_model: str = "flexible"
@@ -155,10 +164,12 @@ class StepResult:
     Attributes
     ----------
     distribution : LoadDistribution
-    friction_torque : float, N m
-        Signed: opposes ``omega`` (torque of the bearing on the moving ring).
-    friction_torque_magnitude : float, N m
-        At full sliding, whatever ``omega``.
+        Ball loads, contact angles and ring displacement of the step.
+    friction_torque : float
+        Friction torque of the bearing on the moving ring about +z, N m. Signed:
+        opposes ``omega`` (regularised near rest by ``omega_regularisation``).
+    friction_torque_magnitude : float
+        Friction torque at full sliding, N m (>= 0), whatever ``omega``.
     """
 
     distribution: LoadDistribution
@@ -170,21 +181,43 @@ class StepResult:
 class BearingSimulator:
     """Load distribution and friction torque, step after step, warm-started.
 
+    Holds a bearing, its (optional) superelement and the solver's warm start, and
+    answers each :meth:`step` with the load distribution and the friction torque for
+    the loads, the rotation ``psi`` and the speed ``omega`` of the moving ring. Its
+    whole state is :meth:`get_state`, so a step can be rolled back and repeated exactly.
+    The FMU wraps this class.
+
     Parameters
     ----------
     bearing : Bearing
+        The bearing definition; ``settings.moving_ring`` and ``settings.preload`` override its own.
     superelement : Superelement, optional
-        Needed for ``settings.ring_model == "flexible"``.
-    settings : SimulatorSettings
+        Both rings' condensed stiffness; needed for ``settings.ring_model == "flexible"``.
+    settings : SimulatorSettings, optional
+        Options; default ``SimulatorSettings()`` (flexible rings).
+
+    Attributes
+    ----------
+    solver : BimeSolver
+        The load distribution solver, kept step to step.
+    last : StepResult or None
+        The last step's answer.
+    life : LifeAccumulator or None
+        The life and wear accumulator when ``settings.life`` is True.
+
+    Raises
+    ------
+    ValueError
+        If ``ring_model`` is "flexible" and no superelement is given.
 
     Examples
     --------
     >>> from slewing_model import load_bearing, Loads
-    >>> from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+    >>> from slewing_model.simulation import BearingSimulator, SimulatorSettings
     >>> sim = BearingSimulator(load_bearing("examples/bearings/table3.toml"),
     ...                        settings=SimulatorSettings(ring_model="rigid", friction_coefficient=0.0))
-    >>> r = sim.step(Loads(Fz=5e4), psi=0.0, omega=0.1)
-    >>> r.distribution.displacement[2] > 0
+    >>> r = sim.step(Loads(Fz=5e4), psi=0.0, omega=0.1)     # N; rad, rad/s
+    >>> bool(r.distribution.displacement[2] > 0)            # the inner ring moves towards +z
     True
     """
 
@@ -228,8 +261,19 @@ class BearingSimulator:
             self.life = LifeAccumulator(LifeModel(bearing, s.moving_ring, s.load_frame), kernel=s.contact_kernel)
 
     def tune(self, **changes) -> None:
-        """Change the tunable settings (``friction_coefficient``, ``seal_torque``,
-        ``omega_regularisation``) between steps; the others need a new simulator."""
+        """Change the tunable settings between steps; the others need a new simulator.
+
+        Parameters
+        ----------
+        **changes
+            New values of ``friction_coefficient`` (-), ``seal_torque`` (N m) or
+            ``omega_regularisation`` (rad/s).
+
+        Raises
+        ------
+        ValueError
+            If a setting is not tunable.
+        """
         for name in changes:
             if name not in ("friction_coefficient", "seal_torque", "omega_regularisation"):
                 raise ValueError(f"{name} is not tunable: build a new simulator")
@@ -250,16 +294,19 @@ class BearingSimulator:
         """Solve the step: load distribution at rotation ``psi`` (warm-started
         from the previous step), then the friction torque at speed ``omega``.
 
-        A step whose loads and ``psi`` equal the last step's, where that one ended at an equilibrium
-        (its load distribution and friction torque converged), answers that equilibrium again at once:
-        the same load distribution (its arrays, ``iterations`` 0) and friction torque magnitude, and the
-        signed torque at this ``omega`` (the magnitude is that of a unit speed, whatever ``omega``).
-        Solving it again would start at that equilibrium, take no Newton iteration and give the same
-        numbers to round-off (the friction's balls take their last small Newton step again: within
-        ``friction_tolerance``); the life accumulator adds nothing in such a step (no ball crosses a
-        slice, ``psi`` does not move), so it is not called. Held inputs are what a parked or idling
-        drive, a master's repeated step and the held stretches of step-wise load cases send
-        (``benchmarks/bench_realtime.py``'s reversal, jump and feather scenarios).
+        Parameters
+        ----------
+        loads : Loads
+            External load on the moving ring, N and N m, in the frame ``settings.load_frame``.
+        psi : float
+            Rotation of the moving ring, rad.
+        omega : float
+            Speed of the moving ring relative to the fixed ring about +z, rad/s.
+
+        Returns
+        -------
+        StepResult
+            The load distribution and the signed and full-sliding friction torques.
 
         Raises
         ------
@@ -269,6 +316,18 @@ class BearingSimulator:
             The load cannot be carried. The simulator is then as it was before the
             step (the solver's rotation and kept operator restored): the next step
             goes on as if this one had not been asked for.
+
+        Notes
+        -----
+        A step whose loads and ``psi`` equal the last step's, where that one ended at an equilibrium
+        (its load distribution and friction torque converged), answers that equilibrium again at once:
+        the same load distribution (its arrays, ``iterations`` 0) and friction torque magnitude, and the
+        signed torque at this ``omega`` (the magnitude is that of a unit speed, whatever ``omega``).
+        Solving it again would start at that equilibrium, take no Newton iteration and give the same
+        numbers to round-off (the friction's balls take their last small Newton step again: within
+        ``friction_tolerance``); the life accumulator adds nothing in such a step (no ball crosses a
+        slice, ``psi`` does not move), so it is not called. Held inputs are what a parked or idling
+        drive, a master's repeated step and the held stretches of step-wise load cases send.
         """
         for name, value in (("psi", psi), ("omega", omega)):
             if not math.isfinite(value):
@@ -361,10 +420,17 @@ class BearingSimulator:
         self.solver.operator, self.solver.pending_operator = operator, pending
 
     def get_state(self) -> dict:
-        """Everything that affects the next step: the warm start, the rotation and
-        the solver's reused Newton operator (numpy arrays, not copied: they are
-        never changed in place). :func:`encode_state` makes it JSON data.
+        """Everything that affects the next step.
 
+        Returns
+        -------
+        dict
+            The warm start, the rotation ``psi`` (rad), the solver's reused Newton operator,
+            the friction's ball motions and the life accumulator's state (numpy arrays, not
+            copied: they are never changed in place). :func:`encode_state` makes it JSON data.
+
+        Notes
+        -----
         ``held`` is the last step's inputs and result where it ended at an equilibrium (:meth:`step`):
         objects, kept only as long as the state is in memory (an FMU's ``fmi2GetFMUstate``), so that a
         step repeated from the state repeats exactly; :func:`encode_state` leaves it out, and a state
@@ -378,7 +444,13 @@ class BearingSimulator:
                 "life": None if self.life is None else self.life.get_state(), "held": self._held}
 
     def set_state(self, state: dict) -> None:
-        """Restore :meth:`get_state` (or its :func:`decode_state`)."""
+        """Restore a state.
+
+        Parameters
+        ----------
+        state : dict
+            What :meth:`get_state` returned (or :func:`decode_state` of its JSON form).
+        """
         self._warm = None if state["warm"] is None else np.asarray(state["warm"], dtype=float)
         self._previous = None if state.get("previous") is None else np.asarray(state["previous"], dtype=float)
         self._loads = tuple(None if f is None else np.asarray(f, dtype=float)
