@@ -52,17 +52,10 @@ test: $(STAMP)
 	$(PY) -c "$(COMPILE_LOOPS)"
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
-# speed figures of the README (several minutes: the FMU memory run takes 100 000 steps)
+# the benchmark suite's main set (python -m benchmarks --list names them all; tables printed and written as
+# JSON to results/bench/); the FMU benchmarks measure the released version named by --baseline beside this one
 bench: $(STAMP)
-	$(PY) benchmarks/bench_rigid.py
-	$(PY) benchmarks/bench_superelement.py
-	$(PY) benchmarks/bench_flexible.py
-	$(PY) benchmarks/bench_operator.py
-	$(PY) benchmarks/bench_friction.py
-	$(PY) benchmarks/bench_fmu.py
-	$(PY) benchmarks/bench_batch.py
-	$(PY) benchmarks/bench_realtime.py
-	$(PY) benchmarks/bench_flagged.py
+	$(PY) -m benchmarks main
 
 # the documentation site (Sphinx, warnings as errors) into docs/_build/html; its tools pinned in the docs extra
 DOCS_STAMP := $(VENV)/.docs-installed

@@ -1,4 +1,4 @@
-"""The co-simulation cases users run, as plain input series: what `bench_fmu.py` times and
+"""The co-simulation cases users run, as plain input series: what the ``fmu`` benchmark times and
 `tests/test_step_accuracy.py` checks step by step against tight-tolerance solves.
 
 Each case is a bearing file, the FMU parameters (ring model, load frame) and, per step of

@@ -145,8 +145,9 @@ def benchmark_case(name: str, steps: int):
     coarse superelement (free rings)."""
     import sys
 
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from cases import CASES
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks.cases import CASES
     from slewing_model import load_bearing
     from slewing_model.rings.superelement import build_superelement
 

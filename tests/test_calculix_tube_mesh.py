@@ -1,5 +1,5 @@
 """The C3D20 tube mesher of the CalculiX tube references (references/calculix/tube_mesh.py, used by
-benchmarks/calculix_tube.py and references/calculix/connected/imported_tube.py): its counts and
+references/calculix/calculix_tube.py and references/calculix/connected/imported_tube.py): its counts and
 geometry, no CalculiX run."""
 import importlib.util
 import math

@@ -20,8 +20,9 @@ from slewing_model.rings.superelement import build_superelement
 from conftest import ROOT, benchmark_case
 from statics import load_on_moving_ring
 
-sys.path.insert(0, str(ROOT / "benchmarks"))
-from cases import CASES  # noqa: E402
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+from benchmarks.cases import CASES  # noqa: E402
 
 #: relative accuracy asked of every output at every step, and the absolute floor of each output
 #: where it passes through zero (the tilts change sign; the torque is 0 while a yaw drive rests).

@@ -1,5 +1,5 @@
 """What the win64 tests and benchmark need: wine, the embeddable Windows Python with fmpy, our C host and
-fmusim cross-compiled with mingw-w64 (tests/test_win64.py, benchmarks/bench_win64.py).
+fmusim cross-compiled with mingw-w64 (tests/test_win64.py, the win64 benchmark: benchmarks/win64.py).
 
 Kept under ``$SLEWING_WINE_DIR`` (default ``/var/cache/slewing-wine``, like the Debian chroots): the
 wine prefix, the Windows Python with fmpy, and fmusim with its libraries built for mingw. Wine runs with

@@ -1,25 +1,24 @@
 """Rigid-BIME speed: our Newton solver against scipy.optimize.minimize (BFGS, numeric
 gradient) on the same energy, table1.toml (100 balls), a combined load, cold start.
 
-Run: .venv/bin/python benchmarks/bench_rigid.py
+``--runs``: the Newton solves timed (default 15); BFGS, a third of them (at least 2).
+
+Run: .venv/bin/python -m benchmarks rigid [--runs 15]
 """
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
-from scipy.optimize import minimize
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import median_time, print_table  # noqa: E402
+from .suite import ROOT, median_time, print_table, record
 
-from slewing_model import BimeSolver, Loads, load_bearing  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
+RUNS = 15
 
 
-def main() -> None:
+def main(args) -> None:
+    from scipy.optimize import minimize
+
+    from slewing_model import BimeSolver, Loads, load_bearing
+
     bearing = load_bearing(ROOT / "examples/bearings/table1.toml")
     loads = Loads(Fx=150e3, Fy=-50e3, Fz=800e3, Mx=400e3, My=-1.2e6)
 
@@ -39,10 +38,11 @@ def main() -> None:
 
     ours = newton()
     ref = bfgs()
-    t_newton = median_time(newton, repeat=15)
-    t_bfgs = median_time(bfgs, repeat=5)
+    t_newton = median_time(newton, repeat=args.runs)
+    t_bfgs = median_time(bfgs, repeat=max(2, args.runs // 3))
     disp_ref = ref.x / scale
     agreement = np.abs(disp_ref - ours.displacement).max() / np.abs(ours.displacement).max()
+    record("seconds", {"newton": t_newton, "bfgs": t_bfgs})
     print_table(
         f"Rigid-BIME cold solve, {bearing.name} ({bearing.ball_count} balls), loads {loads}",
         ["method", "median time", "ratio to Newton", "iterations / energy evaluations", "max rel. diff. of displacement"],
@@ -53,7 +53,3 @@ def main() -> None:
              f"{ref.nfev}", f"{agreement:.1e}"],
         ],
     )
-
-
-if __name__ == "__main__":
-    main()

@@ -19,24 +19,22 @@ the first free worker, each case's cost drawn from the measured ones (500 draws)
 as fast as this machine's, the load files on the workers, and a scheduler that keeps up
 (Dask's is good for thousands of tasks per second; a case takes tens of seconds).
 
-Run: .venv/bin/python benchmarks/bench_batch.py [--cases 20] [--duration 20] [--runs 2]
+Run: .venv/bin/python -m benchmarks batch [--cases 20] [--duration 20] [--runs 2]
 """
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import print_table  # noqa: E402
+from .suite import ROOT, note, print_table
 
-ROOT = Path(__file__).resolve().parents[1]
+#: pairs of (1 worker, 2 workers) runs
+RUNS = 2
 DT = 0.05
 
 
@@ -61,7 +59,7 @@ def write_inputs(folder: Path, cases: int, duration: float) -> Path:
     return study
 
 
-def run(study: Path, out: Path, workers: int) -> dict:
+def run_study_on(study: Path, out: Path, workers: int) -> dict:
     from distributed import Client, LocalCluster
 
     from slewing_model.study import run_study
@@ -107,12 +105,12 @@ def hms(seconds: float) -> str:
     return f"{seconds:.1f} s"
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cases", type=int, default=20)
-    ap.add_argument("--duration", type=float, default=20.0, help="s of simulated time per case")
-    ap.add_argument("--runs", type=int, default=2, help="pairs of (1 worker, 2 workers) runs")
-    args = ap.parse_args(argv)
+def add_arguments(parser) -> None:
+    parser.add_argument("--cases", type=int, default=20)
+    parser.add_argument("--duration", type=float, default=20.0, help="s of simulated time per case")
+
+
+def main(args) -> None:
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -127,7 +125,7 @@ def main(argv=None) -> int:
         results = []
         for k in range(args.runs):
             for workers in (1, 2):
-                results.append(run(study, tmp / f"out_{k}_{workers}", workers))
+                results.append(run_study_on(study, tmp / f"out_{k}_{workers}", workers))
                 r = results[-1]
                 print(f"run {k + 1}, {workers} worker(s): {r['wall']:.1f} s, {r['per_minute']:.1f} cases/min "
                       f"(cluster start {r['start']:.1f} s)", flush=True)
@@ -136,7 +134,7 @@ def main(argv=None) -> int:
     two = [r for r in results if r["workers"] == 2]
     ratios = [b["per_minute"] / a["per_minute"] for a, b in zip(one, two)]
     steps = results[0]["steps"][0]
-    print(f"\n{args.cases} cases of {args.duration:g} s ({steps} steps at {DT} s), pitch bearing 150 balls, flexible "
+    note(f"\n{args.cases} cases of {args.duration:g} s ({steps} steps at {DT} s), pitch bearing 150 balls, flexible "
           f"rings (coarse superelement, built once in {build:.1f} s), friction on; {args.runs} runs each, alternating; "
           f"the machine's 2 cores are shared with other users")
     rows = []
@@ -164,8 +162,4 @@ def main(argv=None) -> int:
                 f"median {hms(float(np.median(costs600)))}, p95 {hms(float(np.percentile(costs600, 95)))}, overhead "
                 f"{overhead * 1e3:.0f} ms per case; one core per worker as fast as this one)",
                 ["workers", "cases per worker", "wall time (median)", "wall time (p95)"], rows)
-    return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,6 +1,6 @@
-"""Connected structures (issue 29): what they cost at build time, and that the step costs the same.
+"""Connected structures: what they cost at build time, and that the step costs the same.
 
-    .venv/bin/python benchmarks/bench_connected.py [--steps 400] [--meshes coarse fine]
+    .venv/bin/python -m benchmarks connected [--steps 400] [--meshes coarse fine] [--compare] [--tubes]
 
 1. Superelement build time (no cache) of the pitch bearing, free rings and bolted as in
    ``pitch_bearing_bolted.toml`` (hub flange on the outer ring, blade root on the inner one),
@@ -17,15 +17,10 @@
 """
 from __future__ import annotations
 
-import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-sys.path.insert(0, str(ROOT))
+from .suite import ROOT, print_table
 
 
 def builds(meshes):
@@ -42,20 +37,25 @@ def builds(meshes):
             seconds = time.perf_counter() - t0
             rings = se.metadata["rings"]
             extra = [rings[r].get("connection", {}).get("dofs", 0) for r in ("outer", "inner")]
-            rows.append((mesh, name, seconds, [rings[r]["mesh"]["dofs"] for r in ("outer", "inner")], extra,
-                         [rings[r]["harmonics"] for r in ("outer", "inner")]))
-            print(f"build {mesh:6} {name:7} {seconds:7.2f} s  ring DOFs {rows[-1][3]}  adapter DOFs {extra}  "
-                  f"harmonics {rows[-1][5]}", flush=True)
+            dofs = [rings[r]["mesh"]["dofs"] for r in ("outer", "inner")]
+            harmonics = [rings[r]["harmonics"] for r in ("outer", "inner")]
+            rows.append([mesh, name, f"{seconds:.2f} s", f"{dofs[0]}, {dofs[1]}", f"{extra[0]}, {extra[1]}",
+                         f"{harmonics[0]}, {harmonics[1]}"])
+            print(f"  built {mesh} {name}: {seconds:.1f} s", flush=True)
+    print_table("Superelement build of the pitch bearing, no cache, free and bolted rings (pitch_bearing_bolted.toml)",
+                ["mesh", "rings", "build time", "ring DOFs (outer, inner)", "adapter DOFs (outer, inner)",
+                 "harmonics (outer, inner)"], rows)
     return rows
 
 
 def steps(n):
     import numpy as np
 
-    from cases import pitch
     from slewing_model import Loads, load_bearing
     from slewing_model.rings.superelement import build_superelement
     from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+
+    from .cases import pitch
 
     case = pitch(n)
     sims = {}
@@ -74,11 +74,14 @@ def steps(n):
             times[name].append(time.perf_counter() - t0)
             peaks[name].append(r.distribution.max_ball_load)
             iters[name].append(r.distribution.iterations)
+    rows = []
     for name in sims:
         t = np.array(times[name][10:])            # the first steps start cold
-        print(f"step {name:7} median {1e3 * statistics.median(t):.2f} ms, mean {1e3 * t.mean():.2f} ms, "
-              f"Newton iterations mean {np.mean(iters[name]):.2f}, peak ball load max "
-              f"{max(peaks[name]) / 1e3:.1f} kN", flush=True)
+        rows.append([name, f"{1e3 * statistics.median(t):.2f} ms", f"{1e3 * np.percentile(t, 95):.2f} ms",
+                     f"{1e3 * t.mean():.2f} ms", f"{np.mean(iters[name]):.2f}", f"{max(peaks[name]) / 1e3:.1f} kN"])
+    print_table(f"The pitch case ({n} steps, the first 10 left out), free and bolted rings (coarse), interleaved step "
+                "by step", ["rings", "median step", "95th pct", "mean step", "Newton iterations (mean)",
+                            "largest peak ball load"], rows)
 
 
 def compare():
@@ -98,13 +101,15 @@ def compare():
     ses["rigid"] = None
     for k in (int(np.argmax(moment)), int(np.argmin(moment))):
         loads = Loads(*(float(data[f][k]) for f in ("Fx", "Fy", "Fz", "Mx", "My")))
-        print(f"t = {data['time'][k]:.2f} s: |M| = {moment[k] / 1e6:.2f} MN m, Fz = {data['Fz'][k] / 1e3:.0f} kN, "
-              f"Fr = {np.hypot(data['Fx'][k], data['Fy'][k]) / 1e3:.0f} kN")
+        rows = []
         for name, se in ses.items():
             r = solve(plain, loads, model="rigid" if se is None else "flexible", superelement=se)
             f = friction_torque(plain, r, omega=1.0)
-            print(f"  {name:12} peak ball load {r.max_ball_load / 1e3:7.1f} kN, friction torque "
-                  f"{f.magnitude / 1e3:6.2f} kN m", flush=True)
+            rows.append([name, f"{r.max_ball_load / 1e3:.1f} kN", f"{f.magnitude / 1e3:.2f} kN m"])
+        print_table(f"Pitch bearing at t = {data['time'][k]:.2f} s of the blade-root series: |M| = "
+                    f"{moment[k] / 1e6:.2f} MN m, Fz = {data['Fz'][k] / 1e3:.0f} kN, "
+                    f"Fr = {np.hypot(data['Fx'][k], data['Fy'][k]) / 1e3:.0f} kN",
+                    ["rings", "peak ball load", "friction torque"], rows)
 
 
 def tubes():
@@ -125,21 +130,22 @@ def tubes():
         ses[f"tubes {length:g} m"] = build_superelement(
             b.with_connection({"outer": tube("outer", length), "inner": tube("inner", length)}), "coarse", "free")
     for loads in (Loads(0, 0, 0, 0, 1.0e6), Loads(0, 0, 1.0e6, 0, 0)):
-        print(loads)
         q = {k: solve(b, loads, model="flexible", superelement=se).max_ball_load for k, se in ses.items()}
-        for k, v in q.items():
-            print(f"  {k:13} peak {v / 1e3:7.2f} kN, against clamped {100 * (v / q['clamped'] - 1):+6.1f} %, "
-                  f"against frictionless {100 * (v / q['frictionless'] - 1):+6.1f} %", flush=True)
+        print_table(f"table1 on steel tubes, {loads}",
+                    ["rings", "peak ball load", "against clamped", "against frictionless"],
+                    [[k, f"{v / 1e3:.2f} kN", f"{100 * (v / q['clamped'] - 1):+.1f} %",
+                      f"{100 * (v / q['frictionless'] - 1):+.1f} %"] for k, v in q.items()])
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--steps", type=int, default=400)
-    p.add_argument("--meshes", nargs="*", default=["coarse", "fine"])
-    p.add_argument("--no-builds", action="store_true")
-    p.add_argument("--compare", action="store_true", help="the free / clamped / frictionless / bolted table")
-    p.add_argument("--tubes", action="store_true", help="table1 on steel tubes against the idealisations")
-    args = p.parse_args()
+def add_arguments(parser) -> None:
+    parser.add_argument("--steps", type=int, default=400, help="steps of the pitch case (0: no step timing)")
+    parser.add_argument("--meshes", nargs="*", default=["coarse", "fine"])
+    parser.add_argument("--no-builds", action="store_true")
+    parser.add_argument("--compare", action="store_true", help="the free / clamped / frictionless / bolted table")
+    parser.add_argument("--tubes", action="store_true", help="table1 on steel tubes against the idealisations")
+
+
+def main(args) -> None:
     if not args.no_builds:
         builds(args.meshes)
     if args.compare:
@@ -148,7 +154,3 @@ def main():
         tubes()
     if args.steps:
         steps(args.steps)
-
-
-if __name__ == "__main__":
-    main()

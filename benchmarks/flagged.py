@@ -1,8 +1,8 @@
-"""What a bounded step that was flagged answers, against the complete step at the same time (issue 31).
+"""What a bounded step that was flagged answers, against the complete step at the same time.
 
 A bounded step (``step_work`` = "bounded") that cannot reach the equilibrium within its work answers
 with its last iterate, flagged by ``distribution.converged`` False (the FMU: ``equilibrium_residual``
-above ``tolerance``). This runs the pitch bearing's five real-time scenarios (``bench_realtime.py``)
+above ``tolerance``). This runs the pitch bearing's five real-time scenarios (``realtime``)
 through the library's simulator twice, bounded and complete, step by step side by side (flexible
 rings, friction and life on), and compares the flagged steps' friction torque and largest ball load
 with the complete steps': as answered (the iterate) and, for comparison, as the last equilibrium of
@@ -10,19 +10,14 @@ the bounded run would give them (held) and as a rigid-ring simulator stepped alo
 cheap approximate answer such a step could give instead). Accuracy, not time: the figures do not depend
 on the machine.
 
-Run: .venv/bin/python benchmarks/bench_flagged.py [--scenarios reversal nrel ...]
+Run: .venv/bin/python -m benchmarks flagged [--scenarios reversal nrel ...]
 """
 from __future__ import annotations
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_realtime import SCENARIOS, scenario  # noqa: E402
-from timing import print_table  # noqa: E402
+from .realtime import SCENARIOS, scenario
+from .suite import print_table
 
 
 def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
@@ -72,10 +67,11 @@ def _spread(errors: np.ndarray) -> str:
     return f"{np.median(errors):.3g} / {np.percentile(errors, 90):.3g} / {errors.max():.3g}"
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
-    args = parser.parse_args()
+
+
+def main(args) -> None:
     rows = []
     for name in args.scenarios:
         errors, damage = flagged_errors(name)
@@ -90,6 +86,3 @@ def main() -> None:
                  "friction torque: rigid rings", "largest ball load: rigid rings",
                  "life damage, bounded / complete"], rows)
 
-
-if __name__ == "__main__":
-    main()

@@ -1,9 +1,9 @@
-"""What the slowest steps spend their time on (issue 31): each part of the slowest steps of a scenario.
+"""What the slowest steps spend their time on: each part of the slowest steps of a scenario.
 
 The pitch bearing as the FMU runs it (flexible rings, loads in the blade-root frame, friction and life on,
 compiled kernels), started at zero loads as an FMU leaving initialization with its start values, stepped
-through the library's simulator under a scenario of ``bench_realtime.py``; bounded steps by default
-(``step_work="bounded"``, whose slowest step the issue wants under 4 NREL medians). Each part is timed
+through the library's simulator under a scenario of the ``realtime`` benchmark; bounded steps by default
+(``step_work="bounded"``, whose slowest step the goal wants under 4 NREL medians). Each part is timed
 where it is called (the function wrapped for the run, its calls within it not counted twice):
 
 - ``form``: a new operator's ``W`` gathered (``start_operator``);
@@ -22,30 +22,26 @@ bordering, iterations; :mod:`slewing_model.distribution.bime`), shown as the tim
 million a millisecond. A part whose time is far above its share of that count is work the bound does
 not see.
 
-Run: .venv/bin/python benchmarks/bench_slowest.py [--scenarios nrel reversal ...] [--top 5]
+Run: .venv/bin/python -m benchmarks slowest [--scenarios nrel reversal ...] [--top 5]
      [--step-work bounded|complete]   (about 20 s for the five scenarios)
 """
 from __future__ import annotations
 
-import argparse
-import sys
 import time
 from contextlib import ExitStack
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_realtime import SCENARIOS, scenario  # noqa: E402
-from bench_step_parts import patched, timer  # noqa: E402
-from timing import print_table  # noqa: E402
+from slewing_model import Loads, load_bearing
+from slewing_model.distribution import bime
+from slewing_model.life.duty import LifeAccumulator
+from slewing_model.rings import reduced_operator
+from slewing_model.rings.superelement import build_superelement
+from slewing_model.simulation import simulator
 
-from slewing_model import Loads, load_bearing  # noqa: E402
-from slewing_model.distribution import bime  # noqa: E402
-from slewing_model.life.duty import LifeAccumulator  # noqa: E402
-from slewing_model.rings import reduced_operator  # noqa: E402
-from slewing_model.rings.superelement import build_superelement  # noqa: E402
-from slewing_model.simulation import simulator  # noqa: E402
+from .realtime import SCENARIOS, scenario
+from .step_parts import patched, timer
+from .suite import print_table
 
 #: the parts timed: (label, owner, attribute)
 PARTS = (
@@ -66,7 +62,7 @@ PARTS = (
 WORK_RATE = 55e6
 
 
-def run(name: str, step_work: str) -> list[dict]:
+def step_scenario(name: str, step_work: str) -> list[dict]:
     """Every step of the scenario ``name``: its time, flag, work charged and parts (ms)."""
     case = scenario(name)
     bearing = load_bearing(case.bearing)
@@ -89,17 +85,18 @@ def run(name: str, step_work: str) -> list[dict]:
     return steps
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
     parser.add_argument("--top", type=int, default=5, help="the slowest steps shown per scenario")
     parser.add_argument("--step-work", default="bounded", choices=bime.STEP_WORK)
-    args = parser.parse_args()
+
+
+def main(args) -> None:
     scenarios = ["nrel"] + [s for s in args.scenarios if s != "nrel"]     # NREL first: its median is the unit
     labels = list(dict.fromkeys(label for label, _, _ in PARTS))
     nrel_median = None
     for name in scenarios:
-        steps = run(name, args.step_work)
+        steps = step_scenario(name, args.step_work)
         times = np.array([s["time"] for s in steps])
         nrel_median = nrel_median or float(np.median(times))
         if name not in args.scenarios:
@@ -115,6 +112,3 @@ def main() -> None:
                     ["step", "time", "NREL medians", "flagged", "work charged [ms]"] + labels + ["rest"],
                     rows)
 
-
-if __name__ == "__main__":
-    main()

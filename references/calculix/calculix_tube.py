@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""The harmonic tube adapter against a 3-D CalculiX tube (issue 29): run outside `make test`,
+"""The harmonic tube adapter against a 3-D CalculiX tube: run outside `make test`,
 needs `ccx` (Debian calculix-ccx); about a minute.
 
-    .venv/bin/python benchmarks/calculix_tube.py [--keep DIR]
+    .venv/bin/python references/calculix/calculix_tube.py [--keep DIR]
 
 An orthotropic tube (r 760-805 mm, 300 mm long; axial 40 GPa, hoop 15 GPa, shear 5 GPa,
 Poisson 0.3, radial = hoop: the blade-root kind of material) is clamped at its far end, and its
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from references.calculix.tube_mesh import c3d20_tube, nset  # noqa: E402

@@ -1,27 +1,27 @@
 """Flexible-BIME speed: our structured Newton (reduced to the active contacts, reused
 operator) against the dense Newton on all 5 + 8B unknowns, measured side by side.
 
-Run: .venv/bin/python benchmarks/bench_flexible.py
+``--runs``: the warm solves timed (default 15); the cold ones, half of them, the dense ones a fifth
+(at least 2).
+
+Run: .venv/bin/python -m benchmarks flexible [--runs 15]
 """
 from __future__ import annotations
 
 import os
-import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import median_time, print_table  # noqa: E402
+from .suite import ROOT, median_time, print_table
 
-from slewing_model import BimeSolver, Loads, load_bearing  # noqa: E402
-from slewing_model.distribution.bime import solve_dense_newton  # noqa: E402
-from slewing_model.rings.superelement import build_superelement  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
+RUNS = 15
 
 
-def main() -> None:
+def main(args) -> None:
+    from slewing_model import BimeSolver, Loads, load_bearing
+    from slewing_model.distribution.bime import solve_dense_newton
+    from slewing_model.rings.superelement import build_superelement
+
     rows = []
     cases = [("table3_errors.toml", Loads(Fx=1e4, Fz=5e4, Mx=3e3, My=-2e3)),
              ("table1.toml", Loads(Fx=8e4, Fz=8e5, Mx=3e5, My=6e5))]
@@ -43,9 +43,9 @@ def main() -> None:
         def dense():
             return solve_dense_newton(BimeSolver(bearing, se), loads)
 
-        t_cold = median_time(cold, repeat=7)
-        t_warm = median_time(warm, repeat=15)
-        t_dense = median_time(dense, repeat=3)
+        t_cold = median_time(cold, repeat=max(2, args.runs // 2))
+        t_warm = median_time(warm, repeat=args.runs)
+        t_dense = median_time(dense, repeat=max(2, args.runs // 5))
         x, dense_iterations = dense()
         diff = np.abs(x[:5] - base.displacement).max() / np.abs(base.displacement).max()
         rows += [
@@ -60,6 +60,3 @@ def main() -> None:
     print_table(f"Flexible-BIME solve, free rings, coarse superelement (OPENBLAS_NUM_THREADS={threads})",
                 ["bearing", "unknowns", "method", "median time", "ratio to cold", "iterations"], rows)
 
-
-if __name__ == "__main__":
-    main()

@@ -7,10 +7,11 @@ load, turning; and the earlier light table3 case. Friction on, fine superelement
 (the build's defaults).
 
 A step is what a host does each communication step: set the 7 inputs, ``doStep`` (10 ms),
-get 5 outputs. The FMU of the version before this work (``--baseline``, a git revision,
-default ``cd27082``) is built from a temporary git worktree by that version's own
-``build_fmu.py`` and stepped in the same run, its runs alternating with the current one's,
-so that both see the same machine load; the ratio column is current / baseline.
+get 5 outputs. The FMU of a released version (``--baseline VERSION``, default
+:data:`benchmarks.suite.DEFAULT_BASELINE`; ``none``: no baseline) is built from a temporary git
+worktree by that version's own ``build_fmu.py`` and stepped in the same run, its runs alternating
+with the current one's, so that both see the same machine load; the ratio column is current /
+baseline.
 
 Each FMU runs in a worker process of its own: an FMU's Python code runs in its host's
 interpreter, and two FMUs in one process would share the first ``slewing_model`` imported.
@@ -19,7 +20,7 @@ The current FMU runs its friction loops compiled where numba is installed in the
 host's Python (as in this venv); ``--without-numba`` makes numba unimportable in the
 workers, so that the FMU runs its numpy fallback, as on a host without numba.
 
-Run: .venv/bin/python benchmarks/bench_fmu.py [--steps 1000] [--runs 3] [--baseline REV|none]
+Run: .venv/bin/python -m benchmarks fmu [--steps 1000] [--runs 3] [--baseline VERSION|none]
      [--memory-steps 100000] [--without-numba] [--cases pitch yaw ...]
 """
 from __future__ import annotations
@@ -35,11 +36,12 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cases import CASES, DT, load_case  # noqa: E402
-from timing import print_table  # noqa: E402
+from .cases import CASES, DT, load_case
+from .suite import DEFAULT_BASELINE, ROOT, build_baseline, build_fmu_module, print_table, record, spread, \
+    worker_command
 
-ROOT = Path(__file__).resolve().parents[1]
+RUNS = 3
+BASELINE = DEFAULT_BASELINE
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 BEARINGS = ("pitch_bearing", "yaw_bearing", "table3_errors")
@@ -101,9 +103,9 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
     for line in sys.stdin:
         first, count, rewarm = (*map(int, line.split()), 0)[:3]
         if rewarm:
-            # on this machine a step whose memory was not touched for a second or more took 8-40 ms of
-            # CPU time instead of 1 (no page fault: out of the shared host's caches; docs/speed.md,
-            # nineteenth turn): the block's first step, made once and rolled back, warms it first
+            # on a shared machine a step whose memory was not touched for a second or more can take 8-40 ms
+            # of CPU time instead of 1 (no page fault: out of the shared host's caches; docs/speed.md): the
+            # block's first step, made once and rolled back, warms it first
             state = fmu.getFMUstate()
             fmu.setReal(inputs, values_at(first))
             fmu.doStep(first * DT, DT)
@@ -130,9 +132,9 @@ class Worker:
 
     def __init__(self, fmu_path: Path, case_name: str, steps: int, without_numba: bool = False,
                  integers: dict | None = None, outputs=OUTPUTS, trace: str | None = None, start_inputs: bool = False):
-        command = [sys.executable, __file__, "--worker", str(fmu_path), case_name, str(steps),
-                   "--worker-options", json.dumps({"integers": integers or {}, "outputs": list(outputs),
-                                                   "trace": trace, "start_inputs": start_inputs})]
+        command = worker_command("fmu", str(fmu_path), case_name, str(steps),
+                                 "--worker-options", json.dumps({"integers": integers or {}, "outputs": list(outputs),
+                                                                 "trace": trace, "start_inputs": start_inputs}))
         if without_numba:
             command.append("--without-numba")
         self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
@@ -158,54 +160,42 @@ class Worker:
 
 # ---- the parent: builds, alternates, tabulates -------------------------------------------------
 
-def build_current(out: Path) -> dict[str, Path]:
-    sys.path.insert(0, str(ROOT))
-    from build_fmu import build_fmu
-
-    return {name: Path(build_fmu(ROOT / f"examples/bearings/{name}.toml", out / f"current_{name}.fmu"))
-            for name in BEARINGS}
-
-
-def build_baseline(revision: str, out: Path, bearings=BEARINGS, options=()) -> dict[str, Path]:
-    """The FMUs of ``revision`` (of ``bearings``), built by that revision's own build_fmu.py from a git worktree
-    (with its command-line ``options``, e.g. ``("--no-numba",)``)."""
-    tree = out / "baseline_tree"
-    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), revision], check=True,
-                   capture_output=True)
-    try:
-        fmus = {}
-        for name in bearings:
-            fmus[name] = out / f"baseline_{name}.fmu"
-            subprocess.run([sys.executable, "build_fmu.py", f"examples/bearings/{name}.toml", "-o", str(fmus[name]),
-                            *options], cwd=tree, check=True, capture_output=True)
-        return fmus
-    finally:
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
-
-
-def main() -> None:
+def worker_main(argv: list[str]) -> None:
+    """A worker process (:class:`Worker`): ``FMU CASE STEPS [--worker-options JSON] [--without-numba]``."""
     parser = argparse.ArgumentParser()
+    parser.add_argument("worker", nargs=3, metavar=("FMU", "CASE", "STEPS"))
+    parser.add_argument("--worker-options", default="{}")
+    parser.add_argument("--without-numba", action="store_true")
+    args = parser.parse_args(argv)
+    if args.without_numba:
+        sys.meta_path.insert(0, _NoNumba())
+    worker(args.worker[0], args.worker[1], int(args.worker[2]), **json.loads(args.worker_options))
+
+
+def build_current(out: Path, bearings=BEARINGS) -> dict[str, Path]:
+    build_fmu = build_fmu_module().build_fmu
+    return {name: Path(build_fmu(ROOT / f"examples/bearings/{name}.toml", out / f"current_{name}.fmu"))
+            for name in bearings}
+
+
+def add_arguments(parser) -> None:
     parser.add_argument("--steps", type=int, default=1000, help="steps of each timed run")
-    parser.add_argument("--runs", type=int, default=3, help="timed runs per case and FMU (interleaved)")
-    parser.add_argument("--baseline", default="cd27082", help="git revision of the baseline FMU, or 'none'")
     parser.add_argument("--memory-steps", type=int, default=100_000, help="steps of the memory run (0: none)")
-    parser.add_argument("--cases", nargs="*", default=list(CASES))
+    parser.add_argument("--cases", nargs="*", default=list(CASES), choices=list(CASES))
     parser.add_argument("--without-numba", action="store_true",
                         help="make numba unimportable in the workers: the current FMU runs its numpy fallback")
-    parser.add_argument("--worker", nargs=3, metavar=("FMU", "CASE", "STEPS"), help=argparse.SUPPRESS)
-    parser.add_argument("--worker-options", default="{}", help=argparse.SUPPRESS)
-    args = parser.parse_args()
-    if args.worker:
-        if args.without_numba:
-            sys.meta_path.insert(0, _NoNumba())
-        worker(args.worker[0], args.worker[1], int(args.worker[2]), **json.loads(args.worker_options))
-        return
 
+
+def main(args) -> None:
     with tempfile.TemporaryDirectory(prefix="bench_fmu_") as tmp:
         tmp = Path(tmp)
-        fmus = {"current": build_current(tmp)}
-        if args.baseline != "none":
-            fmus["baseline"] = build_baseline(args.baseline, tmp)
+        bearings = {Path(CASES[name](1).bearing).stem for name in args.cases}      # the FMUs the cases step
+        if args.memory_steps:
+            bearings.add("table3_errors")
+        bearings = [b for b in BEARINGS if b in bearings]
+        fmus = {"current": build_current(tmp, bearings)}
+        if args.baseline_commit:
+            fmus["baseline"] = build_baseline(args.baseline_commit, tmp, bearings)
         versions = list(fmus)
         rows, medians, means, kernel = [], {}, {}, ""
         total = WARM + args.steps * args.runs
@@ -224,18 +214,21 @@ def main() -> None:
                 workers[v].close()
                 t = times[v] = np.array(times[v]) * 1e3
                 medians[name, v], means[name, v] = float(np.median(t)), float(np.mean(t))
+                record(f"{name} {v} [ms]", {**spread(t), "mean": means[name, v], "first": first[v] * 1e3,
+                                            "instantiate": workers[v].started["instantiate"] * 1e3})
             kernel = "compiled friction loop (numba)" if workers["current"].started["compiled"] else \
                 "numpy friction (no numba)"
             for v in versions:
-                t = times[v]
+                s = spread(times[v])
                 ratio = "" if v == "baseline" or "baseline" not in versions else \
                     f"{medians[name, v] / medians[name, 'baseline']:.2f}"
                 rows.append([name, v, f"{workers[v].started['instantiate'] * 1e3:.0f} ms", f"{first[v] * 1e3:.1f} ms",
-                             f"{np.median(t):.2f} ms", f"{np.percentile(t, 95):.2f} ms",
-                             f"{np.percentile(t, 99):.2f} ms", f"{t.max():.1f} ms", ratio])
+                             f"{s['median']:.2f} ms", f"{s['p95']:.2f} ms", f"{s['p99']:.2f} ms", f"{s['max']:.1f} ms",
+                             ratio])
             print(f"  {name}: {case.description}", flush=True)
         print_table(f"Bearing FMU through fmpy, one step = setReal + doStep ({DT * 1e3:.0f} ms) + getReal; "
-                    f"{args.runs} runs of {args.steps} steps per case and version, interleaved; current: {kernel}",
+                    f"{args.runs} runs of {args.steps} steps per case and version, interleaved; current: {kernel}"
+                    + (f"; baseline: {args.baseline} ({args.baseline_commit[:9]})" if args.baseline_commit else ""),
                     ["case", "version", "instantiate", "first step", "median", "95th pct", "99th pct", "max",
                      "median ratio to baseline"], rows)
         if {"pitch", "yaw"} <= set(args.cases):
@@ -258,6 +251,3 @@ def main() -> None:
             print_table("Resident memory of the host process (current FMU, table3_light, flexible rings)",
                         ["steps", "RSS [MB]"], memory)
 
-
-if __name__ == "__main__":
-    main()

@@ -1,8 +1,8 @@
-"""Where a co-simulation step's time goes, and what of it one compiled call could save (issue 31).
+"""Where a co-simulation step's time goes, and what of it one compiled call could save: the floor.
 
 The pitch bearing as the FMU runs it (flexible rings, loads in the blade-root frame, friction and
 life on, complete steps), stepped through the library's simulator under a scenario of
-``bench_realtime.py`` (``nrel``, ``turbulence``, ...). Each part of a step is timed where it is
+the ``realtime`` benchmark (``nrel``, ``turbulence``, ...). Each part of a step is timed where it is
 called (the method wrapped for the run):
 
 - ``set_rotation``: the solver's assembly at the ring's angle;
@@ -16,48 +16,45 @@ called (the method wrapped for the run):
 - ``life``: the raceway map and damage;
 - ``simulator``: the step's own bookkeeping (the warm starts, the state), what is left of the step.
 
-Steps that form, border or invert an operator (their time is that work's: ``bench_operator.py``)
+Steps that form, border or invert an operator (their time is that work's: the ``operator`` benchmark)
 are counted apart; the table is of the other steps, the usual ones. The compiled calls (the two big
 ones, the solve's and the friction's, and the other loops a step calls from Python: the start's
 trial point, the ring product, the operator's turn, the contacts' results, the life map) are then
 called again with the arguments they had in those steps, each several times in a row ("hot": its
-data and code in the cache, no Python around it): the sum of the hot calls is what a step made of one compiled call would still cost, the floor of issue
-31's "one compiled call", against the median of the step as it runs now. The gap between a call in
+data and code in the cache, no Python around it): the sum of the hot calls is what a step made of one
+compiled call would still cost, the floor of "one compiled call", against the median of the step as it
+runs now. The gap between a call in
 the step and the same call hot is what the step's cold caches cost it (the other parts' data and
 code ran in between).
 
-``--scenarios`` takes ``bench_realtime.py``'s scenarios and ``yaw`` (``bench_fmu.py``'s yaw case: the
+``--scenarios`` takes the ``realtime`` benchmark's scenarios and ``yaw`` (the ``fmu`` benchmark's yaw case: the
 180-ball yaw bearing under the tower-top series, yawing in bursts). With a pitch scenario and ``yaw``
-the last lines weigh them as issue 31's whole turbine does (3 pitch + 1 yaw bearing at a 10 ms step):
+the last lines weigh them as the whole turbine does (3 pitch + 1 yaw bearing at a 10 ms step):
 the four usual steps' medians and the four steps' compiled calls hot, each as a real-time factor. The
 hot calls are a floor no formulation of the step around these loops goes below; the real-time factor of
-the whole turbine's mean steps, with the ring operators' work, is ``bench_fmu.py``'s.
+the whole turbine's mean steps, with the ring operators' work, is the ``fmu`` benchmark's.
 
-Run: .venv/bin/python benchmarks/bench_step_parts.py [--scenarios nrel turbulence yaw] [--steps 3000]
+Run: .venv/bin/python -m benchmarks step_parts [--scenarios nrel turbulence yaw] [--steps 3000]
 """
 from __future__ import annotations
 
-import argparse
-import sys
 import time
 from contextlib import ExitStack, contextmanager
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_realtime import SCENARIOS, scenario  # noqa: E402
-from cases import DT, yaw  # noqa: E402
-from timing import print_table  # noqa: E402
+from slewing_model import Loads, load_bearing
+from slewing_model.distribution import bime
+from slewing_model.distribution import kernel as distribution_kernel
+from slewing_model.friction import ball_kinematics
+from slewing_model.life import raceway_map
+from slewing_model.life.duty import LifeAccumulator
+from slewing_model.rings.superelement import build_superelement
+from slewing_model.simulation import simulator
 
-from slewing_model import Loads, load_bearing  # noqa: E402
-from slewing_model.distribution import bime  # noqa: E402
-from slewing_model.distribution import kernel as distribution_kernel  # noqa: E402
-from slewing_model.friction import ball_kinematics  # noqa: E402
-from slewing_model.life import raceway_map  # noqa: E402
-from slewing_model.life.duty import LifeAccumulator  # noqa: E402
-from slewing_model.rings.superelement import build_superelement  # noqa: E402
-from slewing_model.simulation import simulator  # noqa: E402
+from .cases import DT, yaw
+from .realtime import SCENARIOS, scenario
+from .suite import note, print_table, record
 
 #: the parts timed, (label, owner, attribute); a label with a leading space is a part of the one above
 PARTS = (
@@ -141,7 +138,7 @@ def recorder(label, calls):
     return wrap
 
 
-def run(name: str, steps: int) -> dict:
+def step_scenario(name: str, steps: int) -> dict:
     case = yaw(steps) if name == "yaw" else scenario(name)
     bearing = load_bearing(case.bearing)
     superelement = build_superelement(bearing, mesh="fine", progress=False)
@@ -190,14 +187,15 @@ def run(name: str, steps: int) -> dict:
             "hot": {k: 1e6 * np.asarray(v) for k, v in hot.items()}, "steps": len(usual["step"])}
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--scenarios", nargs="+", default=["nrel", "turbulence"], choices=(*SCENARIOS, "yaw"))
-    parser.add_argument("--steps", type=int, default=3000)
-    args = parser.parse_args()
+    parser.add_argument("--steps", type=int, default=3000, help="steps of the yaw case (the others: the scenario's)")
+
+
+def main(args) -> None:
     medians, floors = {}, {}
     for name in args.scenarios:
-        found = run(name, args.steps)
+        found = step_scenario(name, args.steps)
         usual, hot = found["usual"], found["hot"]
         step = float(np.median(usual["step"]))
         parts = {label: float(np.mean(usual[label])) for label, _, _ in PARTS}
@@ -215,15 +213,13 @@ def main() -> None:
         print_table(f"{name}: {found['steps']} steps without operator work, us", ["part", "median", "mean",
                                                                                    "share of the mean", "hot"], rows)
         floor = float(np.median(np.sum([hot[label] for label in hot], axis=0)))
-        print(f"the compiled calls hot: {floor:.0f} us, {floor / step:.2f} of the median step ({step:.0f} us)")
+        note(f"the compiled calls hot: {floor:.0f} us, {floor / step:.2f} of the median step ({step:.0f} us)")
+        record(f"{name} [us]", {"median step": step, "compiled calls hot": floor})
         medians[name], floors[name] = step, floor
     pitch = next((name for name in args.scenarios if name != "yaw"), None)
     if pitch is not None and "yaw" in args.scenarios:
         for what, values in (("usual steps' medians", medians), ("compiled calls hot", floors)):
             turbine = 3.0 * values[pitch] + values["yaw"]
-            print(f"whole turbine (3 x {pitch} + yaw), {what}: {turbine:.0f} us a 10 ms step, "
+            note(f"whole turbine (3 x {pitch} + yaw), {what}: {turbine:.0f} us a 10 ms step, "
                   f"{1e6 * DT / turbine:.1f} times real time")
 
-
-if __name__ == "__main__":
-    main()

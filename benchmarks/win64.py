@@ -1,7 +1,7 @@
 """The same FMU on Linux and on win64 under wine: size of each half, instantiation, doStep.
 
 Two builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0), each carrying
-both binaries (build_fmu.py's default, build_win64.py): the default (Linux half with numba; the win64
+both binaries (build_fmu.py's default, fmu_build/win64.py): the default (Linux half with numba; the win64
 half has no numba and runs numpy's loops) and ``--no-numba`` (both halves run numpy's loops). Each FMU
 is unpacked once and run by our C host (``tests/c_host/host.c``, scenario ``bench``): the Linux build with
 ``PATH=/usr/bin:/bin``, the mingw build under wine 8 (``WINEDEBUG=-all``); a fresh process per run, the
@@ -14,17 +14,16 @@ Windows desktop.
 ``--win64-numba``: a third build, the default with ``--win64-numba`` (its win64 half runs numba's loops,
 compiled under wine at build time).
 
-``--baseline REV``: instead of the builds, this tree's ``--no-numba`` FMU against REV's (built by
-REV's own build_fmu.py from a git worktree), both halves of each, alternating: what a change did to numpy's
+``--baseline VERSION``: instead of the builds, this tree's ``--no-numba`` FMU against that released
+version's (built by its own build_fmu.py from a git worktree), both halves of each, alternating: what a change did to numpy's
 loops, the win64 half's. ``--busy N``: N processes that only spin run beside the timed runs (and end with
 them), as a user's pitch system shares the cores with its other FMUs.
 
 Run (root, with wine and mingw-w64: ``make`` installs them):
-    .venv/bin/python benchmarks/bench_win64.py [--steps 1000] [--runs 3] [--win64-numba] [--baseline REV] [--busy 2]
+    .venv/bin/python -m benchmarks win64 [--steps 1000] [--runs 3] [--win64-numba] [--baseline VERSION] [--busy 2]
 """
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
 import sys
@@ -34,23 +33,24 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from bench_fmu_runtime import bench_output, compile_host  # noqa: E402  (our C host for Linux and its output, as that benchmark has them)
-from cases import CASES  # noqa: E402
-from timing import print_table  # noqa: E402
+from .cases import CASES
+from .fmu_variants import bench_output, compile_host  # our C host for Linux and its output
+from .suite import ROOT, build_baseline, build_fmu_module, note, print_table, record, spread
 
-import win64_tools as w  # noqa: E402
+if str(ROOT / "tests") not in sys.path:
+    sys.path.append(str(ROOT / "tests"))
+import win64_tools as w  # noqa: E402  (wine, mingw and the paths wine takes: tests/win64_tools.py)
 
-ROOT = Path(__file__).resolve().parents[1]
+RUNS = 3
+#: no baseline unless --baseline names one (then the --no-numba FMUs of this tree and of that version)
+BASELINE = None
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 VARIANTS = {"default (numba on Linux)": {"numba": True}, "--no-numba": {"numba": False}}
 WARM = 20
 
 
-def run(platform: str, host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict):
+def run_host(platform: str, host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict):
     """One run of the C host: (instantiation s, step times s, final outputs)."""
     integers = sum((["--integer", str(refs[k]), str(v)] for k, v in parameters.items()), [])
     if platform == "linux":
@@ -79,23 +79,22 @@ def sizes(fmu: Path) -> dict:
     return out
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--steps", type=int, default=1000)
-    parser.add_argument("--runs", type=int, default=3)
-    parser.add_argument("--baseline", help="git revision whose --no-numba FMU this tree's is compared with")
     parser.add_argument("--busy", type=int, default=0, help="processes that spin beside the timed runs")
     parser.add_argument("--win64-numba", action="store_true", help="also the default FMU built with --win64-numba")
-    args = parser.parse_args()
-    if args.steps < WARM + 1 or args.runs < 1 or args.busy < 0:
-        parser.error(f"--steps must be > {WARM}, --runs >= 1, --busy >= 0")
-    if args.baseline and args.win64_numba:
-        parser.error("--baseline compares the --no-numba FMUs: not with --win64-numba")
+
+
+def main(args) -> None:
+    if args.steps < WARM + 1 or args.busy < 0:
+        sys.exit(f"--steps must be > {WARM}, --busy >= 0")
+    if args.baseline_commit and args.win64_numba:
+        sys.exit("--baseline compares the --no-numba FMUs: not with --win64-numba")
     if w.missing_tools():
         sys.exit(w.missing_tools())
     from fmpy import read_model_description
 
-    from build_fmu import build_fmu
+    build_fmu = build_fmu_module().build_fmu
 
     case = CASES["pitch"](args.steps)
     with tempfile.TemporaryDirectory(prefix="bench_win64_") as tmp:
@@ -107,11 +106,9 @@ def main() -> None:
         variants = dict(VARIANTS)
         if args.win64_numba:
             variants["--win64-numba (numba on both)"] = {"numba": True, "win64_numba": True}
-        if args.baseline:
-            from bench_fmu import build_baseline
-
-            variants = {"--no-numba, this tree": {"numba": False}, f"--no-numba, {args.baseline}": None}
-            baseline_fmu = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",), options=("--no-numba",))
+        if args.baseline_commit:
+            variants = {"--no-numba, this tree": {"numba": False}, f"--no-numba, version {args.baseline}": None}
+            baseline_fmu = build_baseline(args.baseline_commit, tmp, ("pitch_bearing",), options=("--no-numba",))
         for index, (name, variant) in enumerate(variants.items()):
             fmu = tmp / f"pitch_{index}.fmu"             # (one folder each: unpacked below)
             if variant is None:
@@ -141,7 +138,7 @@ def main() -> None:
                 for name in variants:
                     for platform, host in hosts.items():          # interleaved: Linux, wine, Linux, wine...
                         folder, refs = built[name]
-                        instantiation, steps, final = run(platform, host, folder, refs, inputs, case.parameters)
+                        instantiation, steps, final = run_host(platform, host, folder, refs, inputs, case.parameters)
                         starts[name, platform].append(instantiation)
                         times[name, platform].append(steps[WARM:])
                         finals[name, platform] = final
@@ -149,30 +146,28 @@ def main() -> None:
             for process in busy:
                 process.kill()
                 process.wait()
-    print(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU and platform, "
+    note(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU and platform, "
           "our C host (Linux: PATH=/usr/bin:/bin; win64: mingw build under wine 8)"
           + (f"; {args.busy} spinning processes beside the runs" if args.busy else ""))
     print_table("The FMU's halves: zipped / unpacked", ["FMU", "zipped", "Linux half", "win64 half",
                                                        "model files", "zipped without win64"], size_rows)
     rows = []
-    reference = list(variants)[-1] if args.baseline else list(variants)[0]      # the ratios' baseline
+    reference = list(variants)[-1] if args.baseline_commit else list(variants)[0]      # the ratios' baseline
     for name in variants:
         for platform in hosts:
-            t = np.concatenate(times[name, platform]) * 1e3
-            against = np.median(t) / np.median(np.concatenate(times[reference, platform]) * 1e3)
+            s = spread(np.concatenate(times[name, platform]) * 1e3)
+            record(f"{name} {platform} [ms]", s)
+            against = s["median"] / np.median(np.concatenate(times[reference, platform]) * 1e3)
             variant = variants[name] or {}
             rows.append([name, "Linux" if platform == "linux" else "win64 under wine", "numba" if
                          variant.get("win64_numba" if platform == "win64" else "numba") else "numpy",
-                         f"{np.median(starts[name, platform]):.2f} s", f"{np.median(t):.2f} ms",
-                         f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms", f"{against:.2f}"])
+                         f"{np.median(starts[name, platform]):.2f} s", f"{s['median']:.2f} ms",
+                         f"{s['p95']:.2f} ms", f"{s['p99']:.2f} ms", f"{against:.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",
                 ["FMU", "platform", "loops", "instantiation", "median", "95th pct", "99th pct",
                  f"median / {reference}'s on that platform"], rows)
     for name in variants:
         a, b = np.array(finals[name, "linux"]), np.array(finals[name, "win64"])
-        print(f"{name}: final outputs, win64 under wine against Linux: largest relative difference "
+        note(f"{name}: final outputs, win64 under wine against Linux: largest relative difference "
               f"{np.max(np.abs(a - b) / np.maximum(np.abs(a), 1e-300)):.1e}")
 
-
-if __name__ == "__main__":
-    main()

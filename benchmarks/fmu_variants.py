@@ -3,16 +3,15 @@
 Four builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0),
 all made in this run by this checkout's ``build_fmu.py``:
 
-- ``host + numba``: ``--runtime host``, the FMU as it was before the standalone runtime (issue
-  23): it runs in this machine's Python and venv, with numba and its shipped cache. The baseline.
+- ``host + numba``: ``--runtime host``, the FMU without a runtime of its own: it runs in this
+  machine's Python and venv, with numba and its shipped cache. The baseline.
 - ``standalone``: ``--no-numba``; it carries its Python and numpy, and runs the numpy loops.
 - ``standalone + numba``: the default; it also carries numba and llvmlite, and the compiled loops' cache.
-- ``standalone + aot``: ``--aot``; it carries the loops compiled ahead of time (``build_aot.py``)
+- ``standalone + aot``: ``--aot``; it carries the loops compiled ahead of time (``fmu_build/aot.py``)
   instead of numba, a module for an x86-64-v3 CPU and one for any x86-64, and takes the first this CPU
   runs: its cold build includes their compilation (the modules' cache emptied);
 - ``standalone + aot, generic``: the same FMU without its x86-64-v3 module (removed from the unpacked
-  folder), as a CPU without AVX2 or FMA runs it: the generic loops, which were the ``--aot`` FMU's only ones
-  before issue 31's twenty-ninth turn.
+  folder), as a CPU without AVX2 or FMA runs it: the generic loops.
 
 Each FMU is run by our C host (``tests/c_host/host.c``, scenario ``bench``) in the environment of
 a desktop session (``PATH=/usr/bin:/bin``, nothing else), as a user's C host would run it: a fresh
@@ -26,15 +25,13 @@ Build time: with the runtime staged anew (its cache emptied) and with the runtim
 superelement is cached in both (built before the timing). Instantiation: loading the binary,
 ``fmi2Instantiate``, the parameters and initialisation, in the C host.
 
-Run: .venv/bin/python benchmarks/bench_fmu_runtime.py [--steps 1000] [--runs 3]
+Run: .venv/bin/python -m benchmarks fmu_variants [--steps 1000] [--runs 3]
 """
 from __future__ import annotations
 
-import argparse
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 import zipfile
@@ -42,12 +39,10 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from cases import CASES  # noqa: E402
-from timing import print_table  # noqa: E402
+from .cases import CASES
+from .suite import ROOT, build_fmu_module, note, print_table, record, spread
 
-ROOT = Path(__file__).resolve().parents[1]
+RUNS = 3
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 VARIANTS = {"host + numba": {"runtime": "host", "numba": True},
@@ -71,19 +66,19 @@ def compile_host(folder: Path) -> Path:
 
 def build(variant: dict, output: Path, cold: bool) -> float:
     """Build the pitch FMU of ``variant``; seconds. ``cold``: the runtime staged anew."""
-    import build_runtime
-    from build_fmu import LINUX_BINARIES, build_fmu
+    build_fmu = build_fmu_module()
+    from fmu_build import runtime as build_runtime
 
     if cold and variant["runtime"] == "standalone":
-        key = build_runtime.runtime_key(variant["numba"], LINUX_BINARIES[2])
+        key = build_runtime.runtime_key(variant["numba"], build_fmu.LINUX_BINARIES[2])
         for f in build_runtime.runtime_cache_dir().glob(f"runtime-{key}.*"):
             f.unlink()
     if cold and variant.get("aot"):
-        import build_aot
+        from fmu_build import aot as build_aot
 
         shutil.rmtree(build_aot.aot_cache_dir() / build_aot.cache_key(), ignore_errors=True)
     start = time.perf_counter()
-    build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", output, **variant)
+    build_fmu.build_fmu(ROOT / "examples/bearings/pitch_bearing.toml", output, **variant)
     return time.perf_counter() - start
 
 
@@ -101,7 +96,7 @@ def bench_output(stdout: str) -> tuple[float, np.ndarray, list]:
     return instantiation, np.array(steps), final
 
 
-def run(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) -> tuple[float, np.ndarray, list]:
+def run_host(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) -> tuple[float, np.ndarray, list]:
     """One run of the C host: (instantiation s, step times s, final outputs)."""
     integers = sum((["--integer", str(refs[k]), str(v)] for k, v in parameters.items()), [])
     command = [str(host), str(folder), "SlewingBearing", refs["guid"], "bench",
@@ -113,11 +108,11 @@ def run(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) ->
     return bench_output(out.stdout)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--steps", type=int, default=1000)
-    parser.add_argument("--runs", type=int, default=3)
-    args = parser.parse_args()
+
+
+def main(args) -> None:
     from fmpy import read_model_description
 
     from slewing_model import load_bearing
@@ -155,28 +150,25 @@ def main() -> None:
         for r in range(args.runs):
             for name in VARIANTS:
                 folder, refs = built[name]
-                instantiation, steps, final = run(host, folder, refs, inputs, case.parameters)
+                instantiation, steps, final = run_host(host, folder, refs, inputs, case.parameters)
                 starts[name].append(instantiation)
                 times[name].append(steps[WARM:])
                 finals[name] = final
-    print(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU, "
+    note(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU, "
           f"C host, PATH=/usr/bin:/bin")
     print_table("FMU variants: size and build", ["FMU", "zipped", "unpacked", "build, runtime staged",
                                                    "build, runtime cached"], rows_build)
     base = np.median(np.concatenate(times[BASELINE]))
     rows = []
     for name in VARIANTS:
-        t = np.concatenate(times[name]) * 1e3
-        rows.append([name, f"{np.median(starts[name]):.2f} s", f"{np.median(t):.2f} ms",
-                     f"{np.percentile(t, 95):.2f} ms", f"{np.percentile(t, 99):.2f} ms",
-                     f"{np.median(t) / (base * 1e3):.2f}"])
+        s = spread(np.concatenate(times[name]) * 1e3)
+        record(f"{name} [ms]", s)
+        rows.append([name, f"{np.median(starts[name]):.2f} s", f"{s['median']:.2f} ms", f"{s['p95']:.2f} ms",
+                     f"{s['p99']:.2f} ms", f"{s['median'] / (base * 1e3):.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",
                 ["FMU", "instantiation", "median", "95th pct", "99th pct", f"median / {BASELINE}"], rows)
     reference = np.array(finals[BASELINE])
     for name, final in finals.items():
         deviation = np.max(np.abs(np.array(final) - reference) / np.maximum(np.abs(reference), 1e-300))
-        print(f"final outputs of {name}: largest relative difference to {BASELINE}: {deviation:.1e}")
+        note(f"final outputs of {name}: largest relative difference to {BASELINE}: {deviation:.1e}")
 
-
-if __name__ == "__main__":
-    main()

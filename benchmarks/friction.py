@@ -12,28 +12,27 @@ contact; a mix) it times, as medians of repeated runs in this process:
 * baseline 2, fine rule: the ball equilibrium solved and integrated on a
   48 x 8 rule (the accuracy reference of the relative difference column).
 
-Run: .venv/bin/python benchmarks/bench_friction.py
+``--runs``: the cold and warm evaluations timed (default 21); the per-ball loop and the fine rule,
+a seventh of them (at least 2).
+
+Run: .venv/bin/python -m benchmarks friction [--runs 21]
 """
 from __future__ import annotations
 
 import dataclasses
 import platform
-import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import median_time, print_table  # noqa: E402
+from .suite import ROOT, median_time, print_table
 
-from slewing_model import Loads, load_bearing, solve, synthetic_errors  # noqa: E402
-from slewing_model.friction import friction_torque  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[1]
+RUNS = 21
 
 
 def per_ball_loop(bearing, distribution):
     """Baseline: one call per loaded ball, the other balls unloaded."""
+    from slewing_model.friction import friction_torque
+
     total = 0.0
     for b in np.flatnonzero(distribution.contact_load.max(axis=1) > 0):
         q = np.zeros_like(distribution.contact_load)
@@ -43,7 +42,11 @@ def per_ball_loop(bearing, distribution):
     return total
 
 
-def main() -> None:
+def main(args) -> None:
+    from slewing_model import Loads, load_bearing, solve, synthetic_errors
+    from slewing_model.friction import friction_torque
+
+    few = max(2, args.runs // 7)
     table3 = load_bearing(ROOT / "examples/bearings/table3.toml")
     with_errors = table3.with_preload(10e-6).with_errors(synthetic_errors(table3.ball_count, seed=1))
     cases = [
@@ -59,12 +62,12 @@ def main() -> None:
         dist_next = solve(bearing, next_loads, psi=dpsi, rtol=1e-8)
         result = friction_torque(bearing, dist)
         step = friction_torque(bearing, dist_next, initial=result)
-        t_cold = median_time(lambda: friction_torque(bearing, dist), repeat=21)
-        t_warm = median_time(lambda: friction_torque(bearing, dist_next, initial=result), repeat=21)
-        t_loop = median_time(lambda: per_ball_loop(bearing, dist), repeat=3)
+        t_cold = median_time(lambda: friction_torque(bearing, dist), repeat=args.runs)
+        t_warm = median_time(lambda: friction_torque(bearing, dist_next, initial=result), repeat=args.runs)
+        t_loop = median_time(lambda: per_ball_loop(bearing, dist), repeat=few)
         fine = friction_torque(bearing, dist, quadrature=(48, 8), solve_quadrature=None)
         t_fine = median_time(lambda: friction_torque(bearing, dist, quadrature=(48, 8), solve_quadrature=None),
-                             repeat=3)
+                             repeat=few)
         loop_value = per_ball_loop(bearing, dist)
         assert abs(loop_value / result.contact_part - 1) < 1e-3, "per-ball loop must give the same torque"
         rows.append([
@@ -82,6 +85,3 @@ def main() -> None:
         rows,
     )
 
-
-if __name__ == "__main__":
-    main()

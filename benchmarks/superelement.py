@@ -1,29 +1,28 @@
-"""Speed and memory of the ring superelement build (issue 3), and the convergence studies of
+"""Speed and memory of the ring superelement build, and the convergence studies of
 docs/superelement.md.
 
-    .venv/bin/python benchmarks/bench_superelement.py             # benchmark table (~1.5 min)
-    .venv/bin/python benchmarks/bench_superelement.py --study     # + convergence and patch tables (~4 min)
+    .venv/bin/python -m benchmarks superelement             # benchmark table (~1.5 min)
+    .venv/bin/python -m benchmarks superelement --study     # + convergence and patch tables (~4 min)
 
 Benchmark: table1.toml (100 balls), both rings, free, no cache. Each build runs in a fresh
 process (so that its peak resident memory, ru_maxrss, is its own); the table gives the median
-of ``--repeat`` runs and the ratio to the coarse build measured in the same run. Goals on a
+of ``--runs`` runs and the ratio to the coarse build measured in the same run. Goals on a
 2-core machine: fine < 60 s, coarse < 10 s, peak memory < 4 GB.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import platform
 import statistics
 import subprocess
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+from .suite import ROOT, note, print_table, worker_command
+
+RUNS = 3
 TABLE1 = ROOT / "examples" / "bearings" / "table1.toml"
 GOALS = {"coarse": 10.0, "fine": 60.0}
 MEMORY_GOAL_GB = 4.0
@@ -49,7 +48,7 @@ def child(mesh: str) -> None:
 
 
 def run_child(mesh: str) -> dict:
-    out = subprocess.run([sys.executable, __file__, "--child", mesh], capture_output=True, text=True, check=True)
+    out = subprocess.run(worker_command("superelement", mesh), capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -67,9 +66,12 @@ def cache_hit_seconds() -> float:
         return time.perf_counter() - t0
 
 
+def worker_main(argv: list[str]) -> None:
+    """A worker process (:func:`run_child`): one build of mesh ``argv[0]``."""
+    child(argv[0])
+
+
 def benchmark(repeat: int) -> None:
-    print(f"# Superelement build, table1.toml (B = 100), both rings, free; median of {repeat} runs")
-    print(f"# {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}")
     results = {}
     for mesh in ("coarse", "fine"):
         runs = [run_child(mesh) for _ in range(repeat)]
@@ -77,17 +79,19 @@ def benchmark(repeat: int) -> None:
                          "peak_gb": max(r["peak_gb"] for r in runs), "dofs": runs[0]["dofs"],
                          "harmonics": runs[0]["harmonics"]}
     base = results["coarse"]["seconds"]
-    print()
-    print("| mesh | DOFs per ring (outer, inner) | harmonics | median time [s] | x coarse | peak memory [GB] | goal |")
-    print("|---|---|---|---|---|---|---|")
+    rows = []
     for mesh, r in results.items():
         ok = r["seconds"] < GOALS[mesh] and r["peak_gb"] < MEMORY_GOAL_GB
-        print(f"| {mesh} | {r['dofs'][0]}, {r['dofs'][1]} | {r['harmonics'][0]}, {r['harmonics'][1]} "
-              f"| {r['seconds']:.2f} | {r['seconds'] / base:.2f} | {r['peak_gb']:.2f} "
-              f"| < {GOALS[mesh]:.0f} s, < {MEMORY_GOAL_GB:.0f} GB: {'met' if ok else 'MISSED'} |")
-    print(f"| coarse, cache hit | | | {cache_hit_seconds():.3f} | | | |")
-    print()
-    print("Paper (ANSYS, 14 cores): coarse 10 s, fine 5 min.")
+        rows.append([mesh, f"{r['dofs'][0]}, {r['dofs'][1]}", f"{r['harmonics'][0]}, {r['harmonics'][1]}",
+                     f"{r['seconds']:.2f}", f"{r['seconds'] / base:.2f}", f"{r['peak_gb']:.2f}",
+                     f"< {GOALS[mesh]:.0f} s, < {MEMORY_GOAL_GB:.0f} GB: {'met' if ok else 'MISSED'}"])
+    rows.append(["coarse, cache hit", "", "", f"{cache_hit_seconds():.3f}", "", "", ""])
+    print_table(f"Superelement build, table1.toml (B = 100), both rings, free; median of {repeat} runs "
+                f"({platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
+                f"Python {platform.python_version()})",
+                ["mesh", "DOFs per ring (outer, inner)", "harmonics", "median time [s]", "x coarse",
+                 "peak memory [GB]", "goal"], rows)
+    note("Paper (ANSYS, 14 cores): coarse 10 s, fine 5 min.")
 
 
 # ---- studies -------------------------------------------------------------------------------------
@@ -117,14 +121,8 @@ def _entries(stiff) -> dict:
             "g10 n1n1": n1 @ g10 @ n1 * 1e9}
 
 
-def _row(label, entries, ref=None):
-    cells = []
-    for k, v in entries.items():
-        if ref is None:
-            cells.append(f"{v:.4f}")
-        else:
-            cells.append(f"{v:.4f} ({100 * (v / ref[k] - 1):+.2f} %)")
-    return f"| {label} | " + " | ".join(cells) + " |"
+def _cells(entries, ref, digits=2):
+    return [f"{v:.4f} ({100 * (v / ref[k] - 1):+.{digits}f} %)" for k, v in entries.items()]
 
 
 def study() -> None:
@@ -136,72 +134,57 @@ def study() -> None:
     ring, B = "outer", bearing.ball_count
     factors = (4, 8, 12, 16, 24)
     ns = [auto_harmonics(bearing, ring, f) for f in factors]
-    print("\n## Convergence, table1.toml, outer ring, free\n")
-    print("C0, C1: blocks 0 and 1 of the first block row of K, GN/m. Compliance entries in um/kN (1e-9 m/N): "
-          "G_k = block k of the first row of the ring's compliance (pseudo-inverse of K), along the contact-1 "
-          "normal n1 or the groove tangent t1 at contact 1; G0 - G1: the part of a ball's own compliance not "
-          "shared with its neighbour; g10: compliance of ball harmonic 10 (inverse of its 4x4 block) along n1.\n")
+    note("\nConvergence, table1.toml, outer ring, free. "
+         "C0, C1: blocks 0 and 1 of the first block row of K, GN/m. Compliance entries in um/kN (1e-9 m/N): "
+         "G_k = block k of the first row of the ring's compliance (pseudo-inverse of K), along the contact-1 "
+         "normal n1 or the groove tangent t1 at contact 1; G0 - G1: the part of a ball's own compliance not "
+         "shared with its neighbour; g10: compliance of ball harmonic 10 (inverse of its 4x4 block) along n1.")
     harm = {}
     for mesh in ("coarse", "fine", "finer"):
         t0 = time.perf_counter()
         harm[mesh] = ring_harmonics(bearing, ring, MESH_PRESETS[mesh], "free", max(ns), dict(DEFAULT_OPTIONS))
-        print(f"<!-- {mesh}: {harm[mesh].info['mesh']} solved {max(ns) + 1} harmonics in "
-              f"{time.perf_counter() - t0:.1f} s -->")
+        note(f"{mesh}: {harm[mesh].info['mesh']} solved {max(ns) + 1} harmonics in {time.perf_counter() - t0:.1f} s")
     ref = _entries(condense_ring(harm["finer"], B, max(ns))[0])
     keys = list(ref)
-    print("| mesh, harmonics N | " + " | ".join(keys) + " |")
-    print("|---|" + "---|" * len(keys))
+    rows = []
     for mesh in ("coarse", "fine", "finer"):
         for f, n in zip(factors, ns):
             label = f"{mesh}, N = {n} ({f} r/w)" + (" **default**" if f == 12 else "")
-            print(_row(label, _entries(condense_ring(harm[mesh], B, n)[0]), ref))
-    print(f"\nPercentages: against finer, N = {max(ns)}.")
+            rows.append([label, *_cells(_entries(condense_ring(harm[mesh], B, n)[0]), ref)])
+    print_table(f"Convergence, table1.toml, outer ring, free (percentages: against finer, N = {max(ns)})",
+                ["mesh, harmonics N", *keys], rows)
 
-    print("\n## Patch size and the Hertz part, table1.toml, outer ring, free, fine mesh\n")
-    print("| patch (x Hertz ellipse at 2.5 GPa) | half-space part | N | " + " | ".join(keys) + " |")
-    print("|---|---|---|" + "---|" * len(keys))
-    base = None
+    rows, base = [], None
     for scale in (1.0, 0.5, 2.0):
         opts = dict(DEFAULT_OPTIONS, patch_scale=scale)
         h = ring_harmonics(bearing, ring, MESH_PRESETS["fine"], "free", 2 * ns[2], opts)
         for subtract in (True, False):
             for n in (ns[2], 2 * ns[2]):
                 e = _entries(condense_ring(h, B, n, subtract_halfspace=subtract)[0])
-                if base is None:
-                    base = e
-                cells = " | ".join(f"{v:.4f} ({100 * (v / base[k] - 1):+.1f} %)" for k, v in e.items())
-                print(f"| {scale} | {'removed' if subtract else 'kept'} | {n} | {cells} |")
-    print("\nPercentages: against patch 1.0, half-space part removed, N = "
-          f"{ns[2]} (the default).")
+                base = base or e
+                rows.append([f"{scale}", "removed" if subtract else "kept", f"{n}", *_cells(e, base, 1)])
+    print_table("Patch size and the Hertz part, table1.toml, outer ring, free, fine mesh (percentages: against "
+                f"patch 1.0, half-space part removed, N = {ns[2]}, the default)",
+                ["patch (x Hertz ellipse at 2.5 GPa)", "half-space part", "N", *keys], rows)
 
-    print("\n## Compliance floor, table1.toml, outer ring, free, fine mesh, N default\n")
-    print("| floor (x half-space compliance of the patch) | " + " | ".join(keys) + " |")
-    print("|---|" + "---|" * len(keys))
-    base = None
+    rows, base = [], None
     for eps in (0.05, 0.02, 0.1, 0.2):
         h = ring_harmonics(bearing, ring, MESH_PRESETS["fine"], "free", ns[2],
                            dict(DEFAULT_OPTIONS, compliance_floor=eps))
         e = _entries(condense_ring(h, B)[0])
         base = base or e
-        cells = " | ".join(f"{v:.4f} ({100 * (v / base[k] - 1):+.1f} %)" for k, v in e.items())
-        print(f"| {eps} | {cells} |")
+        rows.append([f"{eps}", *_cells(e, base, 1)])
+    print_table("Compliance floor, table1.toml, outer ring, free, fine mesh, N default",
+                ["floor (x half-space compliance of the patch)", *keys], rows)
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--repeat", type=int, default=3, help="runs per mesh (median), default 3")
-    p.add_argument("--study", action="store_true", help="also print the convergence and patch-size tables")
-    p.add_argument("--no-bench", action="store_true", help="skip the timing table")
-    p.add_argument("--child", help=argparse.SUPPRESS)
-    args = p.parse_args()
-    if args.child:
-        child(args.child)
-        return
+def add_arguments(parser) -> None:
+    parser.add_argument("--study", action="store_true", help="also the convergence and patch-size tables")
+    parser.add_argument("--no-bench", action="store_true", help="skip the timing table")
+
+
+def main(args) -> None:
     if not args.no_bench:
-        benchmark(args.repeat)
+        benchmark(args.runs)
     if args.study:
         study()
-
-
-if __name__ == "__main__":
-    main()

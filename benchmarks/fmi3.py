@@ -8,11 +8,10 @@ step is: set the 7 inputs, ``doStep`` (10 ms). "doStep" times the call alone; "s
 adds reading every per-ball result (FMI 2.0: 8 B = 1200 scalars by value reference; FMI 3.0: the
 three arrays). The ratio column is FMI 3.0 / FMI 2.0; the goal is a doStep ratio of at most 1.10.
 
-Run: .venv/bin/python benchmarks/bench_fmi3.py [--steps 1000] [--rigid] [--bearing pitch_bearing]
+Run: .venv/bin/python -m benchmarks fmi3 [--steps 1000] [--rigid] [--bearing pitch_bearing] [--mesh fine]
 """
 from __future__ import annotations
 
-import argparse
 import math
 import shutil
 import sys
@@ -22,12 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import print_table  # noqa: E402
+from .suite import ROOT, build_fmu_module, note, print_table, record, spread
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "fmu_src"))
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 DT = 0.01
 
@@ -57,9 +52,11 @@ def _instances(fmu2: Path, fmu3: Path, ring_model: int):
     return f2, f3, refs2, refs3, dirs
 
 
-def run(fmu2: Path, fmu3: Path, steps: int, ring_model: int) -> dict:
+def step_both(fmu2: Path, fmu3: Path, steps: int, ring_model: int) -> dict:
     """Times (s) of doStep and of a step with the per-ball results read, per FMU; and the largest
     relative difference of the friction torque between them (a check that both did the same work)."""
+    if str(ROOT / "fmu_src") not in sys.path:
+        sys.path.insert(0, str(ROOT / "fmu_src"))
     from bearing_variables import BALL_ARRAYS
     from slewing_drives import LoadSeries
 
@@ -102,21 +99,22 @@ def run(fmu2: Path, fmu3: Path, steps: int, ring_model: int) -> dict:
     return times
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--steps", type=int, default=1000)
     parser.add_argument("--rigid", action="store_true", help="rigid rings instead of flexible rings")
     parser.add_argument("--bearing", default="pitch_bearing", help="a definition of examples/bearings")
     parser.add_argument("--mesh", choices=("coarse", "fine"), default="fine")
-    args = parser.parse_args(argv)
-    from build_fmu import build_fmu
+
+
+def main(args) -> None:
+    build_fmu = build_fmu_module().build_fmu
 
     with tempfile.TemporaryDirectory(prefix="bench_fmi3_") as tmp:
         tmp = Path(tmp)
         definition = ROOT / "examples" / "bearings" / f"{args.bearing}.toml"
         fmu2 = build_fmu(definition, tmp / "fmi2.fmu", mesh=args.mesh)
         fmu3 = build_fmu(definition, tmp / "fmi3.fmu", mesh=args.mesh, fmi_version=3)
-        times = run(fmu2, fmu3, args.steps, ring_model=1 if args.rigid else 2)
+        times = step_both(fmu2, fmu3, args.steps, ring_model=1 if args.rigid else 2)
     rows = []
     for label, key in (("doStep", "do"), ("step + per-ball results", "all")):
         a, b = times[f"{key}2"] * 1e3, times[f"{key}3"] * 1e3
@@ -127,11 +125,9 @@ def main(argv=None) -> int:
     print_table(f"{args.bearing}, {rings} rings, {args.mesh} superelement, {args.steps} steps of 10 ms, "
                 f"FMI 2.0 and FMI 3.0 alternating (ms)",
                 ["what", "statistic", "FMI 2.0", "FMI 3.0", "ratio 3.0/2.0"], rows)
-    print(f"\nlargest relative difference of friction_torque between the two: {times['friction_difference']:.1e}")
+    for key in ("do2", "do3", "all2", "all3"):
+        record(f"{key} [ms]", spread(times[key] * 1e3))
+    note(f"\nlargest relative difference of friction_torque between the two: {times['friction_difference']:.1e}")
     ratio = np.median(times["do3"]) / np.median(times["do2"])
-    print(f"goal: median doStep ratio <= 1.10: {'met' if ratio <= 1.10 else 'NOT met'} ({ratio:.3f})")
-    return 0
+    note(f"goal: median doStep ratio <= 1.10: {'met' if ratio <= 1.10 else 'NOT met'} ({ratio:.3f})")
 
-
-if __name__ == "__main__":
-    sys.exit(main())

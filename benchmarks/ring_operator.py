@@ -2,7 +2,7 @@
 
 A fresh operator ``W^-1 = (A^-1 + M)_aa^-1`` is what sets the tail of a co-simulation step
 (`docs/speed.md`). This takes the operators ``W`` the simulator forms while stepping the
-benchmark cases (`benchmarks/cases.py`: the pitch and yaw bearings, fine superelement) and
+benchmark cases (``benchmarks/cases.py``: the pitch and yaw bearings, fine superelement) and
 inverts each by :func:`slewing_model.rings.reduced_operator.spd_inverse` (Schur complements,
 matrix products) and by ``np.linalg.inv`` (LU, then triangular solves), alternately, on one
 BLAS thread as in a step; it prints the median and tail of each, their ratio, and the
@@ -16,31 +16,29 @@ inversion of the whole: where the kernel hands bordering to numpy
 
 With ``--stages``: the time of each stage a bounded step counts in floating-point operations
 (:data:`slewing_model.distribution.bime.BOUNDED_WORK`): forming ``W`` from the pitch bearing's
-operators of 160-600 rows (the loads of ``bench_realtime.py``'s reversal scenario) and each stage of its
+operators of 160-600 rows (the loads of the ``realtime`` benchmark's reversal scenario) and each stage of its
 inverse (:data:`slewing_model.rings.reduced_operator.STAGES`), against the work counted for it
 (:func:`~slewing_model.rings.reduced_operator.forming_work`,
 :func:`~slewing_model.rings.reduced_operator.stage_work`): what ``BOUNDED_WORK`` is in time here.
 
-Run: .venv/bin/python benchmarks/bench_operator.py [--runs 30] [--border | --stages [--method 0|1|2]]
+Run: .venv/bin/python -m benchmarks operator [--runs 30] [--border | --stages [--method 0|1|2]]
 """
 from __future__ import annotations
 
-import argparse
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cases import CASES  # noqa: E402
-from timing import print_table  # noqa: E402
+import slewing_model.rings.reduced_operator as reduced_operator
+from slewing_model import Loads, load_bearing
+from slewing_model.numerics.blas import blas_threads
+from slewing_model.rings.superelement import build_superelement
+from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
 
-import slewing_model.rings.reduced_operator as reduced_operator  # noqa: E402
-from slewing_model import Loads, load_bearing  # noqa: E402
-from slewing_model.numerics.blas import blas_threads  # noqa: E402
-from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings  # noqa: E402
-from slewing_model.rings.superelement import build_superelement  # noqa: E402
+from .cases import CASES
+from .suite import print_table
+
+RUNS = 30
 
 
 def formed_operators(case_name: str, steps: int) -> list[np.ndarray]:
@@ -162,16 +160,16 @@ def stages(runs: int, method: int = 0) -> None:
                 ["rows", "stage", "time [ms]", "counted work [M]", "counted per ms [M]"], rows)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--runs", type=int, default=30, help="inversions of each operator by each method")
+def add_arguments(parser) -> None:
     parser.add_argument("--steps", type=int, default=200, help="steps of each case that form the operators")
     parser.add_argument("--border", action="store_true", help="time bordering instead (compiled against numpy)")
     parser.add_argument("--stages", action="store_true", help="time forming W and each stage of its inverse instead")
     parser.add_argument("--method", type=int, default=0, choices=(0, 1, 2),
                         help="with --stages: the stages of a PendingOperator of this method (1 and 2: through the "
                              "Cholesky factor, FACTOR_STAGES, in single and in double precision)")
-    args = parser.parse_args()
+
+
+def main(args) -> None:
     if args.border:
         return bordering(args.runs)
     if args.stages:
@@ -206,6 +204,3 @@ def main() -> None:
                 ["case", "operators", "method", "median", "95th pct", "99th pct", "ratio to lapack",
                  "max |X W - I|"], rows)
 
-
-if __name__ == "__main__":
-    main()

@@ -1,5 +1,5 @@
 """The pitch bearing FMU against a real-time clock: median, tail and slowest step under the loads
-that make a step slow (issue 31).
+that make a step slow.
 
 Five scenarios, each on the pitch bearing (`examples/bearings/pitch_bearing.toml`, flexible rings,
 friction and life on: the FMU's defaults) with its loads in the blade-root frame (``load_frame`` 2):
@@ -14,11 +14,11 @@ friction and life on: the FMU's defaults) with its loads in the blade-root frame
 Three versions: this tree's FMU as built (``step_work`` = 1, complete: every step solved to the
 tolerance), the same FMU with ``step_work`` = 2 (bounded: a step's work capped, what it could not do
 carried over and flagged by ``equilibrium_residual`` above the tolerance; the table counts those
-steps), and a baseline revision's (built by that revision's own build_fmu.py). Each runs in a
-worker process of its own through fmpy (``bench_fmu.Worker``); their runs of each scenario
-alternate in blocks, so all see the same machine load. On this machine a step whose memory was not
-touched for a second or more takes 8-40 ms of CPU time, not 1 (docs/speed.md, issue 31's nineteenth
-turn), and a worker waits while the others run, so each block after a worker's first starts
+steps), and a released version's (``--baseline VERSION``, built by that version's own build_fmu.py).
+Each runs in a worker process of its own through fmpy (:class:`benchmarks.fmu.Worker`); their runs of
+each scenario alternate in blocks (``--runs``), so all see the same machine load. On a shared machine a
+step whose memory was not touched for a second or more can take 8-40 ms of CPU time, not 1
+(docs/speed.md), and a worker waits while the others run, so each block after a worker's first starts
 with its first step made once and rolled back (``rewarm``), and each worker's first block follows its
 instantiation at once. A step is ``setReal`` of the 7 inputs,
 ``doStep`` (10 ms) and ``getReal`` of 5 outputs. "first step" is the first ``doStep`` after
@@ -28,7 +28,7 @@ has them solved (completely) when the FMU leaves initialization: a second instan
 starts so ("instantiation, inputs at initialization": instantiation and that solve), and the
 slowest of its first 10 steps is reported against the scenario's median.
 
-Goals of issue 31, printed beside the figures: median at most 0.45 of the baseline's, the slowest
+The goals, printed beside the figures: median at most 0.45 of the baseline's, the slowest
 step at most 4 times the NREL median (and how many steps, after the first, were slower than that: one
 step held up by the machine shows in the slowest, not in that count), the first step at most 10 times
 the median. A step whose inputs are the last step's is answered at once (``BearingSimulator.step``):
@@ -36,12 +36,11 @@ the reversal, jump and feather scenarios hold their inputs most of the time, so 
 held step's; the table also gives the median of the steps whose inputs moved ("moving steps", the
 solver's work) against the baseline's over the same steps, and the first step against the NREL median.
 
-Run: .venv/bin/python benchmarks/bench_realtime.py [--baseline REV|none] [--blocks 4]
+Run: .venv/bin/python -m benchmarks realtime [--baseline VERSION|none] [--runs 4]
      [--scenarios nrel reversal ...]
 """
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import tempfile
@@ -49,17 +48,16 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_fmu import OUTPUTS, Worker, build_baseline  # noqa: E402
-from cases import DT, Case, save  # noqa: E402
-from timing import print_table  # noqa: E402
+from .cases import DT, Case, save
+from .fmu import OUTPUTS, Worker
+from .suite import DEFAULT_BASELINE, ROOT, build_baseline, build_fmu_module, print_table, record, spread
 
-ROOT = Path(__file__).resolve().parents[1]
+#: alternating blocks per scenario and FMU (``--runs``)
+RUNS = 4
+BASELINE = DEFAULT_BASELINE
 OPENFAST = ROOT.parent / "shared/data/openfast/NREL5MW_Land_FASTv8_CertTest18_turb12mps_60s.outb"
 BEARING = ROOT / "examples/bearings/pitch_bearing.toml"
 PARAMETERS = {"ring_model": 2, "load_frame": 2}
-#: the revision before issue 31's work (main at the start of that turn)
-DEFAULT_BASELINE = "f1ef800"
 SCENARIOS = ("nrel", "reversal", "jump", "feather", "turbulence")
 #: the FMU's default tolerance: a step whose equilibrium_residual is above it was stopped by step_work = 2
 TOLERANCE = 1e-7
@@ -108,65 +106,23 @@ def scenario(name: str, duration: float = 20.0) -> Case:
     raise ValueError(f"scenario {name!r}: must be one of {', '.join(SCENARIOS)}")
 
 
-def step_variants(name: str, step_work: str, variants: list[dict], start_values: bool = False) -> list[dict]:
-    """The scenario ``name`` stepped through one library simulator per variant (the pitch bearing, flexible
-    rings, compiled kernels, friction and life on), each variant a set of the load distribution's module
-    constants (``{"BOUNDED_WORK": 8e7}``, :mod:`slewing_model.distribution.bime`) set before each of its
-    steps, the order of the variants reversed every other step so that all see the same machine load.
-    ``start_values``: each simulator first solves zero loads, as an FMU leaving initialization with its
-    start values. Per variant: the step times [ms], the steps flagged and each step's Newton iterations."""
-    import time
-
-    from slewing_model import Loads, load_bearing
-    from slewing_model.distribution import bime
-    from slewing_model.rings.superelement import build_superelement
-    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
-
-    case = scenario(name)
-    bearing = load_bearing(case.bearing)
-    superelement = build_superelement(bearing, mesh="fine", progress=False)
-    settings = SimulatorSettings(ring_model="flexible", load_frame="rotating", life=True, step_work=step_work,
-                                 contact_kernel="auto")
-    sims = [BearingSimulator(bearing, superelement, settings) for _ in variants]
-    if start_values:
-        for sim in sims:
-            sim.step(Loads(), 0.0, 0.0)
-    found = [{"times": [], "flagged": 0, "iterations": []} for _ in variants]
-    defaults = {key: getattr(bime, key) for variant in variants for key in variant}
-    try:
-        for k in range(case.steps):
-            for i in (range(len(variants)) if k % 2 else reversed(range(len(variants)))):
-                for key, value in {**defaults, **variants[i]}.items():      # a variant without a key: its default
-                    setattr(bime, key, value)
-                start = time.perf_counter()
-                out = sims[i].step(Loads(*case.loads[k]), float(case.psi[k]), float(case.omega[k]))
-                found[i]["times"].append(1e3 * (time.perf_counter() - start))
-                found[i]["flagged"] += not out.distribution.converged
-                found[i]["iterations"].append(out.distribution.iterations)
-    finally:
-        for key, value in defaults.items():
-            setattr(bime, key, value)
-    return found
-
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--baseline", default=DEFAULT_BASELINE, help="git revision of the baseline FMU, or 'none'")
-    parser.add_argument("--blocks", type=int, default=4, help="alternating blocks per scenario and FMU")
+def add_arguments(parser) -> None:
     parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), choices=SCENARIOS)
-    args = parser.parse_args()
+
+
+def main(args) -> None:
     if not OPENFAST.exists():
         sys.exit(f"the NREL 5MW file is not here: {OPENFAST} (../shared/data/openfast, see its README)")
-    sys.path.insert(0, str(ROOT))
-    from build_fmu import build_fmu
+    build_fmu = build_fmu_module().build_fmu
+    args.blocks = args.runs
 
     with tempfile.TemporaryDirectory(prefix="bench_realtime_") as tmp:
         tmp = Path(tmp)
         current = Path(build_fmu(BEARING, tmp / "current.fmu"))
         fmus = {"complete": current, "bounded": current}
         integers = {"bounded": {"step_work": 2}}
-        if args.baseline != "none":
-            fmus["baseline"] = build_baseline(args.baseline, tmp, bearings=("pitch_bearing",))["pitch_bearing"]
+        if args.baseline_commit:
+            fmus["baseline"] = build_baseline(args.baseline_commit, tmp, ("pitch_bearing",))["pitch_bearing"]
         rows, medians, all_times = [], {}, {}
         for name in args.scenarios:
             case = scenario(name)
@@ -205,6 +161,9 @@ def main() -> None:
                 medians[name, v] = float(np.median(t))
                 medians[name, v, "moving"] = float(np.median(t[moved]))
                 all_times[name, v] = t
+                record(f"{name} {v} [ms]", {**spread(t), "first": first[v] * 1e3,
+                                            "moving median": medians[name, v, "moving"],
+                                            "flagged": None if v == "baseline" else flagged[v]})
                 initialization, early = started[v][0], np.array(started[v][1]) * 1e3
                 rows.append([name, v, f"{first[v] * 1e3:.1f}", f"{np.median(t):.2f}", f"{np.percentile(t, 99):.2f}",
                              f"{t.max():.1f}", f"{first[v] * 1e3 / np.median(t):.0f}",
@@ -224,7 +183,7 @@ def main() -> None:
                     f"{float(row[2]) / nrel_median:.1f}", str(over)]
         print_table("Pitch bearing FMU through fmpy (flexible rings, friction and life on), one step = setReal + "
                     f"doStep ({DT * 1e3:.0f} ms) + getReal; {args.blocks} alternating blocks per scenario; "
-                    f"baseline {args.baseline}",
+                    f"baseline: {f'{args.baseline} ({args.baseline_commit[:9]})' if args.baseline_commit else 'none'}",
                     ["scenario", "version", "first step [ms]", "median [ms]", "p99 [ms]", "slowest [ms]",
                      "first / median", "instantiation, inputs at initialization [s]", "its first step [ms]",
                      f"slowest of its first {START_STEPS} [ms]", f"slowest of first {START_STEPS} / median",
@@ -233,6 +192,3 @@ def main() -> None:
                      "steps over 4 NREL medians"],
                     rows)
 
-
-if __name__ == "__main__":
-    main()

@@ -1,7 +1,7 @@
-"""How slow this machine makes a step whose work never changes: the floor under issue 31's slowest-step goal.
+"""How slow this machine makes a step whose work never changes: the floor under the slowest-step goal.
 
-Issue 31 asks that a bounded step never take more than 4 times the NREL median, measured as the slowest of
-the scenario's steps (``bench_realtime.py``: 6000 NREL steps, 2000 of the others). A step's time is its
+The goal is that a bounded step never takes more than 4 times the NREL median, measured as the slowest of
+the scenario's steps (``realtime``: 6000 NREL steps, 2000 of the others). A step's time is its
 work plus whatever the machine does to it meanwhile: another process on the core, an interrupt, the
 shared host's caches. This times a compiled loop whose work is the same every call (square roots of
 the same numbers), sized to about one NREL median of the pitch bearing FMU (``--us``), called as often
@@ -9,20 +9,18 @@ as the scenario has steps, several runs: the spread it shows is the machine's al
 call passes 4 medians, the slowest-step goal cannot be told from the machine's noise here, whatever the
 step does.
 
-Run: .venv/bin/python benchmarks/bench_machine_noise.py [--us 600] [--steps 6000] [--runs 5]
+Run: .venv/bin/python -m benchmarks machine_noise [--us 600] [--steps 6000] [--runs 5]
 """
 from __future__ import annotations
 
-import argparse
-import sys
 import time
-from pathlib import Path
 
 import numba
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import print_table  # noqa: E402
+from .suite import print_table
+
+RUNS = 5
 
 #: the goal's factor: the slowest step against the NREL median
 GOAL = 4.0
@@ -51,12 +49,12 @@ def _timed(values: np.ndarray, passes: int) -> float:
     return time.perf_counter() - start
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
     parser.add_argument("--us", type=float, default=600.0, help="the work of a call, microseconds (an NREL median)")
     parser.add_argument("--steps", type=int, default=6000, help="calls a run (the NREL scenario's steps)")
-    parser.add_argument("--runs", type=int, default=5)
-    args = parser.parse_args()
+
+
+def main(args) -> None:
     values = np.random.default_rng(0).random(2000)
     passes = passes_for(values, args.us)
     rows = []
@@ -71,6 +69,3 @@ def main() -> None:
                 ["run", "median [ms]", "p99 / median", "p99.9 / median", "slowest / median",
                  f"calls over {GOAL:g} medians", f"slowest within {GOAL:g} medians"], rows)
 
-
-if __name__ == "__main__":
-    main()
