@@ -189,7 +189,7 @@ poisson_ratio = 0.25
 @pytest.mark.parametrize("text, key, rule", [
     (TUBE + "length = 3.0\n", "connection.outer.length", "unknown key in table [connection.outer]"),
     (TUBE.replace('type = "tube"', 'type = "pipe"'), "connection.outer.type", "must be one of 'tube', 'plate'"),
-    (TUBE.replace("length_mm = 500.0\n", ""), "connection.outer.length_mm", "missing key"),
+    (TUBE.replace("length_mm = 500.0\n", ""), "[connection.outer]", "missing key `length_mm`"),
     (TUBE.replace("length_mm = 500.0", "length_mm = -5.0"), "connection.outer.length_mm", "must be > 0"),
     (TUBE.replace("inner_diameter_mm = 1510.0", "inner_diameter_mm = 1700.0").replace("1630.0", "1800.0"),
      "connection.outer.inner_diameter_mm", "must overlap the outer ring's bolted face"),
@@ -199,7 +199,7 @@ poisson_ratio = 0.25
     ("\n[connection]\nouter_ring = 1\n", "connection.outer_ring", "unknown key in table [connection]"),
     ("\n[connection.outer]\ntype = \"plate\"\ninner_diameter_mm = 1510.0\nouter_diameter_mm = 1700.0\n"
      "thickness_mm = 50.0\nyoungs_modulus_gpa = 200.0\npoisson_ratio = 0.3\n",
-     "connection.outer.clamped_edge", "missing key"),
+     "[connection.outer]", "missing key `clamped_edge`"),
     ("\n[connection.outer]\ntype = \"matrix\"\nformat = \"calculix\"\nfile = \"nothere.mtx\"\n"
      "nodes_csv = \"n.csv\"\nstiffness_unit = \"N/mm\"\n", "connection.outer.file", "no such file"),
     ("\n[connection.outer]\ntype = \"matrix\"\nformat = \"abaqus\"\n", "connection.outer.format",

@@ -1,6 +1,7 @@
 """Bearing definition files: every rejection rule names the key, the value and the rule."""
 import copy
 import math
+import tomllib
 
 import numpy as np
 import pytest
@@ -88,10 +89,69 @@ def test_bad_value_is_refused_naming_key_value_and_rule(table, key, value, rule)
     with pytest.raises(BearingDefinitionError) as info:
         bearing_from_dict(_with(table, key, value))
     message = str(info.value)
-    assert message.startswith(f"{table}.{key}") or message.startswith(f"{table}.") and key in message
+    if value is _DELETE:     # TOML has no null: the message names the table and the absent key
+        assert message.startswith(f"[{table}]: ") and f"missing key `{key}`" in message, message
+    else:
+        assert message.startswith(f"{table}.{key}") or message.startswith(f"{table}.") and key in message
     assert rule.replace("\\", "") in message or __import__("re").search(rule, message)
     if value is not _DELETE and not isinstance(value, list):
-        assert repr(value) in message or str(value) in message
+        assert _spelt_value(message) == value or math.isnan(value) and math.isnan(_spelt_value(message))
+
+
+def _spelt_value(message):
+    """The value a message ``key = value: rule`` quotes, read back as TOML (fails on a Python spelling
+    such as True, None or 'text' with a quote inside)."""
+    assert " = " in message, message
+    spelt = message.split(" = ", 1)[1]
+    for end in range(len(spelt), 0, -1):      # the longest prefix that is a TOML value followed by ": "
+        if spelt[end:].startswith(": "):
+            try:
+                return tomllib.loads(f"v = {spelt[:end]}")["v"]
+            except tomllib.TOMLDecodeError:
+                continue
+    raise AssertionError(f"no TOML value in {message!r}")
+
+
+@pytest.mark.parametrize("table,key,value", [
+    ("bearing", "ball_count", True),
+    ("bearing", "pitch_diameter_mm", False),
+    ("bearing", "moving_ring", True),
+    ("bearing", "groove_radius_mm", [13.25, True]),
+    ("bearing", "ball_diameter_mm", {"value": 25.0, "unit": "mm"}),
+    ("bearing", "moving_ring", "it's \"inner\""),
+    ("rings", "inner_ring_bolted_face", ["lower"]),
+    ("material", "poisson_ratio", float("inf")),
+])
+def test_refused_value_is_quoted_as_toml(table, key, value):
+    # the value in the message reads back (as TOML) to what the file held: true, not True
+    with pytest.raises(BearingDefinitionError) as info:
+        bearing_from_dict(_with(table, key, value))
+    assert _spelt_value(str(info.value)) == value, str(info.value)
+
+
+def test_misspelt_subtable_is_named_as_a_table(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(BEARING_TOML + "\n[connection.outter]\ntype = 'tube'\ninner_diameter_mm = 560.0\n")
+    with pytest.raises(BearingDefinitionError) as info:
+        load_bearing(p)
+    message = str(info.value)
+    assert "unknown table [connection.outter]" in message and "known: inner, outer" in message, message
+    assert "{" not in message and "560" not in message, message      # not the table's content
+
+
+def test_missing_key_of_a_subtable_is_named(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(BEARING_TOML + "\n[connection.outer]\ntype = 'tube'\ninner_diameter_mm = 560.0\n"
+                 "outer_diameter_mm = 620.0\nyoungs_modulus_gpa = 210.0\npoisson_ratio = 0.3\n")
+    with pytest.raises(BearingDefinitionError) as info:
+        load_bearing(p)
+    message = str(info.value)
+    assert "[connection.outer]: missing key `length_mm`" in message and "None" not in message, message
+
+
+BEARING_TOML = "\n".join(f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"'
+                         for k, v in GOOD["bearing"].items())
+BEARING_TOML = "[bearing]\n" + BEARING_TOML + "\n"
 
 
 def test_missing_bearing_table_is_refused():

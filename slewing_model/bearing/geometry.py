@@ -51,13 +51,13 @@ class RingSection:
 
     Attributes
     ----------
-    inner_radius, outer_radius : float, m
-        Radial extent of the ring.
-    height : float, m
-        Axial extent, centred on the ball plane z = 0.
-    bolted_face : str
-        ``"lower"`` (z = -height/2) or ``"upper"`` face, the one bolted to the
-        support for the ``clamped`` and ``frictionless`` boundary conditions.
+    inner_radius, outer_radius : float
+        Radial extent of the ring: radius of its bore and of its outer face, m.
+    height : float
+        Axial extent, centred on the ball plane z = 0, m.
+    bolted_face : {"lower", "upper"}
+        The face bolted to the support for the ``clamped`` and ``frictionless``
+        boundary conditions: ``"lower"`` (z = -height/2) or ``"upper"``.
     """
 
     inner_radius: float
@@ -70,34 +70,51 @@ class RingSection:
 class Bearing:
     """Nominal definition of a four-point contact slewing bearing, SI units.
 
+    Frozen: build one with :func:`load_bearing` (TOML file) or
+    :func:`bearing_from_dict`, change it with :meth:`with_preload`,
+    :meth:`with_errors` and :meth:`with_connection`.
+
     Attributes
     ----------
     name : str
-    pitch_diameter : float, m
-        ``dm``, diameter of the circle through the ball centres.
-    ball_diameter : float, m
-        Nominal ball diameter ``Dw_nom`` (without preload).
-    groove_radius : ndarray (4,), m
-        Raceway (groove) radius ``Rc`` of contacts 1..4.
-    contact_angle : float, rad
-        Initial (nominal) contact angle.
+        Name of the bearing (``"bearing"`` when the file gives none).
+    pitch_diameter : float
+        ``dm``, diameter of the circle through the ball centres, m.
+    ball_diameter : float
+        Nominal ball diameter ``Dw_nom`` (without preload), m.
+    groove_radius : ndarray, shape (4,)
+        Raceway (groove) radius ``Rc`` of contacts 1..4, m.
+    contact_angle : float
+        Initial (nominal) contact angle, rad.
     ball_count : int
-        ``B``.
-    preload : float, m
-        Ball oversize ``delta_P`` (paper eq 5); negative for clearance.
-    youngs_modulus : float, Pa
-    poisson_ratio : float
-    moving_ring : str
-        ``"inner"`` or ``"outer"``: the ring the loads act on.
-    first_ball_angle : float, rad
-        ``phi_0``.
+        Number of balls ``B``.
+    preload : float, default 0.0
+        Ball oversize ``delta_P`` (paper eq 5), m; negative for clearance.
+    youngs_modulus : float, default 200e9
+        Young's modulus of balls and rings, Pa.
+    poisson_ratio : float, default 0.3
+        Poisson's ratio of balls and rings.
+    moving_ring : {"inner", "outer"}
+        The ring the loads act on (default ``"inner"``).
+    first_ball_angle : float, default 0.0
+        Angular position ``phi_0`` of ball 0, rad.
     outer_section, inner_section : RingSection
         Ring cross-sections (documented defaults when the file gives none).
     errors : ManufacturingErrors or None
         Measured or synthetic manufacturing errors; None for the nominal bearing.
     connection : dict or None
         ``{"outer": ..., "inner": ...}`` (either or both): what each ring's bolted face is bolted
-        to (:mod:`.connection`, issue 29); None or {}: nothing (the superelement's ``bc`` applies).
+        to (an adapter or an imported stiffness); None or ``{}``: nothing (the superelement's
+        boundary condition applies).
+    source : dict
+        The definition as read (TOML tables), kept for reference; not compared.
+
+    Examples
+    --------
+    >>> from slewing_model import load_bearing
+    >>> b = load_bearing("examples/bearings/table1.toml")
+    >>> b.ball_count, b.osculation.shape
+    (100, (4,))
     """
 
     name: str
@@ -120,7 +137,7 @@ class Bearing:
     # ---- derived quantities -------------------------------------------------
     @property
     def osculation(self) -> np.ndarray:
-        """Osculation ratio ``s = Dw / (2 Rc)`` of contacts 1..4 (paper eq 10)."""
+        """Osculation ratio ``s = Dw / (2 Rc)`` of contacts 1..4 (paper eq 10), shape (4,)."""
         return self.ball_diameter / (2.0 * self.groove_radius)
 
     @functools.cached_property
@@ -148,10 +165,22 @@ class Bearing:
         return _read_only(centre - offset[:, None] * self.contact_normals)
 
     def groove_edge_angle(self, contact: int) -> float:
-        """Angle, seen from the groove centre, at which the raceway arc of
-        ``contact`` (1..4) meets the ring's land (face towards the other ring), rad.
+        """Angle at which the raceway arc of a contact meets the ring's land.
 
-        A contact ellipse that reaches past this angle is truncated."""
+        A contact ellipse that reaches past this angle is truncated.
+
+        Parameters
+        ----------
+        contact : int
+            Contact number, 1..4.
+
+        Returns
+        -------
+        float
+            Angle, seen from the groove centre and measured from the radial direction as
+            the contact angle is, at which the raceway meets the land (the face towards the
+            other ring), rad.
+        """
         i = contact - 1
         ring = self.outer_section if contact in RING_CONTACTS["outer"] else self.inner_section
         o_r = self.groove_centres[i, 0]
@@ -160,17 +189,62 @@ class Bearing:
         return math.acos(min(cos_edge, 1.0))
 
     def with_preload(self, preload: float) -> "Bearing":
-        """A copy with another ball preload (m)."""
+        """A copy with another ball preload.
+
+        Parameters
+        ----------
+        preload : float
+            Ball oversize, m; negative for clearance. Its magnitude must be below
+            10 % of the ball diameter.
+
+        Returns
+        -------
+        Bearing
+            The new definition.
+
+        Raises
+        ------
+        BearingDefinitionError
+            If the preload is not finite or too large.
+        """
         _check_preload(preload, self.ball_diameter, "preload")
         return _replace(self, preload=float(preload))
 
     def with_errors(self, errors) -> "Bearing":
-        """A copy carrying these manufacturing errors (None: nominal bearing)."""
+        """A copy carrying these manufacturing errors.
+
+        Parameters
+        ----------
+        errors : ManufacturingErrors or None
+            The errors; None for the nominal bearing.
+
+        Returns
+        -------
+        Bearing
+            The new definition.
+        """
         return _replace(self, errors=errors)
 
     def with_connection(self, connection) -> "Bearing":
-        """A copy whose rings are bolted to ``connection`` ({ring: Adapter or ImportedStiffness});
-        None: to nothing (free, clamped or frictionless as the superelement's ``bc`` says)."""
+        """A copy whose rings are bolted to other structures.
+
+        Parameters
+        ----------
+        connection : dict or None
+            ``{ring: Adapter or ImportedStiffness}``, ring ``"outer"`` or ``"inner"``;
+            None: bolted to nothing (free, clamped or frictionless as the superelement's
+            boundary condition says).
+
+        Returns
+        -------
+        Bearing
+            The new definition.
+
+        Raises
+        ------
+        BearingDefinitionError
+            If a key is not a ring name or its value belongs to the other ring.
+        """
         connection = dict(connection) if connection else None
         for ring, c in (connection or {}).items():
             if ring not in RING_CONTACTS or getattr(c, "ring", None) != ring:
@@ -179,7 +253,14 @@ class Bearing:
         return _replace(self, connection=connection)
 
     def to_dict(self) -> dict:
-        """The definition as plain SI data (for hashes, JSON and the FMU)."""
+        """The definition as plain SI data (for hashes, JSON and the FMU).
+
+        Returns
+        -------
+        dict
+            Keys as the attribute names, values in SI units (lists for arrays);
+            ``errors`` and ``connection`` only when present.
+        """
         d = {
             "name": self.name,
             "pitch_diameter": self.pitch_diameter,
@@ -203,7 +284,18 @@ class Bearing:
 
     @classmethod
     def from_si_dict(cls, d: Mapping[str, Any]) -> "Bearing":
-        """Inverse of :meth:`to_dict` (no unit conversion; validated again)."""
+        """Inverse of :meth:`to_dict` (no unit conversion; validated again).
+
+        Parameters
+        ----------
+        d : mapping
+            Data as :meth:`to_dict` writes it, SI units.
+
+        Returns
+        -------
+        Bearing
+            The validated definition.
+        """
         errors = ManufacturingErrors.from_dict(d["errors"]) if d.get("errors") else None
         b = cls(
             name=d["name"],
@@ -319,17 +411,36 @@ def _sections(rings: Mapping[str, Any], dm: float, dw: float) -> tuple[RingSecti
 def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = ".") -> Bearing:
     """Build and validate a :class:`Bearing` from the TOML layout (units in key names).
 
+    Lengths are given in the unit their key names (``pitch_diameter_mm``,
+    ``preload_um``, ``contact_angle_deg``, ``youngs_modulus_gpa``) and converted
+    here, once, to SI.
+
     Parameters
     ----------
     data : mapping
         Tables ``[bearing]``, optional ``[material]``, ``[rings]``, ``[errors]``, ``[connection]``.
-    base_dir : path
-        Folder against which file names of ``[errors]`` and ``[connection]`` are resolved.
+    base_dir : str or path-like, optional
+        Folder against which file names of ``[errors]`` and ``[connection]`` are resolved
+        (default: the current folder).
+
+    Returns
+    -------
+    Bearing
+        The validated definition, SI units.
 
     Raises
     ------
     BearingDefinitionError
         Naming the key, the value and the rule broken.
+
+    Examples
+    --------
+    >>> from slewing_model import bearing_from_dict
+    >>> b = bearing_from_dict({"bearing": {"pitch_diameter_mm": 1500, "ball_diameter_mm": 50,
+    ...                                    "groove_radius_mm": 26.25, "contact_angle_deg": 45,
+    ...                                    "ball_count": 80}})
+    >>> b.pitch_diameter, b.ball_diameter
+    (1.5, 0.05)
     """
     for name in data:
         if name not in BEARING_TABLES:
@@ -427,6 +538,23 @@ def validate(bearing: Bearing) -> None:
 
 def load_bearing(path: str | os.PathLike) -> Bearing:
     """Read and validate a bearing definition TOML file (see ``examples/bearings``).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The TOML file. File names inside it (measured errors, connections) are
+        resolved against its folder.
+
+    Returns
+    -------
+    Bearing
+        The validated definition, SI units.
+
+    Raises
+    ------
+    BearingDefinitionError
+        If the file is not valid TOML or breaks a rule; the message names the
+        file, the key, the value and the rule.
 
     Examples
     --------

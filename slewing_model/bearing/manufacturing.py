@@ -30,7 +30,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .conventions import BEARING_TABLES, RING_CONTACTS, BearingDefinitionError, check_known_keys
+from .conventions import BEARING_TABLES, RING_CONTACTS, BearingDefinitionError, check_known_keys, fail
 
 _UM = 1e-6
 #: the keys of ``[errors.synthetic]``
@@ -42,15 +42,18 @@ _MM = 1e-3
 class RingErrorMap:
     """Groove-centre deviations of one ring against the ring's own angle.
 
+    The table is fixed to the ring: it turns with the ring, so the deviation
+    under a ball changes with the ring's rotation.
+
     Attributes
     ----------
-    angle : ndarray (N,), rad
-        Strictly increasing, in [0, 2 pi).
-    radial, axial : ndarray (N, 2), m
-        Deviation of the groove centre of the ring's two contacts
+    angle : ndarray, shape (N,)
+        Ring angles of the table's rows, rad, strictly increasing, in [0, 2 pi).
+    radial, axial : ndarray, shape (N, 2)
+        Deviation of the groove centre of the ring's two contacts, m
         (outer ring: contacts 1, 4; inner ring: contacts 2, 3).
-    groove_radius : ndarray (N, 2), m, or None
-        Measured groove radius of the two contacts; None keeps the nominal one.
+    groove_radius : ndarray, shape (N, 2), or None
+        Measured groove radius of the two contacts, m; None (default) keeps the nominal one.
     """
 
     angle: np.ndarray
@@ -59,11 +62,23 @@ class RingErrorMap:
     groove_radius: np.ndarray | None = None
 
     def at(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        """Periodic linear interpolation at ring angles ``theta`` (rad, shape (B,)): numpy's
-        ``interp`` of each column of :attr:`table` at ``theta`` modulo ``2 pi`` (a compiled loop
-        does the same, :func:`slewing_model.distribution.kernel.add_groove_errors`).
+        """Deviations at given ring angles, by periodic linear interpolation.
 
-        Returns radial (B, 2), axial (B, 2) and groove radius (B, 2) or None."""
+        numpy's ``interp`` of each column of :attr:`table` at ``theta`` modulo ``2 pi`` (a
+        compiled loop of the run time does the same).
+
+        Parameters
+        ----------
+        theta : ndarray, shape (B,)
+            Ring angles, rad (any value: taken modulo 2 pi).
+
+        Returns
+        -------
+        radial, axial : ndarray, shape (B, 2)
+            Groove-centre deviations of the ring's two contacts, m.
+        groove_radius : ndarray, shape (B, 2), or None
+            Groove radii of the two contacts, m; None when the map has none.
+        """
         angle, table = self.table
         x = np.asarray(theta, dtype=float) % (2.0 * np.pi)
         values = np.stack([np.interp(x, angle, column) for column in table], axis=1)
@@ -89,6 +104,7 @@ class RingErrorMap:
         return angle, np.array(columns)
 
     def to_dict(self) -> dict:
+        """The map as plain data (lists), SI units; inverse of :meth:`from_dict`."""
         return {
             "angle": self.angle.tolist(),
             "radial": self.radial.tolist(),
@@ -98,6 +114,7 @@ class RingErrorMap:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "RingErrorMap":
+        """The map from data as :meth:`to_dict` writes it (SI units)."""
         rc = d.get("groove_radius")
         return cls(np.asarray(d["angle"], float), np.asarray(d["radial"], float),
                    np.asarray(d["axial"], float), None if rc is None else np.asarray(rc, float))
@@ -107,12 +124,16 @@ class RingErrorMap:
 class ManufacturingErrors:
     """All manufacturing errors of one bearing.
 
+    Read from the ``[errors]`` table of a bearing file (CSV tables of measured
+    deviations) or made by :func:`synthetic_errors`; attach them with
+    :meth:`Bearing.with_errors <slewing_model.Bearing.with_errors>`.
+
     Attributes
     ----------
     outer, inner : RingErrorMap or None
-        Per-ring groove tables; None for a perfect ring.
-    ball_diameter_deviation : ndarray (B,), m, or None
-        Deviation of each ball from the nominal diameter.
+        Per-ring groove tables; None (default) for a perfect ring.
+    ball_diameter_deviation : ndarray, shape (B,), or None
+        Deviation of each ball from the nominal diameter, m; None (default) for nominal balls.
     """
 
     outer: RingErrorMap | None = None
@@ -120,6 +141,7 @@ class ManufacturingErrors:
     ball_diameter_deviation: np.ndarray | None = None
 
     def to_dict(self) -> dict:
+        """The errors as plain data (lists), SI units; inverse of :meth:`from_dict`."""
         return {
             "outer": None if self.outer is None else self.outer.to_dict(),
             "inner": None if self.inner is None else self.inner.to_dict(),
@@ -129,6 +151,7 @@ class ManufacturingErrors:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "ManufacturingErrors":
+        """The errors from data as :meth:`to_dict` writes it (SI units)."""
         balls = d.get("ball_diameter_deviation")
         return cls(
             outer=RingErrorMap.from_dict(d["outer"]) if d.get("outer") else None,
@@ -266,24 +289,26 @@ def synthetic_errors(
     Parameters
     ----------
     ball_count : int
-    seed : int
-        Seed of :class:`numpy.random.Generator`; equal seeds give equal errors.
-    waviness_orders : sequence of int
-        Harmonic orders (lobes per turn).
-    radial_amplitude, axial_amplitude : float or sequence, m
-        Amplitude per order (one value serves all orders).
-    groove_radius_amplitude : float, m
-        Amplitude of groove-radius waviness (needs ``nominal_groove_radius``).
-    nominal_groove_radius : sequence of 4 floats, m
-        Nominal groove radii of contacts 1..4.
-    ball_tolerance : float, m
-        Half-width of the ball diameter tolerance band.
-    samples : int
-        Table points per turn.
+        Number of balls ``B`` (one diameter deviation each).
+    seed : int, optional
+        Seed of :class:`numpy.random.Generator`; equal seeds give equal errors. Default 0.
+    waviness_orders : sequence of int, optional
+        Harmonic orders (lobes per turn). Default (2, 3, 4, 5).
+    radial_amplitude, axial_amplitude : float or sequence of float, optional
+        Amplitude per order, m (one value serves all orders). Defaults 10e-6 and 5e-6.
+    groove_radius_amplitude : float, optional
+        Amplitude of groove-radius waviness, m (needs ``nominal_groove_radius``). Default 0.
+    nominal_groove_radius : sequence of 4 float, optional
+        Nominal groove radii of contacts 1..4, m.
+    ball_tolerance : float, optional
+        Half-width of the ball diameter tolerance band, m. Default 2e-6.
+    samples : int, optional
+        Table points per turn. Default 360.
 
     Returns
     -------
     ManufacturingErrors
+        Both rings' tables and the ball diameter deviations.
 
     Examples
     --------
@@ -320,16 +345,16 @@ def errors_from_table(table: Mapping[str, Any], base_dir: str | os.PathLike, bal
     check_known_keys(table, "errors", BEARING_TABLES["errors"])
     if "synthetic" in table:
         if not isinstance(table["synthetic"], Mapping):
-            raise BearingDefinitionError(f"errors.synthetic = {table['synthetic']!r}: must be a table [errors.synthetic]")
+            fail("errors.synthetic", table["synthetic"], "must be a table [errors.synthetic]")
         s = dict(table["synthetic"])
         check_known_keys(s, "errors.synthetic", SYNTHETIC_KEYS)
         for key in ("radial_amplitude_um", "axial_amplitude_um", "ball_tolerance_um"):
             values = np.atleast_1d(np.asarray(s.get(key, 0.0), dtype=float))
             if not np.all(np.isfinite(values)) or np.any(values < 0):
-                raise BearingDefinitionError(f"errors.synthetic.{key} = {s.get(key)!r}: must be finite and >= 0")
+                fail(f"errors.synthetic.{key}", s.get(key), "must be finite and >= 0")
         orders = s.get("waviness_orders", [2, 3, 4, 5])
         if not all(isinstance(k, int) and k >= 1 for k in orders):
-            raise BearingDefinitionError(f"errors.synthetic.waviness_orders = {orders!r}: must be whole numbers >= 1")
+            fail("errors.synthetic.waviness_orders", orders, "must be whole numbers >= 1")
         return synthetic_errors(
             ball_count, seed=int(s.get("seed", 0)), waviness_orders=orders,
             radial_amplitude=np.asarray(s.get("radial_amplitude_um", 10.0), float) * _UM,

@@ -65,6 +65,8 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
+from ..bearing.conventions import definition_message
+
 
 #: a case's name: its load series' name, this, its bearing variant's name
 CASE_NAME_SEPARATOR = " | "
@@ -94,11 +96,14 @@ SYNTHETIC_KEYS = ("waviness_orders", "radial_amplitude_um", "axial_amplitude_um"
 
 
 class StudyDefinitionError(ValueError):
-    """A study file breaks a rule; the message names the key, the value and the rule."""
+    """A study file breaks a rule; the message names the key, the value and the rule.
+
+    A :class:`ValueError`.
+    """
 
 
 def _fail(key: str, value: Any, rule: str):
-    raise StudyDefinitionError(f"{key} = {value!r}: {rule}")
+    raise StudyDefinitionError(definition_message(key, value, rule))
 
 
 @dataclass(frozen=True)
@@ -120,7 +125,9 @@ class Case:
         ``file`` (absolute), ``ring_model``, ``preload_um`` (None: the file's),
         ``friction_coefficient``, ``error_seed`` (None: the file's errors), ``synthetic_errors``.
     simulation : dict
-        The settings of :data:`SIMULATION_DEFAULTS`.
+        The ``[simulation]`` settings (``mesh``, ``bc``, ``moving_ring``, ``seal_torque_Nm``,
+        ``omega_regularisation_rad_s``, ``tolerance``, ``friction_tolerance``,
+        ``histogram_bins``), defaults filled in.
     spec : dict
         What the key is computed from: the above with files named by their content digest.
     """
@@ -138,9 +145,14 @@ class Case:
 class Study:
     """A study file, read and validated.
 
+    Build one with :func:`load_study`; :meth:`cases` expands it.
+
     Attributes
     ----------
     name : str
+        The study's name (default: the file's name without its suffix).
+    description : str
+        The study's description (``[study] description``), or empty.
     path : str
         The study file.
     base_dir : str
@@ -150,6 +162,16 @@ class Study:
     variants : list of dict
         One entry per bearing variant (the product of the ``[bearings]`` lists).
     simulation : dict
+        The ``[simulation]`` settings, defaults filled in (``seal_torque_Nm`` in N m,
+        ``omega_regularisation_rad_s`` in rad/s).
+
+    Examples
+    --------
+    >>> from slewing_model.study import load_study
+    >>> study = load_study("examples/studies/table3_tolerance_monte_carlo.toml")
+    >>> cases = study.cases()
+    >>> len(cases), cases[0].name
+    (2000, 'idling, one turn | table3, rigid, preload 0 um, mu 0.1, errors seed 1')
     """
 
     name: str
@@ -161,7 +183,13 @@ class Study:
     description: str = ""
 
     def cases(self) -> list[Case]:
-        """The product load series x bearing variants, in that order (loads outermost)."""
+        """The cases of the study.
+
+        Returns
+        -------
+        list of Case
+            The product load series x bearing variants, in that order (loads outermost).
+        """
         digests: dict[str, str] = {}
         out = []
         for i, (load, variant) in enumerate(itertools.product(self.loads, self.variants)):
@@ -213,6 +241,20 @@ def _with_digests(entry: dict, path_keys, digests: dict) -> dict:
 def load_study(path: str | os.PathLike) -> Study:
     """Read and validate a study file.
 
+    The layout of the file (TOML: ``[study]``, ``[[loads]]``, ``[bearings]``,
+    ``[simulation]``) is described on the user guide's studies page.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The study file; relative paths in it are resolved against ``[study] base_dir``,
+        itself relative to the file's folder.
+
+    Returns
+    -------
+    Study
+        The validated study.
+
     Raises
     ------
     StudyDefinitionError
@@ -238,13 +280,27 @@ def load_study(path: str | os.PathLike) -> Study:
 
 
 def study_from_dict(data: Mapping[str, Any], study_dir: str, path: str = "<dict>") -> Study:
-    """Validate the TOML layout of a study (see the module docstring).
+    """Validate the TOML layout of a study (as :func:`load_study` reads it).
 
     Parameters
     ----------
     data : mapping
-    study_dir : path
+        Tables ``[study]`` (optional), ``[[loads]]``, ``[bearings]`` and ``[simulation]``
+        (optional), as read from TOML.
+    study_dir : str or path-like
         Folder of the study file; ``study.base_dir`` is relative to it.
+    path : str, optional
+        The study file's name, for the default study name and messages. Default ``"<dict>"``.
+
+    Returns
+    -------
+    Study
+        The validated study.
+
+    Raises
+    ------
+    StudyDefinitionError
+        Naming the key, the value and the rule broken.
     """
     _known(data, "", {"study", "loads", "bearings", "simulation"})
     head = _table(data, "study", required=False)
@@ -277,6 +333,9 @@ def _known(table: Mapping, where: str, known: set) -> None:
         if not where:
             _fail(key, table[key], f"unknown table [{key}] (known tables: "
                   f"{', '.join(f'[{t}]' for t in sorted(known))}; names are case-sensitive)")
+        if isinstance(table[key], Mapping):     # a misspelt [where.key] sub-table
+            _fail(where + key, None, f"unknown table [{where}{key}] "
+                  f"(known: {', '.join(sorted(known))}; names are case-sensitive)")
         _fail(where + key, table[key],
               f"unknown key in table [{where[:-1]}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
 
