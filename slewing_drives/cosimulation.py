@@ -12,6 +12,7 @@ Every communication step ``dt``:
 """
 from __future__ import annotations
 
+import math
 import shutil
 from dataclasses import dataclass
 
@@ -23,6 +24,33 @@ from .load_series import LoadSeries
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("friction_torque", "friction_torque_magnitude", "max_ball_load", "max_contact_pressure",
            "static_safety_factor", "z", "rx", "ry")
+
+
+#: the band of the settling time (deg), and from when after a command step the max error is taken (s)
+SETTLED_DEG = 0.1
+SETTLED_AFTER_S = 1.0
+
+
+def settling(time, command_deg, error_deg, band: float = SETTLED_DEG, after: float = SETTLED_AFTER_S):
+    """(settling time, s; max |error|, deg, from ``after`` s after the last command step). A step is a
+    change of the command by more than ``band`` from one sample to the next; the settling time is the
+    longest over the steps (inf: outside the band until the next step or the end). Without a step:
+    (0, max |error|)."""
+    time, command_deg, error = np.asarray(time), np.asarray(command_deg), np.abs(np.asarray(error_deg))
+    steps = np.flatnonzero(np.abs(np.diff(command_deg, prepend=command_deg[:1])) > band)
+    if not steps.size:
+        return 0.0, float(error.max()) if error.size else 0.0
+    worst = 0.0
+    for i, k in enumerate(steps):
+        end = steps[i + 1] if i + 1 < steps.size else time.size
+        outside = np.flatnonzero(error[k:end] > band)
+        if outside.size and k + outside[-1] == end - 1:
+            worst = math.inf                    # still outside the band when the next step comes
+        elif outside.size:
+            worst = max(worst, time[k + outside[-1] + 1] - time[k])
+    last = np.searchsorted(steps, np.arange(time.size), side="right") - 1     # the last step up to each sample
+    late = (last < 0) | (time - time[steps[np.maximum(last, 0)]] >= after)
+    return float(worst), float(error[late].max()) if late.any() else math.nan
 
 
 @dataclass
@@ -45,13 +73,19 @@ class ManoeuvreResult:
         return self.outputs["friction_torque_magnitude"]
 
     def summary(self) -> dict:
-        """Figures a drive engineer reads first."""
+        """Figures a drive engineer reads first. The tracking figures leave out the command's steps
+        themselves (right after a step the error is the step): the settling time is the longest,
+        over the steps, from a step until the error stays within :data:`SETTLED_DEG` (inf: it does
+        not before the next step or the end); the max error is that more than :data:`SETTLED_AFTER_S`
+        after the last step."""
         error = np.degrees(self.command - self.angle)
+        settle, late_error = settling(self.time, np.degrees(self.command), error)
         return {
             "peak motor torque [N m]": float(np.abs(self.motor_torque).max()),
             "motor torque limit [N m]": self.params.torque_limit,
             "motor energy [kJ]": self.motor_energy / 1e3,
-            "max tracking error [deg]": float(np.abs(error).max()),
+            f"settling time to within {SETTLED_DEG:g} deg of a step [s]": settle,
+            f"max tracking error, from {SETTLED_AFTER_S:g} s after a step [deg]": late_error,
             "rms tracking error [deg]": float(np.sqrt(np.mean(error**2))),
             "peak friction torque [kN m]": float(self.friction_torque.max() / 1e3),
             "max ball load [kN]": float(self.outputs["max_ball_load"].max() / 1e3),
@@ -80,7 +114,7 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
         False sets the FMU's friction coefficient and seal torque to zero: the
         same manoeuvre without bearing friction.
     progress : bool
-        Show a progress bar (tqdm).
+        Show the progress on stderr (tqdm's bar on a terminal, plain lines otherwise).
     logger : callable, optional
         Called with every FMU log message (str); the last ones are also quoted
         in the error raised when the co-simulation fails.
@@ -151,9 +185,9 @@ def run_manoeuvre(fmu_path, drive: DriveParameters, loads: LoadSeries, command, 
             held = fmu.getReal([refs["friction_torque_magnitude"]])[0]
         iterator = range(steps)
         if progress:
-            from tqdm import tqdm
+            from slewing_model.progress import progress_bar   # a bar on a terminal, plain lines in a file
 
-            iterator = tqdm(iterator, desc=f"{drive.name}", unit="step", leave=False)
+            iterator = progress_bar(desc=f"{drive.name}", unit="step", leave=False, iterable=iterator)
         out_refs = [refs[n] for n in OUTPUTS]
         for k in iterator:
             t = time[k]

@@ -36,20 +36,37 @@ _FRAME_COMMENT = re.compile(r"^#\s*load_frame\s*=\s*(\w+)\s*$")
 class LoadSeries:
     """Loads (and optionally the ring's motion) against time.
 
+    Read and written as CSV by :meth:`read_csv` and :meth:`write_csv` (header
+    ``time,Fx,Fy,Fz,Mx,My[,Mz[,psi,omega]]``, SI units).
+
     Attributes
     ----------
-    time : ndarray (n,), s, strictly increasing
+    time : ndarray (n,), s
+        Sample times, strictly increasing.
     loads : ndarray (n, 6)
         Fx, Fy, Fz (N), Mx, My (N m) on the moving ring; Mz (N m), the moment
         the drive works against (positive when it opposes positive rotation).
     psi : ndarray (n,) or None, rad
-        Recorded angle of the moving ring (None: not recorded).
+        Recorded angle of the moving ring (None, default: not recorded).
     omega : ndarray (n,) or None, rad/s
-        Recorded speed of the moving ring.
+        Recorded speed of the moving ring (given with ``psi`` or not at all).
     load_frame : {"fixed", "rotating"} or None
         Frame of ``Fx..My``: the fixed ring's, or the moving ring's (turned by
         ``psi``; the FMU's and :class:`slewing_model.simulation.simulator.SimulatorSettings`'
-        ``load_frame``). None: not stated.
+        ``load_frame``). None (default): not stated.
+
+    Raises
+    ------
+    ValueError
+        If the shapes do not match, only one of ``psi`` and ``omega`` is given or
+        ``load_frame`` is unknown.
+
+    Examples
+    --------
+    >>> from slewing_drives import LoadSeries
+    >>> series = LoadSeries.read_csv("examples/loads/blade_root_loads.csv")
+    >>> series.at(1.0).shape                # Fx, Fy, Fz (N), Mx, My, Mz (N m)
+    (6,)
     """
 
     time: np.ndarray
@@ -77,19 +94,57 @@ class LoadSeries:
         return self.psi is not None
 
     def at(self, t: float) -> np.ndarray:
-        """Loads (6,) at time ``t`` (held constant outside the series)."""
+        """Loads at a time, interpolated linearly.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the loads are held constant outside the series).
+
+        Returns
+        -------
+        ndarray, shape (6,)
+            Fx, Fy, Fz (N), Mx, My, Mz (N m).
+        """
         return np.array([np.interp(t, self.time, self.loads[:, k]) for k in range(6)])
 
     def motion_at(self, t: float) -> tuple:
-        """``(psi, omega)`` at time ``t`` (rad, rad/s; held constant outside the series)."""
+        """Recorded motion at a time, interpolated linearly.
+
+        Parameters
+        ----------
+        t : float
+            Time, s (the motion is held constant outside the series).
+
+        Returns
+        -------
+        psi : float
+            Angle of the moving ring, rad.
+        omega : float
+            Its speed, rad/s.
+
+        Raises
+        ------
+        ValueError
+            If the series has no recorded motion.
+        """
         if not self.has_motion:
             raise ValueError("this load series has no recorded motion (psi, omega)")
         return float(np.interp(t, self.time, self.psi)), float(np.interp(t, self.time, self.omega))
 
     def write_csv(self, path, comments=()) -> None:
-        """Write the CSV (header ``time,Fx,Fy,Fz,Mx,My,Mz`` plus ``psi,omega``
-        when recorded), after ``comments`` (lines, each written after ``# ``)
-        and the ``load_frame`` when it is stated."""
+        """Write the series as CSV, SI units.
+
+        Header ``time,Fx,Fy,Fz,Mx,My,Mz`` plus ``psi,omega`` when recorded, after the
+        comments and the ``load_frame`` when it is stated.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file written.
+        comments : sequence of str, optional
+            Lines written at the top of the file, each as a comment (after a ``#`` and a space).
+        """
         with open(path, "w", newline="") as fh:
             for line in comments:
                 fh.write(f"# {line}\n")
@@ -107,8 +162,24 @@ class LoadSeries:
 
     @classmethod
     def read_csv(cls, path) -> "LoadSeries":
-        """Read a CSV of either header (``time,Fx,Fy,Fz,Mx,My[,Mz]`` or with
-        ``psi,omega``); a missing ``Mz`` is 0."""
+        """Read a CSV of either header (``time,Fx,Fy,Fz,Mx,My[,Mz]`` or with ``psi,omega``).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The CSV file, SI units; a missing ``Mz`` is 0.
+
+        Returns
+        -------
+        LoadSeries
+            With ``load_frame`` from a ``# load_frame = ...`` comment, if any.
+
+        Raises
+        ------
+        ValueError
+            Naming the file and line: a bad header, a value that is not a finite number,
+            fewer than two rows or time not strictly increasing.
+        """
         frame = None
         with open(path, newline="") as fh:
             rows, numbers = [], []            # the data rows and their line numbers in the file
@@ -172,22 +243,41 @@ def synthetic_blade_root_loads(duration: float, *, dt: float = 0.01, seed: int =
 
     Parameters
     ----------
-    duration, dt : float, s
-    seed : int
-    rotor_speed_rpm : float
-    blade_mass : float, kg
-    blade_cg_radius : float, m
-        Distance of the blade's centre of gravity from the blade root.
-    mean_thrust_moment, mean_thrust_force : float, N m and N
-    turbulence_intensity : float
-        Standard deviation of the thrust terms over their mean.
-    turbulence_time_scale : float, s
-    mean_pitching_moment, pitching_moment_gravity : float, N m
-        Mean and 1P amplitude of the moment about the pitch axis (on the drive).
+    duration : float
+        Length of the series, s.
+    dt : float, optional
+        Time step, s. Default 0.01.
+    seed : int, optional
+        Seed of the turbulence; equal seeds give equal series. Default 0.
+    rotor_speed_rpm : float, optional
+        Rotor speed, rpm (1P period). Default 9.
+    blade_mass : float, optional
+        Blade mass, kg. Default 35e3.
+    blade_cg_radius : float, optional
+        Distance of the blade's centre of gravity from the blade root, m. Default 25.
+    mean_thrust_moment : float, optional
+        Mean flapwise (thrust) moment, N m. Default 10e6.
+    mean_thrust_force : float, optional
+        Mean flapwise shear, N. Default 4.5e5.
+    turbulence_intensity : float, optional
+        Standard deviation of the thrust terms over their mean. Default 0.12.
+    turbulence_time_scale : float, optional
+        Time constant of the turbulence filter, s. Default 3.
+    mean_pitching_moment, pitching_moment_gravity : float, optional
+        Mean and 1P amplitude of the moment about the pitch axis (on the drive), N m.
+        Defaults 8e4 and 4e4.
 
     Returns
     -------
     LoadSeries
+        Loads only (no recorded motion), ``load_frame = "rotating"``.
+
+    Examples
+    --------
+    >>> from slewing_drives import synthetic_blade_root_loads
+    >>> series = synthetic_blade_root_loads(60.0, seed=1)
+    >>> series.time.size, series.load_frame
+    (6001, 'rotating')
     """
     rng = np.random.default_rng(seed)
     t = np.arange(0.0, duration + dt / 2, dt)
@@ -218,9 +308,40 @@ def synthetic_tower_top_loads(duration: float, *, dt: float = 0.05, seed: int = 
                               rotor_nacelle_mass: float = 350e3, thrust: float = 8e5, hub_height_offset: float = 3.0,
                               overhang_moment: float = 2.5e6, yaw_moment: float = 1.5e5,
                               turbulence_intensity: float = 0.1, turbulence_time_scale: float = 5.0) -> LoadSeries:
-    """Yaw bearing loads: weight of rotor and nacelle, rotor thrust and its tilting
-    moment, overhang moment of the rotor weight, aerodynamic yaw moment (Mz) with
-    seeded turbulence. Nacelle frame (turns with the yaw angle)."""
+    """Yaw bearing loads of a multi-megawatt turbine.
+
+    Weight of rotor and nacelle, rotor thrust and its tilting moment, overhang moment
+    of the rotor weight, aerodynamic yaw moment (Mz) with seeded turbulence (first-order
+    filtered noise on thrust and yaw moment). Nacelle frame (turns with the yaw angle).
+
+    Parameters
+    ----------
+    duration : float
+        Length of the series, s.
+    dt : float, optional
+        Time step, s. Default 0.05.
+    seed : int, optional
+        Seed of the turbulence. Default 0.
+    rotor_nacelle_mass : float, optional
+        Mass of rotor and nacelle, kg (``Fz = -m g``). Default 350e3.
+    thrust : float, optional
+        Mean rotor thrust, N (``Fx``). Default 8e5.
+    hub_height_offset : float, optional
+        Height of the hub above the yaw bearing, m (thrust's tilting moment). Default 3.
+    overhang_moment : float, optional
+        Tilting moment of the overhanging rotor weight, N m. Default 2.5e6.
+    yaw_moment : float, optional
+        Mean aerodynamic yaw moment, N m (``Mz``). Default 1.5e5.
+    turbulence_intensity : float, optional
+        Standard deviation of the gust factor. Default 0.1.
+    turbulence_time_scale : float, optional
+        Time constant of the turbulence filter, s. Default 5.
+
+    Returns
+    -------
+    LoadSeries
+        Loads only (no recorded motion); ``load_frame`` not stated (None).
+    """
     rng = np.random.default_rng(seed)
     t = np.arange(0.0, duration + dt / 2, dt)
     a = math.exp(-dt / turbulence_time_scale)

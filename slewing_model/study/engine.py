@@ -73,6 +73,7 @@ class StudyInterrupted(KeyboardInterrupt):
     Attributes
     ----------
     report : StudyReport
+        What the run did up to the interruption.
     """
 
     def __init__(self, report: "StudyReport"):
@@ -87,6 +88,7 @@ class StudyReport:
     Attributes
     ----------
     cases : int
+        Number of cases of the study.
     skipped : list of str
         Keys of the cases found finished in the output directory.
     ran : list of str
@@ -124,7 +126,7 @@ STUDY_RECORD = "study.json"
 
 
 class ForeignOutputError(ValueError):
-    """The output directory holds another study's results."""
+    """The output directory holds another study's results (``overwrite`` clears them); a :class:`ValueError`."""
 
 
 def _foreign_study(out_dir: str, study: Study, cases: list) -> str | None:
@@ -465,31 +467,33 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     Parameters
     ----------
     study : Study or path
-        A :class:`~.definition.Study` or a study file.
-    out_dir : path
-        Output directory (created).
+        A :class:`Study` or a study file.
+    out_dir : str or path-like
+        Output directory (created): ``summary.csv``, ``cases/`` (one folder per case key)
+        and ``figures/``.
     workers : int, optional
         Worker processes of the embedded ``LocalCluster`` (default: one per core).
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:8786``) to submit to instead.
     client : distributed.Client, optional
         An existing client (tests); neither ``workers`` nor ``scheduler`` then.
-    progress : bool
-        Show a progress bar over the cases.
-    retry_failed : bool
-        Run again the cases that finished with an error.
-    figures : bool
-        Write ``figures/*.png`` (needs matplotlib).
+    progress : bool, optional
+        Show a progress bar over the cases. Default True.
+    retry_failed : bool, optional
+        Run again the cases that finished with an error. Default False.
+    figures : bool, optional
+        Write ``figures/*.png`` (needs matplotlib). Default True.
     on_result : callable, optional
         ``on_result(case, record, client)`` after each result is written (tests, monitoring).
-    overwrite : bool
+    overwrite : bool, optional
         Clear the results of another study found in ``out_dir`` (``cases/``, ``figures/``,
         ``summary.csv``) instead of refusing the folder. The same study's results are always
-        kept and its finished cases skipped.
+        kept and its finished cases skipped. Default False.
 
     Returns
     -------
     StudyReport
+        Cases skipped, run and failed, the summary's rows, wall time (s) and figures.
 
     Raises
     ------
@@ -497,6 +501,14 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
         On Ctrl-C (SIGINT), after writing ``summary.csv`` for the cases finished so far.
     ForeignOutputError
         ``out_dir`` holds another study's results and ``overwrite`` is not set.
+
+    Examples
+    --------
+    >>> from slewing_model.study import run_study
+    >>> report = run_study("examples/studies/nrel5mw_pitch.toml", "results/nrel5mw_pitch",
+    ...                    workers=2)                                           # doctest: +SKIP
+    >>> report.failed                                                           # doctest: +SKIP
+    {}
     """
     if not isinstance(study, Study):
         study = load_study(study)
@@ -608,9 +620,9 @@ def _run_pending(out_dir, pending, study, records, lost, report, workers, schedu
                 else:
                     report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
                 if progress:
-                    from tqdm import tqdm
+                    from ..progress import progress_bar     # a bar on a terminal, plain lines in a file
 
-                    bar = tqdm(total=total, initial=total - len(tasks), desc=study.name, unit="case")
+                    bar = progress_bar(total, study.name, "case", initial=total - len(tasks))
                 by_key = {}
                 start = time.perf_counter()
                 futures = []

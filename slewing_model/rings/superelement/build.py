@@ -166,9 +166,9 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
     t_start = time.perf_counter()
     bar = None
     if progress:
-        from tqdm import tqdm
+        from ...progress import progress_bar
 
-        bar = tqdm(total=sum(harmonics.values()) + 4, desc="superelement harmonics", unit="harmonic")
+        bar = progress_bar(sum(harmonics.values()) + 4, "superelement harmonics", "harmonic")
     rings, ring_meta = {}, {}
     try:
         for ring in ("outer", "inner"):
