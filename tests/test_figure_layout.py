@@ -46,7 +46,7 @@ def _texts_outside(fig, dpi: float, saved_with_tight_box: bool) -> list[str]:
     frame = Bbox.from_extents(frame.x0 - 1, frame.y0 - 1, frame.x1 + 1, frame.y1 + 1)
     texts = list(fig.texts) + ([fig._suptitle] if fig._suptitle is not None else [])
     for ax in fig.axes:              # the tick labels drawn (those of ticks within the view), titles, labels
-        for axis in (ax.xaxis, ax.yaxis):
+        for axis in (ax.xaxis, ax.yaxis) if ax.axison else ():      # an axes turned off draws no ticks
             texts += [label for tick in axis._update_ticks() for label in (tick.label1, tick.label2)]
         texts += list(ax.texts)
         texts += [ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label]
@@ -111,3 +111,81 @@ def test_torque_against_psi_keeps_its_titles_inside_the_figure(tmp_path, monkeyp
     fig, outside = _saved_figure(monkeypatch, lambda: friction_study.psi_figure(tmp_path, True))
     assert outside == []
     assert friction_study.ERRORS_TEXT in fig._suptitle.get_text()   # the error amplitudes still stated
+
+
+def _life_case(folder, damage_map, duration=100.0, dg03_h=float("inf")):
+    """A case folder as a study writes it (raceway_damage.csv, life_cycles.csv, life_summary.json)."""
+    import json
+
+    folder.mkdir(parents=True)
+    angle = (np.arange(damage_map.shape[1]) + 0.5) * 360.0 / damage_map.shape[1]
+    np.savetxt(folder / "raceway_damage.csv", np.column_stack([angle, damage_map.T]), delimiter=",",
+               header="angle_deg,contact1,contact2,contact3,contact4", comments="")
+    track = damage_map.sum(axis=1)
+    cycles = np.column_stack([np.full(3, 1.0), np.full(3, 0.5), [0.5, 3.0, 900.0]] + [np.full(3, t / 3) for t in track])
+    np.savetxt(folder / "life_cycles.csv", cycles, delimiter=",", comments="",
+               header="swing_rad,count,travel_ratio,damage_1,damage_2,damage_3,damage_4")
+    summary = {"duration_s": duration, "track_damage": list(track), "life_dg03_L10_h": dg03_h,
+               "life_worst_track": int(np.argmax(track)) + 1, "micro_swing_rad": 1e-5}
+    (folder / "life_summary.json").write_text(json.dumps(summary))
+    return str(folder)
+
+
+def _life_groups(tmp_path, count):
+    """``count`` bearing variants with long names and damage maps decades apart (one far above the
+    rest); DG03 sees no damage in half of them."""
+    rng = np.random.default_rng(3)
+    shape = 1.0 + 0.5 * np.sin(np.radians(np.arange(0.5, 360, 1.0)))[None, :] * np.ones((4, 1))
+    groups = {}
+    for k in range(count):
+        scale = 1e3 if k == count - 1 else 10 ** rng.uniform(-3, 0)
+        label = f"pitch_bearing_nrel5mw, flexible, preload {10 * (k % 5)} um, mu 0.1, errors seed {k}"
+        groups[label] = [_life_case(tmp_path / f"c{k}", 1e-9 * scale * shape, dg03_h=float("inf") if k % 2 else 1e6)]
+    return groups
+
+
+def _overlapping_texts(fig) -> list[tuple[str, str]]:
+    """Pairs (text, what it runs into) of a title, a text or a legend drawn over another axes'
+    frame or over another of these texts (a title clipped by the next panel, a legend over a text)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig).draw()                      # the figure was closed once saved: lay it out again
+    renderer = fig.canvas.get_renderer()
+    items = []
+    for ax in fig.axes:
+        for t in [ax.title, ax._left_title, ax._right_title] + list(ax.texts):
+            if t.get_visible() and t.get_text().strip():
+                items.append((ax, t.get_window_extent(renderer), t.get_text()))
+        if ax.get_legend() is not None:
+            items.append((ax, ax.get_legend().get_window_extent(renderer), "legend"))
+    shrink = lambda b: b.expanded(1, 1).__class__.from_extents(b.x0 + 1, b.y0 + 1, b.x1 - 1, b.y1 - 1)  # noqa: E731
+    found = []
+    for i, (ax, box, text) in enumerate(items):
+        for other in fig.axes:
+            if other is not ax and other.axison and shrink(box).overlaps(other.bbox):
+                found.append((text, f"axes {other.get_title(loc='left') or other.get_title()}"))
+        for _, box2, text2 in items[i + 1:]:
+            if shrink(box).overlaps(shrink(box2)):
+                found.append((text, text2))
+    return found
+
+
+@pytest.mark.parametrize("count", [1, 6, 200])     # one duty; a line per variant; median and band beyond six
+def test_life_figure_keeps_its_texts_apart_and_its_median_in_view(tmp_path, monkeypatch, count):
+    from slewing_model.study.figures import life_figure
+
+    groups = _life_groups(tmp_path, count)
+    draw = lambda: life_figure(str(tmp_path / "life.png"), groups if count > 1 else next(iter(groups.values())))  # noqa: E731
+    fig, outside = _saved_figure(monkeypatch, draw)
+    assert outside == []
+    assert _overlapping_texts(fig) == []
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert not any("median inf" in t or "median nan" in t for t in texts), texts
+    if count > 6:    # the median of the variants is drawn well above the axis' foot, not flattened by the largest
+        for ax in fig.axes[:4]:
+            median = next(a for a in ax.patches + ax.lines if a.get_label() == "median")
+            path = median.get_path().transformed(median.get_transform())
+            y = path.vertices[:, 1]
+            y = y[np.isfinite(y)]
+            height = (np.median(y) - ax.bbox.y0) / ax.bbox.height
+            assert 0.2 < height <= 1.0, (ax.get_title(loc="left"), height)

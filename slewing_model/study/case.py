@@ -21,7 +21,7 @@ Statistics (SI units)
     the ring rotation ``v = |omega| dt`` (by time when the ring stands still), the
     dynamic equivalent load of the rolling-contact life formula.
 
-Life and wear (:mod:`slewing_model.life`, ``docs/life.md``)
+Life and wear (:mod:`slewing_model.life`; the user guide's life and wear page)
     ``life_L10_h``: the ISO/TS 16281 rating life of the raceways with the oscillation rule, in hours
     of the case's duty repeated, and ``life_worst_track`` (contact 1..4); ``life_damage_per_h``;
     ``life_map_L10_h``: the same from the raceway damage map; ``life_dg03_L10_h`` and
@@ -76,15 +76,18 @@ class CaseTask:
     Attributes
     ----------
     key : str
+        The case's key (16 hex digits).
     bearing : Bearing
         As read from its file (with its own errors, if any).
     superelement : Superelement or None
         For ``variant["ring_model"] == "flexible"``; built once per bearing variant.
     series : MotionSeries
+        Loads and motion of the moving ring, SI units.
     variant : dict
-        ``ring_model``, ``preload_um``, ``friction_coefficient``, ``error_seed``, ``synthetic_errors``.
+        ``ring_model``, ``preload_um`` (um), ``friction_coefficient``, ``error_seed``,
+        ``synthetic_errors``.
     simulation : dict
-        See :data:`slewing_model.study.definition.SIMULATION_DEFAULTS`.
+        The study's ``[simulation]`` settings (:attr:`Case.simulation`).
     """
 
     key: str
@@ -102,16 +105,24 @@ class CaseResult:
     Attributes
     ----------
     key : str
+        The case's key.
     status : str
         ``"ok"`` or the error in one line.
     elapsed : float, s
         Wall time of the case on its worker.
     worker : str
         ``host:pid`` of the process that ran it.
-    timeseries : ndarray (n, len(TIMESERIES_COLUMNS)) or None
+    timeseries : ndarray (n, 20) or None
+        One row a step: ``time`` (s), ``psi`` (rad), ``omega`` (rad/s), ``Fx, Fy, Fz`` (N),
+        ``Mx, My, Mz`` (N m), ``x, y, z`` (m), ``rx, ry`` (rad), ``friction_torque`` and
+        ``friction_torque_magnitude`` (N m), ``max_ball_load`` (N), ``max_contact_pressure``
+        (Pa), ``static_safety_factor``, ``balls_in_four_point_contact``.
     statistics : dict or None
-        As written to ``result.json`` (``json_ready``: an infinite value is "inf", no value None).
-    histogram : ndarray (m, len(HISTOGRAM_COLUMNS)) or None
+        As written to ``result.json`` (an infinite value is "inf", no value None); the
+        statistics listed above, SI units.
+    histogram : ndarray (m, 6) or None
+        The load spectrum, one row a ball, diagonal and bin: ``ball``, ``diagonal``,
+        ``load_lower_N``, ``load_upper_N`` (N), ``time_s`` (s), ``rotation_rad`` (rad).
     life : dict or None
         ``damage_map`` (4, slices) of contacts 1..4; ``swing`` (rad), ``count`` and ``travel_ratio``
         (x/2b) of the rainflow cycles; ``peak_pressure`` (4,), Pa.
@@ -167,8 +178,20 @@ def simulator_for(task: CaseTask):
 
 
 def run_case(task: CaseTask) -> CaseResult:
-    """Step one case through its series (see the module docstring). Never raises for a
-    case that cannot be computed: its ``status`` says why."""
+    """Step one case through its series: what a Dask worker runs.
+
+    Never raises for a case that cannot be computed: its ``status`` says why.
+
+    Parameters
+    ----------
+    task : CaseTask
+        The bearing, its superelement, the series and the settings (no files).
+
+    Returns
+    -------
+    CaseResult
+        Time series, statistics, load spectrum and life of the case, or its error.
+    """
 
     start = time.perf_counter()
     worker = f"{socket.gethostname()}:{os.getpid()}"

@@ -20,6 +20,7 @@
 from __future__ import annotations
 
 import os
+import textwrap
 from collections import defaultdict
 
 import numpy as np
@@ -361,8 +362,34 @@ def _short(label: str, width: int = 48) -> str:
     return label if len(label) <= width else label[:width - 3] + "..."
 
 
+def _distinct_labels(labels: list[str]) -> dict:
+    """Each label without the comma-separated parts all labels share (``table3, rigid, preload 0 um,
+    errors seed 3`` -> ``errors seed 3``), shortened: what sets the variants apart, where a cut
+    label would lose it."""
+    parts = [label.split(", ") for label in labels]
+    common = set.intersection(*(set(p) for p in parts)) if len(labels) > 1 else set()
+    return {label: _short(", ".join(x for x in p if x not in common) or label, 40) for label, p in zip(labels, parts)}
+
+
+def _common_part(labels: list[str]) -> str:
+    """The comma-separated parts all labels share, in the first label's order."""
+    parts = [label.split(", ") for label in labels]
+    common = set.intersection(*(set(p) for p in parts))
+    return ", ".join(x for x in parts[0] if x in common)
+
+
 def _fmt_h(h: float) -> str:
     return "inf" if not np.isfinite(h) else f"{h:.3g} h"
+
+
+def _damage_scale(ax, drawn: np.ndarray) -> None:
+    """A log y-axis for slice damages that span more than two decades (where a linear axis set by
+    the largest shows the others as a line along zero)."""
+    positive = drawn[np.isfinite(drawn) & (drawn > 0)]
+    if positive.size and positive.max() / positive.min() > 100:
+        top = 3 * float(positive.max())
+        ax.set_yscale("log")      # at most seven decades: a slice far below the others leaves the axis at its foot
+        ax.set_ylim(max(0.3 * positive.min(), 1e-7 * top), top)
 
 
 def life_figure(path: str, case_dirs, title: str | None = None) -> str:
@@ -379,40 +406,48 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
     duties = {label: _duty(r) for label, r in runs.items()}
     angle = next(iter(runs.values()))[0]["angle"]
     edges = np.linspace(0.0, 360.0, angle.size + 1)
-    fig = plt.figure(figsize=(13, 9))
-    grid = fig.add_gridspec(4, 2, width_ratios=(1.6, 1.0))
-    axes = [fig.add_subplot(grid[k, 0]) for k in range(4)]
+    # constrained layout: the titles and the text panel keep their room (tight_layout let a map's title
+    # run under the histogram and cut the last text line at the figure's edge)
+    fig = plt.figure(figsize=(13, 9), layout="constrained")
+    grid = fig.add_gridspec(1, 2, width_ratios=(1.6, 1.0))
+    left, right = grid[0, 0].subgridspec(4, 1), grid[0, 1].subgridspec(2, 1, height_ratios=(1.3, 1.0))
+    axes = [fig.add_subplot(left[k, 0]) for k in range(4)]
     one = len(duties) == 1
+    short_labels = _distinct_labels(list(duties))
     for k, ax in enumerate(axes):
         if len(duties) <= MAX_GROUP_LINES:
+            drawn = np.array([duty["map"][k] for duty in duties.values()])
             for j, (label, duty) in enumerate(duties.items()):
                 ax.stairs(duty["map"][k], edges, lw=0.8, fill=one, alpha=0.8 if one else 1.0,
-                          color=f"C{k if one else j}", label=None if one else _short(label))
-        else:
+                          color=f"C{k if one else j}", label=None if one else short_labels[label])
+        else:   # many variants: median and 5-95 % band, and the largest, dotted (on a log axis when far above)
             maps = np.array([duty["map"][k] for duty in duties.values()])
-            ax.stairs(maps.max(axis=0), edges, baseline=maps.min(axis=0), fill=True, alpha=0.35, color=f"C{k}",
-                      label=f"range over the {len(duties)} variants")
-            ax.stairs(np.median(maps, axis=0), edges, color=f"C{k}", lw=0.8, label="median")
+            lo, median, hi = np.percentile(maps, [5, 50, 95], axis=0)
+            drawn = np.array([lo, median, hi, maps.max(axis=0)])
+            ax.stairs(hi, edges, baseline=lo, fill=True, alpha=0.35, color=f"C{k}",
+                      label=f"5-95 % of the {len(duties)} variants")
+            ax.stairs(median, edges, color=f"C{k}", lw=1.2, label="median")
+            ax.stairs(maps.max(axis=0), edges, color="k", lw=0.5, ls=":", label="largest")
+        if not one:     # alternative designs can lie decades apart
+            _damage_scale(ax, drawn)
         if one:
             d = next(iter(duties.values()))
             life_k = d["duration"] / 3600.0 / d["cycle_track"][k] if d["cycle_track"][k] > 0 else float("inf")
             ax.set_title(f"contact {TRACK_LABELS[k]}: D = {d['cycle_track'][k]:.3g} (cycle rule), "
-                         f"{d['map_track'][k]:.3g} (map) in {d['duration']:.4g} s; L10 of the track alone "
+                         f"{d['map_track'][k]:.3g} (map) in {d['duration']:.4g} s\nL10 of the track alone "
                          f"{_fmt_h(life_k)}", fontsize=9, loc="left")
         else:
             dk = np.array([d["map_track"][k] for d in duties.values()])
-            ax.set_title(f"contact {TRACK_LABELS[k]}, map: D median {np.median(dk):.3g}, range {dk.min():.3g}.."
-                         f"{dk.max():.3g} over the {len(duties)} variants", fontsize=9, loc="left")
+            ax.set_title(f"contact {TRACK_LABELS[k]}, map: D median {np.median(dk):.3g}, "
+                         f"range {dk.min():.3g}..{dk.max():.3g}", fontsize=9, loc="left")
         ax.set_xlim(0, 360)
-        ax.set_ylabel("slice damage d_j", fontsize=8)
+        ax.set_ylabel("slice damage d_j" + (" (log)" if ax.get_yscale() == "log" else ""), fontsize=8)
         ax.grid(alpha=0.3)
         if k < 3:
             ax.tick_params(labelbottom=False)
     axes[3].set_xlabel("slice, angle around its own ring [deg] (steps: a slice no ball rolled over is 0)")
-    if not one and len(duties) <= MAX_GROUP_LINES:
-        axes[0].legend(fontsize=7, loc="upper right")
 
-    ax2 = fig.add_subplot(grid[0:3, 1])
+    ax2 = fig.add_subplot(right[0, 0])
     ratios, counted, damage = [], [], []
     for r in (x for group in runs.values() for x in group):
         c = r["cycles"]
@@ -446,30 +481,56 @@ def life_figure(path: str, case_dirs, title: str | None = None) -> str:
     ax2.set_ylabel("share per bin")
     ax2.grid(alpha=0.3)
 
-    ax3 = fig.add_subplot(grid[3, 1])
+    ax3 = fig.add_subplot(right[1, 0])
     ax3.axis("off")
-    lines = []
-    lines.append(f"L10 in hours of the duty ({next(iter(duties.values()))['duration']:.4g} s) repeated:" if one else
-                 "L10 in hours of each variant's duty repeated:")
-    for label, d in (list(duties.items()) if len(duties) <= MAX_GROUP_LINES else []):
-        worst = f"worst track {int(np.argmax(d['cycle_track'])) + 1}" if d["cycle_track"].max() > 0 else "no damage"
-        ratio = "-" if np.isnan(d["ratio"]) else f"{d['ratio']:.2f} x ours"
-        lines.append(f"{_short(label) + ': ' if label else ''}ISO/TS 16281 + oscillation rule {_fmt_h(d['ours_h'])} "
-                     f"({worst})")
-        lines.append(f"{'    ' if label else ''}raceway map {_fmt_h(d['map_h'])};  DG03 {_fmt_h(d['dg03_h'])} = {ratio}")
+    lines = []       # (text, colour): a variant's line in its maps' colour, which makes it the maps' legend
+    lines.append((f"L10 in hours of the duty ({next(iter(duties.values()))['duration']:.4g} s) repeated:" if one else
+                  "L10 in hours of each variant's duty repeated" +
+                  (" (colours as in the maps):" if len(duties) <= MAX_GROUP_LINES else ":"), "k"))
+    if not one and len(duties) <= MAX_GROUP_LINES:
+        lines.append(("ours = ISO/TS 16281 + oscillation rule; map = raceway map", "k"))
+    for j, (label, d) in enumerate(duties.items() if len(duties) <= MAX_GROUP_LINES else []):
+        track = int(np.argmax(d["cycle_track"])) + 1 if d["cycle_track"].max() > 0 else None
+        ratio = ("" if np.isnan(d["ratio"]) else " (no damage)" if np.isinf(d["ratio"])
+                 else f" = {d['ratio']:.2f} x ours")
+        if label:      # one line a variant, named by what sets it apart
+            lines.append((f"{short_labels[label]}: ours {_fmt_h(d['ours_h'])}"
+                          f"{f' (track {track})' if track else ''}, map {_fmt_h(d['map_h'])}, "
+                          f"DG03 {_fmt_h(d['dg03_h'])}{ratio}", f"C{j}"))
+            continue
+        worst = f"worst track {track}" if track else "no damage"
+        lines.append((f"ISO/TS 16281 + oscillation rule {_fmt_h(d['ours_h'])} ({worst})", "k"))
+        lines.append((f"raceway map {_fmt_h(d['map_h'])};  DG03 {_fmt_h(d['dg03_h'])}{ratio}", "k"))
     if len(duties) > MAX_GROUP_LINES:
         ours = np.array([d["ours_h"] for d in duties.values()])
         ratio = np.array([d["ratio"] for d in duties.values()])
-        lines.append(f"{len(duties)} variants: L10 (ours) median {_fmt_h(float(np.median(ours)))}, range "
-                     f"{_fmt_h(float(ours.min()))}..{_fmt_h(float(ours.max()))}; DG03/ours median "
-                     f"{np.nanmedian(ratio):.2f}")
+        lines.append((f"ours: median {_fmt_h(float(np.median(ours)))}, range "
+                      f"{_fmt_h(float(ours.min()))}..{_fmt_h(float(ours.max()))}", "k"))
+        finite = ratio[np.isfinite(ratio)]
+        no_damage = int(np.sum(np.isinf(ratio)))
+        lines.append(("DG03 / ours: " + (f"median {np.median(finite):.2f}, range {finite.min():.2f}.."
+                                         f"{finite.max():.2f}" if finite.size else "no finite ratio"), "k"))
+        if no_damage:   # DG03's equivalent load is zero (an unloaded ring): its life is infinite, not a ratio
+            lines.append((f"DG03 sees no damage (L10 inf) in {no_damage} of the {len(duties)} variants", "k"))
     cases = sum(len(v) for v in groups.values())
-    lines.append(f"{cases} run(s)" + (" of one duty, added" if one and cases > 1 else "") + ("" if one else
-                 f" in {len(duties)} variants (alternative designs): each one's runs added, variants never added"))
-    ax3.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax3.transAxes)
+    lines.append((f"{cases} run(s)" + (" of one duty, added" if one and cases > 1 else "") + ("" if one else
+                  f" in {len(duties)} variants: each variant's runs added, variants (alternative designs) "
+                  f"never added"), "k"))
+    if not one and len(duties) <= MAX_GROUP_LINES and any(short_labels[k] != k for k in short_labels):
+        lines.append((f"all variants: {_common_part(list(duties))}", "k"))
+    size = 9 if len(lines) <= 10 else 8      # wrapped to the panel's width (about 5 inches)
+    anchor = None
+    for text, colour in lines:
+        for wrapped in textwrap.wrap(text, 60 if size == 9 else 66, subsequent_indent="    "):
+            anchor = (ax3.text(0.0, 1.0, wrapped, va="top", fontsize=size, color=colour, transform=ax3.transAxes)
+                      if anchor is None else       # each line under the one before
+                      ax3.annotate(wrapped, xy=(0.0, 0.0), xycoords=anchor, xytext=(0.0, -0.3 * size),
+                                   textcoords="offset points", va="top", fontsize=size, color=colour))
+    if len(duties) > MAX_GROUP_LINES:     # the maps' legend at the panel's foot, not over a map's curves
+        ax3.legend(*axes[0].get_legend_handles_labels(), title="the maps (left), in contact 1's colour",
+                   fontsize=7, title_fontsize=7, loc="lower left", frameon=False)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path

@@ -28,7 +28,8 @@ class MotionSeries:
 
     Attributes
     ----------
-    time : ndarray (n,), s, strictly increasing
+    time : ndarray (n,), s
+        Sample times, strictly increasing.
     loads : ndarray (n, 6)
         Fx, Fy, Fz (N), Mx, My, Mz (N m); Mz is the moment the drive works against
         (recorded, not an input of the load distribution).
@@ -57,7 +58,18 @@ class MotionSeries:
     recorded_motion: bool = True
 
     def where(self, k: int) -> str:
-        """``FILE, line L, t = T s`` of row ``k`` (0-based), for messages."""
+        """Where row ``k`` comes from, for messages.
+
+        Parameters
+        ----------
+        k : int
+            Row, 0-based.
+
+        Returns
+        -------
+        str
+            ``FILE, line L, t = T s`` (``row`` instead of ``line`` when not read from a text file).
+        """
         line = f", line {self.lines[k]}" if self.lines is not None else f", row {k + 1}"
         return f"{self.source}{line}, t = {self.time[k]:.6g} s"
 
