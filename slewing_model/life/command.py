@@ -67,7 +67,8 @@ def run(args) -> int:
     if not series.recorded_motion:
         raise ValueError(f"{args.loads}: no column psi (nor omega): `slewing life` counts the oscillations of the "
                          f"ring angle psi (rad) and needs it on every row; this file has only the loads "
-                         f"(`slewing loads` writes psi and omega from an OpenFAST file's pitch or yaw angle)")
+                         f"(`slewing loads` writes psi and omega from an OpenFAST file's pitch or yaw angle; "
+                         f"examples/loads/blade_root_pitch_series.csv is a series with psi)")
     superelement = None
     if args.ring_model == "flexible":
         from ..rings.superelement import build_superelement
