@@ -98,6 +98,8 @@ def _make_bare_system(release: str, target: Path) -> Path:
     run = subprocess.run([debootstrap, "--variant=minbase", release, str(partial)], capture_output=True, text=True,
                          timeout=900)
     assert run.returncode == 0, f"debootstrap {release} failed:\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
+    for deb in (partial / "var/cache/apt/archives").glob("*.deb"):    # installed: the packages are not needed
+        deb.unlink()
     partial.rename(target)
     return target
 
@@ -180,12 +182,35 @@ def fmpy_steps(fmu, version, steps):
     return np.array(out)
 
 
+#: the FMUs this process unzipped into a bare system's /tmp (each some 100 MB with numba's cache): removed
+#: after each test, so that the kept systems do not grow by what the tests unpack
+PLACED: list[Path] = []
+
+
+def remove_placed() -> None:
+    """Remove what :func:`place` unzipped into the bare systems (an error if something stays)."""
+    left = []
+    while PLACED:
+        path = PLACED.pop()
+        shutil.rmtree(path, ignore_errors=True)
+        left += [str(path)] if path.exists() else []
+    assert not left, f"could not remove the FMUs unzipped into the bare systems: {left}"
+
+
+@pytest.fixture(autouse=True)
+def _remove_placed_fmus():
+    yield
+    remove_placed()
+
+
 def place(fmu, system: Path, name: str) -> tuple[str, str, list[str]]:
-    """Unzip ``fmu`` into ``system``'s /tmp/<name>; returns (its path inside, token, value references)."""
+    """Unzip ``fmu`` into ``system``'s /tmp/<name> (removed after the test: :data:`PLACED`); returns (its
+    path inside, token, value references)."""
     md = read_model_description(str(fmu))
     refs = {v.name: v.valueReference for v in md.modelVariables}
     inside = f"/tmp/{name}"
     shutil.rmtree(system / inside.lstrip("/"), ignore_errors=True)
+    PLACED.append(system / inside.lstrip("/"))
     with zipfile.ZipFile(fmu) as z:
         z.extractall(system / inside.lstrip("/"))
     token = md.guid if md.fmiVersion.startswith("2") else md.instantiationToken
@@ -196,7 +221,10 @@ def run_host(system, host, fmu, version, scenario, folder=None):
     """Our C host on ``fmu`` inside ``system``: (return code, {label: {step: values}}, statuses, logs, output)."""
     shutil.copy2(host, system / "tmp" / host.name)
     inside, token, vrs = place(fmu, system, folder or f"fmu{version}")
-    run = in_system(system, f"/tmp/{host.name}", inside, MODEL[version], token, scenario, *vrs)
+    try:
+        run = in_system(system, f"/tmp/{host.name}", inside, MODEL[version], token, scenario, *vrs)
+    finally:         # also for tests/test_linux_floor.py, which has no fixture of its own for it
+        remove_placed()
     values, statuses, logs, _ = parse_host_output(run.stdout)
     logs = [f"{status} {category} {message}" for status, category, message in logs]
     return run.returncode, values, statuses, logs, run.stdout + run.stderr
@@ -240,7 +268,10 @@ def assert_fmusim_runs_as_fmpy(system: Path, fmusim_binary: Path, fmu, runs: int
     """fmusim runs ``fmu`` ``runs`` times in ``system`` with the C host's inputs; every run exits 0, gives
     fmpy's outputs (driving the same FMU on this machine) to ``rel`` and leaves no unpacked FMU behind."""
     with system_lock(system.name):
-        _fmusim_runs_as_fmpy(system, fmusim_binary, fmu, runs, rel)
+        try:
+            _fmusim_runs_as_fmpy(system, fmusim_binary, fmu, runs, rel)
+        finally:     # its copy of the FMU and of fmusim, its input and output
+            shutil.rmtree(system / "tmp" / "fmusim_run", ignore_errors=True)
 
 
 def _fmusim_runs_as_fmpy(system: Path, fmusim_binary: Path, fmu, runs: int, rel: float):
