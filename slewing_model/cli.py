@@ -160,6 +160,7 @@ def _run_plot(args) -> int:
     label = f"flexible rings ({args.bc})" if se is None else f"flexible rings ({args.superelement})"
     results = {"rigid rings": solve(bearing, loads),
                label: solve(bearing, loads, model="flexible", superelement=se, bc=args.bc, mesh=args.mesh)}
+    os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)   # results/ on a fresh clone
     plot_distribution(results, args.output, quantity=args.quantity,
                       title=f"{bearing.name}, preload {bearing.preload * 1e6:g} um, {loads}")
     print(f"wrote {args.output}")
