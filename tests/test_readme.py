@@ -1,6 +1,6 @@
-"""The README's command lines run as written (issue 25).
+"""The commands of the README and of the documentation's pages run as written.
 
-Every line of the README's ``sh`` blocks, and its ``python`` example, is either run here or
+Every line of their ``sh`` blocks, and their ``python`` examples, is either run here or
 skipped with the reason stated in :data:`SKIPPED` (FMU and SSP builds, full examples and
 studies of minutes, cluster set-up, placeholders). The cheap ones run in a copy of the
 repository (its tracked and new files, committed into a fresh git repository), with
@@ -38,15 +38,23 @@ SKIPPED = (
 )
 
 
+#: the pages whose commands run: the README and the documentation site's Markdown pages
+PAGES = [ROOT / "README.md"] + sorted(p for p in (ROOT / "docs").rglob("*.md") if "_build" not in p.parts)
+#: the FMUs the examples step (`make demo`'s, and one a page builds), by the bearing file they are built from:
+#: the test builds them quickly (coarse superelement, numpy's loops, no win64 half) and steps them instead
+EXAMPLE_FMUS = {"build/SlewingBearing_pitch_bearing.fmu": "examples/bearings/pitch_bearing.toml",
+                "build/table1.fmu": "examples/bearings/table1.toml"}
+
+
 def _blocks(kind: str) -> list[str]:
-    text = (ROOT / "README.md").read_text()
-    return re.findall(rf"^```{kind}\n(.*?)^```", text, flags=re.S | re.M)
+    return [block for page in PAGES
+            for block in re.findall(rf"^```{kind}\n(.*?)^```", page.read_text(), flags=re.S | re.M)]
 
 
 def _commands() -> list[str]:
     out = []
     for block in _blocks("sh"):
-        for line in block.splitlines():
+        for line in block.replace("\\\n", " ").splitlines():                # a command continued on the next line
             line = re.sub(r"\s+#\s.*$", "", line).strip()      # a trailing comment
             if line and not line.startswith("#"):
                 out.append(line)
@@ -60,7 +68,7 @@ def _skip_reason(command: str):
     return None
 
 
-def test_every_readme_command_is_run_or_skipped_with_a_reason():
+def test_every_documented_command_is_run_or_skipped_with_a_reason():
     commands = _commands()
     assert len(commands) > 15
     run = [c for c in commands if _skip_reason(c) is None]
@@ -89,9 +97,15 @@ def copy(tmp_path_factory):
     return repo
 
 
+def _shared_outputs() -> set[str]:
+    """The files the commands on ``../shared``'s files write (``-o results/fastv8.csv``)."""
+    return {out for c in _commands() if "../shared/" in c for out in re.findall(r"(?:-o|--output)\s+(\S+)", c)}
+
+
 def _needs_shared(command: str) -> bool:
-    """A command that reads the public NREL OpenFAST outputs of ``../shared`` (not in a clone)."""
-    return "../shared/" in command
+    """A command that reads the public NREL OpenFAST outputs of ``../shared`` (not in a clone), or what such a
+    command wrote."""
+    return "../shared/" in command or any(out in command.split() for out in _shared_outputs())
 
 
 def _run_commands(copy, commands) -> None:
@@ -102,24 +116,45 @@ def _run_commands(copy, commands) -> None:
         assert done.returncode == 0, f"{command}\n{done.stderr[-2000:]}"
     status = subprocess.run(["git", "status", "--porcelain", "--untracked-files=all"], cwd=copy,
                             capture_output=True, text=True, check=True).stdout
-    assert status == "", f"README commands left files in the repository:\n{status}"
+    assert status == "", f"documented commands left files in the repository:\n{status}"
 
 
-def test_readme_commands_exit_0_and_leave_nothing_in_the_repository(copy):
+def test_documented_commands_exit_0_and_leave_nothing_in_the_repository(copy):
     commands = [c for c in _commands() if _skip_reason(c) is None and not _needs_shared(c)]
     assert any(c.startswith(".venv/bin/slewing solve") for c in commands)
     _run_commands(copy, commands)
 
 
 @pytest.mark.skipif(not OPENFAST.is_dir(), reason=f"the README's `slewing loads` commands read the public NREL "
-                    f"OpenFAST outputs in {OPENFAST}, which is absent (README: '../shared' under 'Two commands')")
-def test_readme_commands_on_the_openfast_files_exit_0(copy):
+                    f"OpenFAST outputs in {OPENFAST}, which is absent (the README says what lives in ../shared)")
+def test_documented_commands_on_the_openfast_files_exit_0(copy):
     commands = [c for c in _commands() if _skip_reason(c) is None and _needs_shared(c)]
-    assert len(commands) >= 2 and all(c.startswith(".venv/bin/slewing loads") for c in commands)
+    assert any(c.startswith(".venv/bin/slewing loads") for c in commands)
     _run_commands(copy, commands)
 
 
-def test_readme_python_example_runs(copy):
-    for block in _blocks("python"):
-        done = subprocess.run([sys.executable, "-c", block], cwd=copy, capture_output=True, text=True, timeout=120)
-        assert done.returncode == 0, done.stderr[-2000:]
+@pytest.fixture(scope="module")
+def example_fmus(tmp_path_factory):
+    """Builds an example FMU the first time a block names it; returns {path in the docs: built FMU}."""
+    sys.path.insert(0, str(ROOT))
+    from build_fmu import build_fmu
+
+    built = {}
+
+    def build(name: str) -> Path:
+        if name not in built:
+            path = tmp_path_factory.mktemp("example_fmu") / Path(name).name
+            built[name] = build_fmu(ROOT / EXAMPLE_FMUS[name], path, mesh="coarse", numba=False, win64=False)
+        return built[name]
+    return build
+
+
+def test_python_examples_run(copy, example_fmus):
+    blocks = _blocks("python")
+    assert any("solve(" in b for b in blocks) and any("simulate_fmu(" in b for b in blocks)
+    for block in blocks:
+        for name in EXAMPLE_FMUS:
+            if name in block:
+                block = block.replace(name, str(example_fmus(name)))
+        done = subprocess.run([sys.executable, "-c", block], cwd=copy, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, f"{block}\n{done.stderr[-2000:]}"
