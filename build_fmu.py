@@ -19,7 +19,7 @@ front of pythonfmu's that starts Python in a C host:
 * ``--runtime host``: the light "tool coupling" FMU, which runs in the Python named in
   ``resources/python_runtime.txt`` (the building one) or by ``SLEWING_FMU_PYTHONHOME``.
 
-See the README's "The FMU on another machine" and ``docs/fmu_hosts.md``.
+What the target machine needs, and the hosts tried: ``docs/fmu/hosts.md``.
 """
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         FMU file; default ``SlewingBearing_<name>.fmu`` beside the definition's name, in ``build/``.
     bc : {"free", "clamped", "frictionless"}
         Ring support of the superelement; a ring the bearing file connects (``[connection.<ring>]``,
-        docs/connected_structures.md) is held by its connected structure instead.
+        docs/guide/connected-structures.md) is held by its connected structure instead.
     mesh : {"coarse", "fine"}
         Superelement mesh; "fine" (default) is within 0.5 % of a finer one, "coarse" is for tests.
     fmi_version : {2, 3}

@@ -14,7 +14,7 @@ Each case is a bearing file, the FMU parameters (ring model, load frame) and, pe
   (10 s yawing, 5 s at rest, alternately in each direction).
 - ``table3_heavy``: table3 with manufacturing errors, Fz 200 kN +- 5 %, Fx +-20 kN, Fy 10 kN,
   Mx +-50 kN m, My +-100 kN m, all varying, the ring turning at 0.1 rad/s.
-- ``table3_light``: the earlier README case, Fz 10-30 kN with a 2 kN m moment, turning at
+- ``table3_light``: table3 with errors, Fz 10-30 kN with a 2 kN m moment, turning at
   0.5 rad/s (light: kept to compare with older figures).
 """
 from __future__ import annotations
@@ -111,7 +111,7 @@ def table3_light(steps: int) -> Case:
     zero = np.zeros_like(t)
     loads = np.stack([zero, zero, 2e4 + 1e4 * np.sin(0.2 * t), 2e3 * np.cos(0.3 * t), zero], axis=1)
     return Case("table3_light", "table3 with errors, light load (Fz 10-30 kN, Mx 2 kN m), turning at 0.5 rad/s, "
-                "flexible rings (the earlier README case)", ROOT / "examples/bearings/table3_errors.toml",
+                "flexible rings", ROOT / "examples/bearings/table3_errors.toml",
                 {"ring_model": 2, "load_frame": 1}, loads, 0.5 * t, np.full_like(t, 0.5))
 
 

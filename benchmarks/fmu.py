@@ -104,7 +104,7 @@ def worker(fmu_path: str, case_name: str, steps: int, integers: dict | None = No
         first, count, rewarm = (*map(int, line.split()), 0)[:3]
         if rewarm:
             # on a shared machine a step whose memory was not touched for a second or more can take 8-40 ms
-            # of CPU time instead of 1 (no page fault: out of the shared host's caches; docs/speed.md): the
+            # of CPU time instead of 1 (no page fault: out of the shared host's caches; docs/performance.md): the
             # block's first step, made once and rolled back, warms it first
             state = fmu.getFMUstate()
             fmu.setReal(inputs, values_at(first))

@@ -18,7 +18,7 @@ steps), and a released version's (``--baseline VERSION``, built by that version'
 Each runs in a worker process of its own through fmpy (:class:`benchmarks.fmu.Worker`); their runs of
 each scenario alternate in blocks (``--runs``), so all see the same machine load. On a shared machine a
 step whose memory was not touched for a second or more can take 8-40 ms of CPU time, not 1
-(docs/speed.md), and a worker waits while the others run, so each block after a worker's first starts
+(docs/performance.md), and a worker waits while the others run, so each block after a worker's first starts
 with its first step made once and rolled back (``rewarm``), and each worker's first block follows its
 instantiation at once. A step is ``setReal`` of the 7 inputs,
 ``doStep`` (10 ms) and ``getReal`` of 5 outputs. "first step" is the first ``doStep`` after

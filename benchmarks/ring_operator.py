@@ -1,7 +1,7 @@
 """The flexible solver's fresh reduced operator: its inverse by halves against LAPACK's.
 
 A fresh operator ``W^-1 = (A^-1 + M)_aa^-1`` is what sets the tail of a co-simulation step
-(`docs/speed.md`). This takes the operators ``W`` the simulator forms while stepping the
+(docs/theory/flexible-bime.md). This takes the operators ``W`` the simulator forms while stepping the
 benchmark cases (``benchmarks/cases.py``: the pitch and yaw bearings, fine superelement) and
 inverts each by :func:`slewing_model.rings.reduced_operator.spd_inverse` (Schur complements,
 matrix products) and by ``np.linalg.inv`` (LU, then triangular solves), alternately, on one

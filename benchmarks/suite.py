@@ -44,7 +44,7 @@ BENCHMARKS = {
     "fmu_variants": "fmu_variants", "win64": "win64", "fmi3": "fmi3", "life": "life", "connected": "connected",
     "step_parts": "step_parts", "slowest": "slowest", "machine_noise": "machine_noise",
 }
-#: the main set: what ``make bench`` runs (the README's speed figures; several minutes)
+#: the main set: what ``make bench`` runs (the figures of docs/performance.md; several minutes)
 MAIN = ("rigid", "superelement", "flexible", "operator", "friction", "fmu", "batch", "realtime", "flagged")
 #: the baseline of the benchmarks that measure one (``fmu``, ``realtime``) unless ``--baseline`` is given
 DEFAULT_BASELINE = "1.0.0"

@@ -1,5 +1,5 @@
-"""Speed and memory of the ring superelement build, and the convergence studies of
-docs/superelement.md.
+"""Speed and memory of the ring superelement build, and its convergence studies (their results:
+docs/theory/superelement.md, Accuracy).
 
     .venv/bin/python -m benchmarks superelement             # benchmark table (~1.5 min)
     .venv/bin/python -m benchmarks superelement --study     # + convergence and patch tables (~4 min)

@@ -1,4 +1,4 @@
-"""Friction torque studies (issue 5): the figures and tables of docs/friction.md.
+"""Friction torque studies: against preload, over one turn, under axial load (docs/guide/manufacturing-errors.md).
 
 Figures (PNG, in --out, default results/friction):
 

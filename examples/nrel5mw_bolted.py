@@ -1,4 +1,6 @@
-"""NREL 5MW pitch bearing: free, clamped and bolted rings over the FAST v8 run (issue 29 item 5).
+"""NREL 5MW pitch bearing: free, clamped and bolted rings over the FAST v8 run.
+
+The results: docs/guide/connected-structures.md ("What it changes").
 
     nice -n 10 .venv/bin/python examples/nrel5mw_bolted.py [-o results/nrel5mw_bolted] [--t-end 20] [--mesh-check]
         [--figure docs/figures/nrel5mw_bolted.png]
@@ -8,7 +10,7 @@
 2. Steps the stand-in pitch bearing through blade 1 of the FAST v8 land-based run (60 s, turbulent
    12 m/s; loads in the blade-root frame, psi = the recorded pitch angle, as ``slewing life`` and the
    study read it: ``slewing_model.study.series.from_openfast``), with four ring models side by side:
-   rigid rings; flexible free rings (the paper's idling model, the study's until issue 29); flexible rings
+   rigid rings; flexible free rings (the paper's idling model); flexible rings
    with clamped bolted faces; flexible rings bolted to the hub and blade-root tubes. Coarse
    superelements (cached). Friction coefficient 0.1 (the study's). Records at every step the peak
    ball load and the friction torque at full sliding (the torque the pitch drive must overcome),
@@ -46,7 +48,7 @@ BOLTED = ROOT / "examples/bearings/pitch_bearing_nrel5mw.toml"
 # Jonkman, Butterfield, Musial, Scott 2009, NREL/TP-500-38060 (NREL 5MW reference turbine)
 # (checked in NREL's FAST input files of the turbine, github.com/old-NWTC/FAST CertTest/5MW_Baseline:
 # NRELOffshrBsline5MW_Onshore_ElastoDyn.dat TipRad 63, HubRad 1.5, HubMass 56780; NRELOffshrBsline5MW_
-# AeroDyn_blade.dat BlChord 3.542 at the root; docs/connected_structures.md)
+# AeroDyn_blade.dat BlChord 3.542 at the root)
 BLADE_LENGTH = 61.5               # m
 ROOT_DIAMETER = 3.542             # m, chord at the blade root (a cylinder)
 HUB_DIAMETER = 3.0                # m

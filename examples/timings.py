@@ -1,4 +1,4 @@
-"""Wall time of each example script, as the README states it.
+"""Wall time of each example script.
 
 Runs every example in a fresh process (``.venv/bin/python examples/NAME.py``), ``--runs``
 times each, one after the other, and prints a markdown table: the median and the range of
@@ -21,7 +21,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: the examples of the README, with what each does
+#: the examples, with what each does
 EXAMPLES = {
     "pitch_manoeuvre": "pitch step with the bearing in the loop (`make demo`)",
     "yaw_manoeuvre": "8 deg yaw move, 6 motors, yaw bearing 3.6 m",

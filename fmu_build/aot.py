@@ -18,7 +18,7 @@ says the target).
 
 numba's ``pycc`` is pending deprecation ("replacement technology is being developed"); it is in
 the pinned numba 0.68.1 and gives the same numbers as numba's JIT, bit for bit, on the benchmark
-cases (docs/speed.md, "Ahead of time"). Linux only: the win64 half of an FMU runs numpy's loops.
+cases (docs/performance.md, "The FMU variants"). Linux only: the win64 half of an FMU runs numpy's loops.
 
 Run: .venv/bin/python -m fmu_build.aot [-o FOLDER] [--target x86-64-v3|generic]    (prints the modules' paths)
 """

@@ -447,8 +447,8 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=No
         on an older system lowers the FMU's glibc floor (``tests/linux_floor/build.sh``).
     """
     if not sys.platform.startswith("linux"):
-        raise RuntimeError(f"a standalone FMU is built on Linux only (this is {sys.platform}); see the README's "
-                           "'Windows' section for what a Windows build needs")
+        raise RuntimeError(f"a standalone FMU is built on Linux only (this is {sys.platform}); its Windows "
+                           "binary is built there too (docs/fmu/hosts.md, 'Windows: the win64 half')")
     cache = Path(cache_dir) if cache_dir else runtime_cache_dir()
     python = interpreter(python)
     key = runtime_key(numba, platform_folder, python)

@@ -22,7 +22,7 @@ checked by their SHA-256:
   the loops are then compiled once under wine, for an x86-64-v3 CPU and for any x86-64 CPU
   (``slewing_model.numerics.targets.PORTABLE_TARGETS``), into the same numba cache files as the Linux ones
   (numba keeps each target's entries apart in them). Without it the win64 half runs
-  numpy's loops; the README gives the cost.
+  numpy's loops; docs/fmu/hosts.md gives the cost.
 
 The staged runtime is cached like the Linux one (``$SLEWING_CACHE_DIR/fmu_runtime/win64-<key>.zip``),
 the downloads in ``$SLEWING_CACHE_DIR/win64_downloads``.

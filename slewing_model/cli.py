@@ -193,7 +193,7 @@ def _add_loads(sub) -> None:
     p.add_argument("--blade", type=int, default=1, metavar="K", help="blade whose pitch bearing")
     p.add_argument("--mounting", default=None,
                    help="which way the bearing's +z axis points: pitch 'tip' (default) or 'hub', yaw 'up' (default) "
-                        "or 'down' (docs/openfast.md)")
+                        "or 'down' (docs/guide/openfast-loads.md)")
     p.add_argument("--frame", choices=("rotating", "fixed"), default="rotating",
                    help="frame of Fx..My: the moving ring's (blade, nacelle) or the fixed ring's (hub, tower)")
     p.add_argument("--source", default="auto",
@@ -219,7 +219,7 @@ def _run_loads(args) -> int:
     series.write_csv(args.output, comments=(
         f"slewing loads: {what} from {args.file}",
         f"channels: {', '.join(used['loads'])} ({used['frame']} frame), psi from {used['angle']}, omega from {rate}",
-        f"mounting = {mounting} (docs/openfast.md); SI units: N, N m, rad, rad/s; Mz opposes positive psi",
+        f"mounting = {mounting} (docs/guide/openfast-loads.md); SI units: N, N m, rad, rad/s; Mz opposes positive psi",
     ))
     print(f"wrote {args.output}: {what}, {series.time.size} rows, t = {series.time[0]:g} .. {series.time[-1]:g} s, "
           f"{args.frame} frame, from {', '.join(used['loads'])} and {used['angle']}")
@@ -268,7 +268,7 @@ def _add_life(sub) -> None:
     from .life import command
 
     p = _add_parser(sub, "life", help="life and wear of one load series: ISO/TS 16281 with oscillations, raceway "
-                                    "damage map, DG03, x/2b (docs/life.md)")
+                                    "damage map, DG03, x/2b (docs/guide/life-and-wear.md)")
     command.add_arguments(p)
     p.set_defaults(func=command.run)
 

@@ -1,4 +1,4 @@
-"""Bearing loads from OpenFAST channels: axes, signs, frames, units (docs/openfast.md)."""
+"""Bearing loads from OpenFAST channels: axes, signs, frames, units (docs/guide/openfast-loads.md)."""
 import dataclasses
 import math
 from pathlib import Path
@@ -181,7 +181,7 @@ def test_fast_v8_b_frame_and_fast_v7_c_frame_runs_agree_loosely():
     v7 = bearing_loads(DATA / "NREL5MW_Land_FASTv7_CertTest18_turb12mps_60s.outb", "pitch", 1)
     for k in (0, 2, 4):                                                          # Fx, Fz (axial), My (flapwise)
         assert v7.loads[:, k].mean() == pytest.approx(v8.loads[:, k].mean(), rel=0.05)
-    assert v8.loads[:, 4].mean() == pytest.approx(8126e3, abs=1e3)               # README: RootMyb1 8126 kN m
+    assert v8.loads[:, 4].mean() == pytest.approx(8126e3, abs=1e3)               # the data's README: RootMyb1 8126 kN m
 
 
 # --- the yaw bearing ----------------------------------------------------------------------------
@@ -336,7 +336,7 @@ def test_load_series_csv_round_trip_with_motion_and_frame(tmp_path):
 
 def test_old_load_series_header_is_still_read():
     shipped = LoadSeries.read_csv(ROOT / "examples/loads/blade_root_loads.csv")
-    assert shipped.loads.shape[1] == 6 and not shipped.has_motion and shipped.load_frame == "rotating"   # issue 28
+    assert shipped.loads.shape[1] == 6 and not shipped.has_motion and shipped.load_frame == "rotating"
     with pytest.raises(ValueError, match="no recorded motion"):
         shipped.motion_at(0.0)
 

@@ -1,4 +1,4 @@
-"""The loops compiled ahead of time (``fmu_build/aot.py``, issue 31): modules that need numpy only, one for
+"""The loops compiled ahead of time (``fmu_build/aot.py``): modules that need numpy only, one for
 an x86-64-v3 CPU and one for any x86-64, each equal to numba's JIT, the first the CPU runs taken, used only
 where they were compiled from these sources, and an FMU that carries them instead of numba and runs in a C
 host."""

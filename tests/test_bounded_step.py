@@ -1,4 +1,4 @@
-"""A bounded step (``step_work="bounded"``, issue 31): a warm solve's work is capped, what it could
+"""A bounded step (``step_work="bounded"``): a warm solve's work is capped, what it could
 not do is flagged and carried over to the next solves, and where it arrives is the complete answer.
 
 The case is the one that made the slowest steps: a tilting moment reversed in one step, which

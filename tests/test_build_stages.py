@@ -1,4 +1,4 @@
-"""`make demo` and build_fmu.py say what they are doing (issue 28): before, `make demo` was silent
+"""`make demo` and build_fmu.py say what they are doing: without it `make demo` would be silent
 for about 11 minutes on a loaded machine before its first progress bar (the superelement, the
 FMU's packaging and Linux binary, its Python runtime, numba's compilation of the loops)."""
 import sys

@@ -1,4 +1,4 @@
-"""A new user's first hour with the ``slewing`` command (issue 25): no silent wrong answers,
+"""A new user's first hour with the ``slewing`` command: no silent wrong answers,
 no nonsense figures, a clean stop on Ctrl-C."""
 import json
 import math

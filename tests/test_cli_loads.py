@@ -86,7 +86,7 @@ def test_loads_command_on_the_real_file_and_its_errors(tmp_path):
     assert out.returncode == 0, out.stderr
     assert "9601 rows" in out.stdout
     series = LoadSeries.read_csv(csv)
-    assert series.loads[:, 4].mean() == pytest.approx(8126e3, abs=1e3)   # README: RootMyb1 8126 kN m, in N m
+    assert series.loads[:, 4].mean() == pytest.approx(8126e3, abs=1e3)   # the data's README: RootMyb1 8126 kN m, in N m
     out = _run("loads", str(V8), "--bearing", "yaw", "-o", str(tmp_path / "yaw.csv"))
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert "YawPzn or NacYaw" in out.stderr and V8.name in out.stderr   # this file has no yaw angle channel

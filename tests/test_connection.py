@@ -1,4 +1,4 @@
-"""Connected structures condensed into the superelement (issue 29, items 1-3).
+"""Connected structures condensed into the superelement (docs/guide/connected-structures.md).
 
 The limits are checked against the superelement's own idealisations, which were built and
 verified independently (tests/test_superelement.py): a very stiff adapter must give the clamped

@@ -1,4 +1,4 @@
-"""CSV errors point at the file's true line (issue 25): comment and blank lines are counted.
+"""CSV errors point at the file's true line: comment and blank lines are counted.
 
 Each file below is written with a known number of comment lines before a bad value, so the
 expected line number is counted by hand in the test, not taken from the reader."""
@@ -51,7 +51,7 @@ def test_ball_csv_names_the_true_line(tmp_path):
         read_ball_csv(path, 5)
 
 
-# ---- time (or angle) that stops increasing: the line where it stops (issue 28) -----------------
+# ---- time (or angle) that stops increasing: the line where it stops ----------------------------
 
 def _swapped(tmp_path, comments=3, rows=200, first=117):
     """A 200-row load series whose rows ``first`` and ``first + 1`` (0-based) are swapped, after

@@ -1,4 +1,4 @@
-"""Figures whose words a reader can read (issue 28): titles show the loads in kN and kN m, not a
+"""Figures whose words a reader can read: titles show the loads in kN and kN m, not a
 raw ``Loads(Fx=0.0, ...)``, and no label, title or legend runs past the figure's edge."""
 import sys
 from pathlib import Path

@@ -1,4 +1,4 @@
-"""Figures a user reads at a glance (issue 25): what each figure states, and that the study
+"""Figures a user reads at a glance: what each figure states, and that the study
 figures draw what a study gives (idling without a drive moment, thousands of cases)."""
 from pathlib import Path
 
@@ -22,7 +22,7 @@ def test_monte_carlo_figure_states_its_error_amplitudes():
 
 
 def test_psi_note_explains_the_sign_of_the_pitch_angle():
-    # docs/openfast.md: a pitch bearing mounted 'tip' (+z to the tip) turns by -BldPitch
+    # docs/guide/openfast-loads.md: a pitch bearing mounted 'tip' (+z to the tip) turns by -BldPitch
     assert "-BldPitch" in psi_note({"kind": "openfast", "bearing": "pitch"})
     assert "+BldPitch" in psi_note({"kind": "openfast", "bearing": "pitch", "mounting": "hub"})
     assert psi_note({"kind": "constant"}) == ""

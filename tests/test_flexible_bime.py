@@ -159,7 +159,7 @@ def test_flexible_gradient_and_hessian_match_finite_differences(table3_errors, t
 
 
 def test_clamped_faces_load_the_contacts_next_to_them_under_a_moment(table1, table1_rings):
-    """Issue 29, item 4. Under a pure moment a rigid bearing loads both diagonals alike and does not
+    """Under a pure moment a rigid bearing loads both diagonals alike and does not
     lift. With the outer ring clamped on its lower face and the inner ring on its upper face,
     contacts 4 and 2 (diagonal 2) sit next to the fixed faces and contacts 1 and 3 (diagonal 1)
     far from them: diagonal 2 is the stiffer one, so it carries more than the rigid value,

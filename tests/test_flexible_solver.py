@@ -390,12 +390,12 @@ def test_operator_in_single_precision_reaches_the_double_precision_equilibrium(m
     a few ``eps cond(W)`` of the exact inverse, and the solver, whose step is in increments, reaches the
     equilibrium an operator in double precision gives, to its tolerance: the inverse's error (and the
     rounding of the Newton step's product with it, partly summed in single precision,
-    ``reduced_operator.single_product``) slows its contraction, it does not stay in the answer (with the step computing the forces themselves, as it
-    did, the solves stalled at 1.5-3.7e-7: docs/speed.md). Its cost in Newton iterations is counted
+    ``reduced_operator.single_product``) slows its contraction, it does not stay in the answer (a step
+    computing the forces themselves, not their increments, stalls at 1.5-3.7e-7). Its cost in Newton iterations is counted
     over this load and four others (single at most 1.25 times double; measured 143 against 127):
     one solve alone follows its own path of operators (this one: 33 against 22 iterations since its
-    first operator, which the inverse by halves misses in single precision, is no longer inverted
-    exactly by LAPACK but through its factor in single precision; over twelve other loads, at
+    first operator, which the inverse by halves misses in single precision, is inverted through its
+    factor in single precision, not exactly by LAPACK; over twelve other loads, at
     ``rtol`` 1e-10, single precision took 314 iterations and double 331)."""
     from slewing_model import load_bearing
     from slewing_model.rings import reduced_operator

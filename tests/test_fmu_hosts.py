@@ -353,7 +353,8 @@ try:
 except Exception as exc:
     print("RAISED", exc)
 """)
-    # TMPDIR: simulate_fmu does not remove the FMU it unzipped when a step fails (FMPy issue 675)
+    # TMPDIR: simulate_fmu does not remove the FMU it unzipped when a step fails (FMPy issue 675,
+    # https://github.com/CATIA-Systems/FMPy/issues/675)
     run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
                          env={**os.environ, "TMPDIR": str(tmp_path)})
     assert "RAISED fmi2DoStep failed with status 3 (error)" in run.stdout, run.stdout + run.stderr

@@ -1,5 +1,5 @@
 """Friction torque (slewing_model.friction) against closed forms, an independent
-per-contact recomputation, and the physical behaviours asked for in issue 5.
+per-contact recomputation, and the physical behaviours the model must show.
 
 Expected values come from closed forms (with their sources), from scipy
 integrations written here independently of the module, or from relations the

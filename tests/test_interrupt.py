@@ -1,4 +1,4 @@
-"""Ctrl-C (SIGINT) in ``slewing batch`` and ``slewing superelement`` (issue 25): one line on
+"""Ctrl-C (SIGINT) in ``slewing batch`` and ``slewing superelement``: one line on
 stderr, exit status 130 (128 + SIGINT, as a shell reports a command it interrupted), and for a
 study a valid ``summary.csv`` of the cases finished so far, which a rerun resumes."""
 import csv
@@ -103,7 +103,7 @@ def test_ctrl_c_to_the_process_group_ends_the_workers_quietly(tmp_path):
     The workers must end without a word (before: a traceback of each, 68-100 lines), the parent
     prints its one line, exit 130, summary.csv of the finished cases, and no process of the group
     is left behind. Dask's default dashboard port is held meanwhile, as when another Dask runs:
-    no "Port 8787 is already in use" warning either (issue 28)."""
+    no "Port 8787 is already in use" warning either."""
     study = tmp_path / "study.toml"
     study.write_text(STUDY)
     out_dir = tmp_path / "out"

@@ -1,4 +1,4 @@
-"""Life and wear (issue 24): published ISO/TS 16281 values and closed forms.
+"""Life and wear: published ISO/TS 16281 values and closed forms.
 
 Every expected value comes from a published case or a closed form stated in the test, never
 from the code's own output.
@@ -14,7 +14,7 @@ from slewing_model.numerics.compiled import AVAILABLE
 from slewing_model import load_bearing
 from slewing_model.life.wear import travel_by_ring_kinematics
 
-# ---- the published ISO/TS 16281 case of a radial ball bearing (issue 24) --------------------------
+# ---- the published ISO/TS 16281 case of a radial ball bearing -------------------------------------
 Z, DW, DM = 7, 11.5e-3, 43.5e-3
 RI, RE, C = 0.52 * DW, 0.53 * DW, 23400.0
 
@@ -192,10 +192,10 @@ def test_small_oscillation_damages_only_the_slices_balls_cross(kernel):
 
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_track_damage_kept_step_by_step_equals_the_whole_map_and_states_stay_as_taken(kernel):
-    """The map changes only where balls crossed, and each track's sum of d_j^(10/9) follows it
-    (issue 31): after a swinging and turning run it equals the sum over the whole map to
-    round-off; a state taken mid-run (the simulator takes one before every step) is not changed
-    by the steps after it, and restoring it gives back the same damages bit for bit."""
+    """The map changes only where balls crossed, and each track's sum of d_j^(10/9) follows it:
+    after a swinging and turning run it equals the sum over the whole map to round-off; a state
+    taken mid-run (the simulator takes one before every step) is not changed by the steps after it,
+    and restoring it gives back the same damages bit for bit."""
     from slewing_model.life.raceway_map import track_damage
 
     model = life.LifeModel(BEARING, "inner", "fixed")
@@ -352,7 +352,7 @@ def test_outer_ring_rotating_swaps_the_exponents():
     assert r.equivalent_load[1] == pytest.approx((np.sum(q ** 3) / Z) ** (1 / 3), rel=1e-14)
 
 
-# ---- issue 28: wrong answers found by a new user and by the life review ----------------------------
+# ---- wrong answers a new user or a life review would meet ------------------------------------------
 @pytest.mark.parametrize("phase_deg", [0.0, 37.0, 90.0, 180.0, 270.0])
 def test_relubrication_gap_does_not_depend_on_where_the_record_starts(phase_deg):
     """A steady ±3° swing at 0.2 Hz (range 6° above the 4.86° threshold) over 40 s: the longest time
@@ -400,7 +400,7 @@ def test_small_swing_exponent_of_the_turning_ring_against_the_closed_form():
     turns relative to the load, yet each point of its raceway meets only the ball next to it, as on a
     ring standing under the load. Its cycle damage takes Qe with exponent 10/3: D = n f(θ)^-3
     (Qe,10/3 / Qc)^3 / 10^6, Qe from the closed form of the moment distribution; the factor against
-    ISO's exponent 3 is (Qe,10/3 / Qe,3)^3 = 1.1389 (closed form; issue 28 quotes about 1.14)."""
+    ISO's exponent 3 is (Qe,10/3 / Qe,3)^3 = 1.1389 (closed form)."""
     model = life.LifeModel(BEARING, "inner", "fixed")
     acc = life.LifeAccumulator(model, record=True)
     theta, n = math.radians(1.0), 4

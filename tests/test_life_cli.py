@@ -44,7 +44,7 @@ def test_parquet_time_series_round_trip(tmp_path):
     np.testing.assert_array_equal(np.column_stack([back.column(c).to_numpy() for c in TIMESERIES_COLUMNS]), table)
 
 
-# ---- issue 28: what a new user tripped on ------------------------------------------------------------
+# ---- what a new user trips on ------------------------------------------------------------------------
 TABLE3 = ROOT / "examples/bearings/table3.toml"
 
 
@@ -154,18 +154,6 @@ def test_life_help_shows_defaults_like_the_other_commands(capsys):
     for option in ("--ring-model", "--slices", "--relubrication-swing", "--rating", "--output"):
         assert option in text
     assert "(default: rigid)" in text and "(default: the first count from 1440" in text
-
-
-def test_docs_life_commands_write_only_into_results():
-    """The commands docs/life.md gives write into results/ (ignored by git), not into the
-    repository's root: the former `-o fastv8.csv` left an untracked file behind."""
-    import re
-
-    text = (ROOT / "docs/life.md").read_text()
-    outputs = re.findall(r"\.venv/bin/slewing (?:loads|life|batch) .*?-o (\S+)", text)
-    assert len(outputs) >= 3
-    assert all(o.startswith("results/") for o in outputs), outputs
-    assert "results/" in (ROOT / ".gitignore").read_text().split()
 
 
 def test_life_cli_runs_on_the_shipped_pitch_series(tmp_path):

@@ -1,4 +1,4 @@
-"""The FMU's life outputs (issue 24): equal to the library's over a run, and rolled back exactly."""
+"""The FMU's life outputs: equal to the library's over a run, and rolled back exactly."""
 import math
 import shutil
 from pathlib import Path
@@ -53,7 +53,7 @@ def test_fmu_life_outputs_equal_the_library(slave):
     """The library stepped as the FMU steps (an initial solve at zero inputs, then each step) gives the
     same worst-track damage and x/2b of the last completed half-cycle, to 1e-7 relative.
 
-    Not to round-off (1e-12 until the twenty-fifth turn of issue 31): the two differ at round-off (the
+    Not to round-off: the two differ at round-off (the
     FMU's superelement and loops are built apart from this test's), and the Newton step rounds its right
     side to single precision for the kept inverse's product (``reduced_operator.single_product``), where a
     round-off difference can change a rounding by one unit (6e-8 of that side): the equilibria then differ

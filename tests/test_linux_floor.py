@@ -1,4 +1,4 @@
-"""The floor-lowered standalone FMU (issue 30): glibc 2.28 and GCC 6's libstdc++, shown in Debian 11.
+"""The floor-lowered standalone FMU: glibc 2.28 and GCC 6's libstdc++, shown in Debian 11.
 
 ``tests/linux_floor/build.sh`` builds, in a Debian 11 ("bullseye") build chroot, a CPython 3.11 with the venv's
 numpy, numba and llvmlite wheels, pythonfmu's FMI 2.0 export library and fmusim; ``build_fmu.py --linux-floor``

@@ -1,4 +1,4 @@
-"""The NREL 5MW bolted example (issue 29 item 5, docs/connected_structures.md): the bearing file
+"""The NREL 5MW bolted example (docs/guide/connected-structures.md): the bearing file
 holds the hub and blade root its script derives from the published sources (no build, no run)."""
 import importlib.util
 import math
@@ -40,7 +40,7 @@ def test_bearing_file_holds_the_derived_hub_and_blade_root():
 
 
 def test_nrel5mw_study_runs_the_bearing_as_it_is_bolted():
-    """The NREL 5MW study's default bearing is the bolted one (issue 29): every case runs flexible
+    """The NREL 5MW study's default bearing is the bolted one: every case runs flexible
     rings on the bearing file that holds the hub and blade root, the rings' support left to them."""
     from slewing_model.study import load_study
 

@@ -182,9 +182,10 @@ def test_real_file_layout_matches_the_readme(name, rows, t0, t1, dt, channels):
     assert all(np.all(np.isfinite(v)) for v in out.channels.values())
 
 
-# README, "Statistics over 0-60 s" of the FAST v8 file: mean +- standard deviation, printed to the digit shown
-# (Wind1VelX: the README prints 1.17 for the standard deviation, the data give 1.1648 -- openfast_io 5.0.0
-# decodes every value of this file identically to this reader -- so only its mean is compared)
+# ../shared/data/openfast/README.md, its line "Statistics over 0-60 s" of the FAST v8 file: mean +- standard
+# deviation, printed to the digit shown (Wind1VelX: the README prints 1.17 for the standard deviation, the
+# data give 1.1648 -- openfast_io 5.0.0 decodes every value of this file identically to this reader -- so only
+# its mean is compared)
 V8_STATISTICS = [
     ("Wind1VelX", 12.94, None, 0.005), ("RotSpeed", 12.08, 0.28, 0.005), ("BldPitch1", 3.47, 2.51, 0.005),
     ("RootMyb1", 8126, 1530, 0.5), ("RootMxb1", 854, 2536, 0.5), ("RootFzb1", 600, 126, 0.5),

@@ -46,14 +46,14 @@ OUTPUTS = ["z", "rx", "friction_torque", "max_ball_load", "static_safety_factor"
 H = 0.01
 #: how far a host's outputs may be from fmpy's driving the same FMU on the same machine: the same code and CPU,
 #: but another process can sum in another order, and the solver's stop rule carries that round-off on. On this
-#: project's AMD EPYC machine (issue 31's twenty-third turn) the bare systems' hosts gave friction torques 2e-10
-#: from fmpy's (7e-12 on earlier machines), and the FMU unpacked in another folder, or the system with /proc and
-#: /sys mounted, moved them by as much: something of the process's layout, not of the FMU, orders the sums. The
+#: project's AMD EPYC machine the bare systems' hosts give friction torques 2e-10 from fmpy's (7e-12 on other
+#: machines), and the FMU unpacked in another folder, or the system with /proc and /sys mounted, moves them by
+#: as much: something of the process's layout, not of the FMU, orders the sums. The
 #: project's other tests of one FMU in another environment hold the same 1e-9 (tests/test_linux_floor.py,
 #: tests/test_win64.py)
 SAME_FMU = 1e-9
-#: fmusim's runs of each FMU in each bare system: 3 in ``make test`` (20 until the twentieth turn, then 10 and 5,
-#: as this machine ran up to twice as slow and the CI neared its 20 minutes); SLEWING_FMUSIM_RUNS=20 for the docs' 20
+#: fmusim's runs of each FMU in each bare system: 3 in ``make test`` (more would bring the CI near its 20 minutes
+#: on a slow day); SLEWING_FMUSIM_RUNS=20 for the 20 of docs/fmu/hosts.md
 FMUSIM_RUNS = int(os.environ.get("SLEWING_FMUSIM_RUNS", "3"))
 HOST_RUNS = int(os.environ.get("SLEWING_HOST_RUNS", "2"))  # our C host's basic scenario, repeated
 MODEL = {2: "SlewingBearing", 3: "SlewingBearing3"}

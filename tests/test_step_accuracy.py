@@ -1,4 +1,4 @@
-"""The co-simulation step answers as exactly as a tight solve (issue 12: speed is not bought with accuracy).
+"""The co-simulation step answers as exactly as a tight solve: speed is not bought with accuracy.
 
 Short versions of the benchmark cases (`benchmarks/cases.py`: the 150-ball pitch bearing pitching
 under the blade-root series, the 180-ball yaw bearing yawing in bursts under the tower-top series,

@@ -195,7 +195,7 @@ def test_bad_cases_are_reported_and_the_others_finish(tmp_path, capsys):
     assert all("\n" not in r["status"] for r in rows.values())
     printed = capsys.readouterr()
     assert "4 failed" in printed.out
-    # each failure names the study file and the case (issue 25)
+    # each failure names the study file and the case
     assert f"{path}: case " in printed.err and "(garbled | table3" in printed.err
 
 
@@ -286,7 +286,7 @@ def test_superelement_built_once_per_bearing_variant(tmp_path):
     flexible[0].check(load_bearing(TABLE3))              # built for this bearing
 
 
-# ---- the files a study names are checked before anything runs (issue 28) ----------------------------
+# ---- the files a study names are checked before anything runs ---------------------------------------
 
 def test_missing_bearing_file_is_refused_up_front_with_one_message(tmp_path, capsys):
     """Before: each of the study's cases failed with the same ValueError (8 lines), exit 1, and

@@ -1,4 +1,4 @@
-"""Ring superelement (issue 3): the harmonic FE model against closed-form ring theory, the
+"""Ring superelement: the harmonic FE model against closed-form ring theory, the
 coupling's treatment of the Hertz part, and the properties of the condensed matrix.
 
 Closed forms used (sources in each test):
@@ -374,8 +374,8 @@ def test_command_writes_the_file_and_prints_a_summary(tmp_path, cache, capsys):
 
 def test_fine_section_mesh_is_built_without_scikit_fem_warnings(caplog):
     """The yaw bearing's fine outer-ring mesh has over 1000 elements: scikit-fem logged
-    "Transforming over 1000 elements to C_CONTIGUOUS." for it (the yaw example's stray line,
-    issue 28) when given the element table transposed."""
+    "Transforming over 1000 elements to C_CONTIGUOUS." for it (a stray line in the yaw
+    example's output) when given the element table transposed."""
     import logging
 
     from slewing_model import load_bearing
@@ -390,7 +390,7 @@ def test_fine_section_mesh_is_built_without_scikit_fem_warnings(caplog):
     assert [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING] == []
     assert all(sm.mesh.t.flags["C_CONTIGUOUS"] and sm.mesh.p.flags["C_CONTIGUOUS"] for sm in meshes)
 
-# ---- the clamped face (issue 29, item 4) -----------------------------------------------------
+# ---- the clamped face ------------------------------------------------------------------------
 
 def test_long_wave_halfspace_subtraction_is_given_back_exactly_for_a_clamped_ring(table3, monkeypatch):
     """The 2-D half-space compliance of a row of patches diverges at n = 0; the condensation

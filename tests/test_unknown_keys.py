@@ -1,9 +1,10 @@
-"""Every table of a bearing file and of a study file refuses a key it does not know (issue 25).
+"""Every table of a bearing file and of a study file refuses a key it does not know.
 
 A misspelt key used to be ignored and its default used without a word (``[material]
 youngs_modulus = 100.0`` gave the 200 GPa result). Each refusal names the file, the table,
 the key and the known keys. The known keys below are written out from the file formats
-documented in README.md and slewing_model/study/definition.py, not taken from the code.
+documented in docs/guide/bearing-files.md, docs/guide/studies.md and
+slewing_model/study/definition.py, not taken from the code.
 """
 import re
 import subprocess

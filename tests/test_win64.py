@@ -11,14 +11,12 @@ fmpy's outputs on Linux within 1e-9 relative.
 
 The tolerance: the Windows half runs another numpy (1.26.4 with its OpenBLAS, against 2.x on Linux) and
 another C library's libm (wine's ucrtbase against glibc), so the last bits of the solver's
-floating-point results may differ; both Newton solvers converge to 1e-12 or better, and 3e-14 was
-measured. 1e-9 is what the Linux tests allow between machine codes (numba's generic loops). Since the
-Newton step rounds its right side to single precision for the kept inverse's product
-(``reduced_operator.single_product``, issue 31's twenty-fifth turn), a round-off difference can change one
-such rounding and the two halves' equilibria differ within the solver's tolerance: measured 2.6e-10 (the
-friction torque in the C host's six steps; z 1e-11, the others below 6e-11), against 2.2e-11 on the commit
-before (``50781ef``, the same steps; the 3e-14 above is an older measurement). ``SLEWING_WIN64_REL`` sets another
-tolerance, to measure the margin.
+floating-point results may differ; both Newton solvers converge to 1e-12 or better. 1e-9 is what the
+Linux tests allow between machine codes (numba's generic loops). The Newton step rounds its right side to
+single precision for the kept inverse's product (``reduced_operator.single_product``), so a round-off
+difference can change one such rounding and the two halves' equilibria differ within the solver's
+tolerance: measured 2.6e-10 (the friction torque in the C host's six steps; z 1e-11, the others below
+6e-11). ``SLEWING_WIN64_REL`` sets another tolerance, to measure the margin.
 
 Wine (Debian's wine 8) and mingw-w64 are installed by ``make`` as root; the prefix and the Windows Python
 are kept in ``$SLEWING_WINE_DIR`` (default /var/cache/slewing-wine). Without root or without them the
@@ -430,7 +428,7 @@ def test_the_ssps_four_fmus_carry_win64_and_run_together_in_fmpy_on_windows(tabl
 
 
 def test_a_non_ascii_folder_is_refused_with_a_message_not_a_crash(fmus, hosts, tmp_path):
-    # a known limit of pythonfmu's Windows DLL (docs/standalone_fmu.md): given such a folder it fails or crashes
+    # a known limit of pythonfmu's Windows DLL (docs/fmu/hosts.md): given such a folder it fails or crashes
     # the host, so our layer refuses it first, saying why; the host goes on
     for case in ("bearing2", "bearing3"):
         folder = w.unpack(fmus[case], tmp_path / f"Lager für {case}")
@@ -445,4 +443,4 @@ def test_a_non_ascii_folder_is_refused_with_a_message_not_a_crash(fmus, hosts, t
             # loaded nothing (the check comes before Python and pythonfmu's DLL). Not diagnosed: the
             # refusal above is asserted; the crash at exit is reported as an expected failure, not hidden
             pytest.xfail(f"{case}: wine page fault at the test host's exit after the refusal (intermittent, "
-                         "not diagnosed; issue 30's note)")
+                         "not diagnosed)")

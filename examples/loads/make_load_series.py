@@ -38,7 +38,7 @@ PITCH_SCHEDULE = dict(mean_deg=3.0, turbulence_deg=1.5, time_constant_s=1.5, gus
 def pitch_series(loads=PITCH_LOADS, schedule=PITCH_SCHEDULE):
     """The blade-root loads with the pitch bearing's motion: the pitch angle beta follows the thrust's
     turbulence through a first-order lag (more thrust, more pitch to feather), plus a gust step at the
-    drive's rate; psi = -beta (the bearing's +z towards the blade tip, docs/openfast.md) and omega its
+    drive's rate; psi = -beta (the bearing's +z towards the blade tip, docs/guide/openfast-loads.md) and omega its
     time derivative."""
     series = synthetic_blade_root_loads(**loads)
     t = series.time

@@ -1,4 +1,4 @@
-"""The C3D20 tube mesh of the CalculiX tube references (issue 29): one mesher for
+"""The C3D20 tube mesh of the CalculiX tube references: one mesher for
 ``references/calculix/connected/imported_tube.py`` and ``references/calculix/calculix_tube.py``.
 
 Both import it as ``references.calculix.tube_mesh`` with the repository root on ``sys.path``.

@@ -1,5 +1,5 @@
 """What a ring's bolted face is bolted to: the ``[connection.outer]`` / ``[connection.inner]`` tables
-of a bearing file (issue 29, items 1-2).
+of a bearing file (docs/guide/connected-structures.md).
 
 A ring whose table is given is joined, over its bolted face (``[rings] *_bolted_face``), to the
 stiffness of the structure it is bolted to, and the superelement

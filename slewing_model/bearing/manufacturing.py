@@ -10,7 +10,7 @@ individual ball diameters.
   Values at a ball are interpolated linearly and periodically.
 * Each ball carries a diameter deviation (ball ``b`` keeps its own).
 
-CSV formats (documented in the README):
+CSV formats (docs/guide/manufacturing-errors.md):
 
 ring file
     ``angle_deg,radial_um_<i>,axial_um_<i>[,groove_radius_mm_<i>]`` for both

@@ -73,21 +73,21 @@ from ..rings.reduced_operator import (
 from ..rings.compliance import contact_compliance, product_operands, ring_compliances, ring_selector  # noqa: F401
 
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
-#: residual by less than this factor (0.25 until a new operator was spread over two steps;
-#: since, 0.4 measured better: pitch mean -3 %, yaw 95th percentile -35 %; docs/speed.md)
+#: residual by less than this factor (with a new operator spread over two steps, 0.4 measures better
+#: than 0.25: pitch mean -3 %, yaw 95th percentile -35 %)
 REFRESH = 0.4
 #: ... unless, at the rate of that iteration, the residual reaches the tolerance within this many
 #: more iterations, which cost less than a new operator (pitch bearing: 3 of 0.1 ms against
-#: one operator of 2.5 ms, 4 ms when this was measured; docs/speed.md)
+#: one operator of 2.5 ms)
 FINISH_ITERATIONS = 3
 #: in a warm solve a new operator is inverted over this solve and the next (a bounded one: as its work
 #: allows, BOUNDED_WORK), while the solver goes on
 #: with the one it has (:class:`slewing_model.rings.reduced_operator.PendingOperator`); all at once when an
-#: iteration past this many in one solve is still slow (docs/speed.md)
+#: iteration past this many in one solve is still slow
 SPREAD_ITERATIONS = 8
 #: what a bounded warm solve (``step_work="bounded"``) may spend of work: the ring operator's, and at
 #: least one piece of it (forming ``W``, a stage of its inverse on its way, a bordering), whatever else
-#: it spent; and, since issue 31's thirteenth turn, its Newton iterations' (:data:`ITERATION_WEIGHT`): once
+#: it spent; and its Newton iterations' (:data:`ITERATION_WEIGHT`): once
 #: it has done operator work it starts an iteration only where the work left covers it. Floating-point
 #: operations weighted so that they track time, some 55 million a millisecond on one core here (the
 #: stages of a spread inverse of ``W = (A^-1 + M)_aa``:
@@ -95,21 +95,18 @@ SPREAD_ITERATIONS = 8
 #: :func:`~slewing_model.rings.reduced_operator.forming_work`;
 #: bordering: :func:`~slewing_model.rings.reduced_operator.bordering_work`). Work, not time, so that a
 #: step's answer does not depend on the machine. 1e8, about 1.8 ms, chosen by the pitch bearing's
-#: scenarios of ``benchmarks/bench_realtime.py`` with ``benchmarks/bench_bound.py`` (library, caps side
-#: by side in one run; docs/speed.md, "Issue 31, fifteenth turn"), once a new operator's check and
-#: coupling no longer took 0.4-0.5 ms outside the count: against 1.1e8 (the thirteenth turn's choice),
-#: two runs, the slowest steps of the reversal, the jump, the feather and the turbulence 3.3-3.6 NREL
-#: medians instead of 3.6-4.7, none of them over 4 instead of 0-7 a scenario; NREL's flagged steps 61 of
-#: 6000 instead of 36, the reversal's 51 of 2000 instead of 44 (9e7: 198 and 65). Before, 8e7 of operator
-#: work alone, with the iterations free and the stages counted at 0.75 of their time (the eleventh turn).
-#: ...
+#: scenarios of the ``realtime`` benchmark (``python -m benchmarks realtime``; the library's solves, caps
+#: side by side in one run): against 1.1e8, two runs, the slowest steps of the reversal, the jump, the
+#: feather and the turbulence 3.3-3.6 NREL medians instead of 3.6-4.7, none of them over 4 instead of 0-7
+#: a scenario; NREL's flagged steps 61 of 6000 instead of 36, the reversal's 51 of 2000 instead of 44
+#: (9e7: 198 and 65)
 BOUNDED_WORK = 1e8
 #: a bounded solve's one piece of operator work (:meth:`BimeSolver._take`), where it is a bordering, borders
 #: the contacts that closed whose work is at most this, or the work left if more (that a run of bounded solves
 #: gets on; :meth:`BimeSolver._bordering_that_fits`): what a step has after a held-rings start (HELD_WORK)
 BORDER_PIECE = 5e7
 #: ... and Newton iterations (each a product with ``W^-1`` and a line search: 0.05-0.2 ms on the
-#: pitch bearing); what is left is carried over to the next solve (docs/speed.md, "Issue 31, third turn")
+#: pitch bearing); what is left is carried over to the next solve
 BOUNDED_ITERATIONS = 12
 #: a warm start whose relative residual is above this (the loads jumped) tries the moving ring's
 #: equilibrium with the rings held (BimeSolver._held_rings_start); steps of slowly varying loads
@@ -126,20 +123,19 @@ DAMPING = 1e-12
 RIGID_START_TOLERANCE = 1e-6
 #: ... and kept where more than this share of the diagonals it loads were open at the start
 HELD_NEW_CONTACTS = 0.25
-#: the held-rings start's rigid solve counts as this much of a bounded solve's BOUNDED_WORK. Sized by its
-#: time when it was 0.9 ms on the pitch bearing (about half a step's operator work;
-#: benchmarks/bench_held_start.py); compiled since (kernel._rigid_solve), it takes 0.15 ms, but a step
-#: that tries it is a step after a jump, whose Newton iterations and friction's cold balls cost more too:
-#: charged by its time alone (1e7), the reversal's bounded run flagged 41 steps instead of 54, but 8-17 of its
-#: steps took more than 4.2 ms instead of 2-5, the slowest 5.1-5.2 ms against 4.5-4.7, and its first step
-#: from the start values 5.4-5.5 ms against 4.1-4.6 (three runs; docs/speed.md, "Issue 31, twelfth turn")
+#: the held-rings start's rigid solve counts as this much of a bounded solve's BOUNDED_WORK (about 0.9 ms,
+#: half a step's operator work, on the pitch bearing). Compiled (kernel._rigid_solve) it takes 0.15 ms, but
+#: a step that tries it is a step after a jump, whose Newton iterations and friction's cold balls cost more
+#: too: charged by its time alone (1e7), the reversal's bounded run flags 41 steps instead of 54, but 8-17 of
+#: its steps take more than 4.2 ms instead of 2-5, the slowest 5.1-5.2 ms against 4.5-4.7, and its first step
+#: from the start values 5.4-5.5 ms against 4.1-4.6 (three runs)
 HELD_WORK = 5e7
 #: a bounded solve's Newton iterations count against BOUNDED_WORK too, each (BimeSolver._iteration_work)
 #: its product with the operator's inverse, ``2 n^2`` for ``n`` rows, times the first, and its trial point and
 #: ring products, the second times the balls: 2.9e6 for the pitch bearing's kept operator (368 rows, 150
-#: balls), whose iterations took 55 us each in a step (``benchmarks/bench_step_parts.py``: 254 us for 4.6).
-#: With the kept inverse in single precision (fourteenth turn) they take 44.8 us; a product factor of 2.9
-#: made no clear difference side by side (docs/speed.md), so it stays
+#: balls), whose iterations take 44.8 us each in a step with the kept inverse in single precision (55 us
+#: in double; ``python -m benchmarks step_parts``). A product factor of 2.9 instead of 5.0 makes no clear
+#: difference side by side, so it stays
 ITERATION_WEIGHT = (5.0, 1.1e4)
 STEP_WORK = ("complete", "bounded")
 #: a warm solve with a kept operator and no stage of a new one due (a co-simulation's usual step) runs its
@@ -508,7 +504,7 @@ class BimeSolver:
                 return self._result(loads, point, iterations, residual, contacts=contacts)
         # the iterations beyond the usual step's compiled call: the operator's work runs numpy's BLAS on
         # blas_threads threads (the usual step uses none: its context's three calls to OpenBLAS cost
-        # about 20 us of it, docs/speed.md, "Issue 31, eighteenth turn")
+        # about 20 us of it)
         with blas_threads(self.blas_threads):
             if point is None:
                 point = self._evaluate(qs, y, f_scaled)
@@ -910,10 +906,10 @@ class BimeSolver:
         (:func:`~slewing_model.rings.reduced_operator.bordering_work`); where the solve did no operator
         work yet (its one piece, :meth:`_take`), what :data:`BORDER_PIECE` allows if more. The others
         carry no force in this solve's Newton steps (as a fresh operator's rows left out,
-        :func:`~slewing_model.rings.reduced_operator.off_rows`) and enter in the next solves. Before, the
-        pitch bearing's NREL step 3 from its start values bordered 74 rows onto 402 at once: 1.8 ms of work
-        by its count where the held-rings start had left 0.9 ms (3.4 ms measured), the scenario's slowest
-        step (docs/speed.md, "Issue 31, seventeenth turn")."""
+        :func:`~slewing_model.rings.reduced_operator.off_rows`) and enter in the next solves. All at once,
+        the pitch bearing's NREL step 3 from its start values would border 74 rows onto 402: 1.8 ms of work
+        by its count where the held-rings start left 0.9 ms (3.4 ms measured), the scenario's slowest
+        step."""
         n, count = op.rows.size, int(np.count_nonzero(closed))
         allowed = self._work_left if self._operator_work_done else max(self._work_left, BORDER_PIECE)
         if bordering_work(2 * count, n) <= allowed:

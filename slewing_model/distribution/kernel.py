@@ -26,8 +26,8 @@ of operations, one loop each:
 
 Where a loop sums ``W^-1 v`` it does so column by column (``W^-1`` symmetric), which differs from
 numpy's row sums by round-off; the Newton step's product with a single-precision ``W^-1`` is partly
-summed in single precision, the same operations in both paths (:func:`_single_times`). docs/speed.md
-has what each gave.
+summed in single precision, the same operations in both paths (:func:`_single_times`; why:
+docs/design-decisions.md, "The kept operator in single precision, and what it means").
 
 numba is optional, as for the friction's loops (:mod:`slewing_model.friction.kernel`, whose
 :func:`~slewing_model.friction.kernel.compile_all` compiles these too, and whose
@@ -72,7 +72,7 @@ def _trial_point(separation, jacobian_rows, qs, dq, y, dy, ring_motion, ring_mot
     Three passes over the springs: ``e``; then each spring's length, direction and force; then the
     sums, in the order of one pass (so the same numbers bit for bit), the gradient's five in locals.
     Apart, the first two carry no chain of sums, whose latency held the one pass: 33 -> 26 us (pitch
-    bearing, hot; docs/speed.md, "Issue 31, twenty-fourth turn")."""
+    bearing, hot)."""
     n_balls = separation.shape[0]
     qs_t = qs + t * dq
     y_t = y + t * dy
@@ -153,8 +153,7 @@ def _symmetric_times(matrix, vectors):
 
     Four columns a pass, ``out += (M_j v_j + M_j+1 v_j+1) + (M_j+2 v_j+2 + M_j+3 v_j+3)``: ``out`` read and
     written once for four of ``M``'s rows, not for each (its passes, not ``M``'s, were the cost: 1.4 times
-    faster for one vector of 370-460 rows, summed in double all the same; docs/speed.md, "Issue 31,
-    sixteenth turn")."""
+    faster for one vector of 370-460 rows, summed in double all the same)."""
     k, n = vectors.shape
     out = np.zeros((k, n))
     j = 0
@@ -186,7 +185,7 @@ def _single_times(matrix, vector):
     (45 -> 21 us hot, 376 rows). The sum's rounding,
     about ``1e-7`` of ``|W^-1| |v|``, is of the size of the single-precision inverse's own error (about
     ``1e-7 cond(W)``): it changes the Newton direction, not the step's fixed point
-    (:func:`_newton_step`, in increments). docs/speed.md, "Issue 31, twenty-fifth turn"."""
+    (:func:`_newton_step`, in increments)."""
     n = vector.size
     v = vector.astype(np.float32)
     out = np.zeros(n)
@@ -546,8 +545,8 @@ def _segment(x, xp, guess):
 
     The bisection halves the range ``[base, base + size)`` that holds ``j`` by moving its start or not:
     a choice LLVM makes without a branch, where ``lo, hi`` moved by an ``if`` mispredicted about half of
-    its 13 steps in the 6001-row Hertz table (the contacts' results 114 -> 101 us hot, pitch bearing;
-    docs/speed.md, "Issue 31, twenty-fourth turn")."""
+    its 13 steps in the 6001-row Hertz table (the contacts' results 114 -> 101 us hot, pitch
+    bearing)."""
     last = xp.size - 1
     if 0 <= guess < last and xp[guess] <= x < xp[guess + 1]:
         return guess
@@ -703,8 +702,7 @@ def _ring_times(cos_table, sin_table, harmonic_real, harmonic_imag, v):
 
     Both sums take four balls (four harmonics) a pass over a row of ``V`` (of the result): each entry
     read and written once for four terms, added one after the other in the order of a pass per ball,
-    so the same numbers as that, bit for bit, in 26 instead of 32 us (pitch bearing, hot; docs/speed.md,
-    "Issue 31, twenty-fourth turn")."""
+    so the same numbers as that, bit for bit, in 26 instead of 32 us (pitch bearing, hot)."""
     n_harmonics = cos_table.shape[0]
     m = harmonic_real.shape[1]
     n_balls = v.size // m
@@ -1087,12 +1085,11 @@ ERROR_MODEL = "numpy"
 
 
 #: LLVM's fast-math flags of these loops: none. ``contract`` (fused multiply-adds, as the friction's loops take,
-#: :data:`slewing_model.friction.kernel.FASTMATH`) made the usual solve's one call 0.94-0.97 as long (hot, call by
-#: call, ``benchmarks/bench_kernel_ab.py --kernel distribution --flags contract``), about 2 % of a step, but the
-#: Newton iterations' residuals then move by round-off, and where one sits at the stop rule's tolerance the
-#: rounding decides an iteration: the answers would depend on whether the CPU the loops are compiled for has
-#: fused multiply-adds (numba's loops for this CPU against the generic ones, or numpy's), by more than round-off
-#: (docs/speed.md, "Issue 31, twenty-third turn"). ``bench_kernel_ab.py --flags`` tries other flags
+#: :data:`slewing_model.friction.kernel.FASTMATH`) makes the usual solve's one call 0.94-0.97 as long (hot, call by
+#: call), about 2 % of a step, but the Newton iterations' residuals then move by round-off, and where one sits at
+#: the stop rule's tolerance the rounding decides an iteration: the answers would depend on whether the CPU the
+#: loops are compiled for has fused multiply-adds (numba's loops for this CPU against the generic ones, or
+#: numpy's), by more than round-off
 FASTMATH = frozenset()
 
 
@@ -1148,7 +1145,7 @@ def column_turn(old, new, coupling, mu, tolerance=0.0):
 
 #: from this many new rows on, bordering is numpy's (BLAS's products): the compiled loop sums
 #: ``W^-1 B`` and ``X S X^T`` without blocking: 7.3 ms against 2.0 ms for 92 rows onto 368, 0.75
-#: against 0.60 ms for 16, 0.52 against 0.58 for 12 (benchmarks/bench_operator.py --border)
+#: against 0.60 ms for 16, 0.52 against 0.58 for 12 (``python -m benchmarks operator --border``)
 BORDER_BLAS_ROWS = 12
 
 

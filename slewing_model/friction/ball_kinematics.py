@@ -761,8 +761,8 @@ class WarmFrictionStep:
     :func:`warm_friction_step` gives.
 
     Preparing these operands every step (the bearing's ball radii, the rules' arrays, the distribution's
-    arrays checked and copied) and building a :class:`~slewing_model.friction.FrictionTorque` took 35-55 us
-    of the pitch bearing's 1 ms NREL step (docs/speed.md, "Issue 31, eighteenth turn")."""
+    arrays checked and copied) and building a :class:`~slewing_model.friction.FrictionTorque` would take
+    35-55 us of the pitch bearing's 1 ms NREL step."""
 
     bearing: Bearing
     operands: tuple          # the bearing's, before mu

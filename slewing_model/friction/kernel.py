@@ -62,8 +62,7 @@ def _contact_sums(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, deriv
     ``points`` (:data:`POINT_ROWS`, I), the caller's): a loop with no chain of the ball's sums through it,
     so that the points' square roots and divisions overlap (scalar ones: the loop along the ellipse inside
     it keeps LLVM from making vector operations of it); then the points' terms summed into the ball's, in
-    the order of one loop over the points, so the same numbers bit for bit as that loop (docs/speed.md,
-    "Issue 31, twenty-fourth turn")."""
+    the order of one loop over the points, so the same numbers bit for bit as that loop."""
     n_across, n_along = g10.shape[1], t2.shape[0]
     for i in range(n_across):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
@@ -234,7 +233,7 @@ def _damped_step(x, c_first, c_last, g10, g12, h1, s0, s1, hs, weight, t2, eps2,
 #: a converged ball's last Newton step is taken without evaluating the power at it (the check that it lowers
 #: the power: :func:`_minimise_balls`, ``minimise_power``) where its largest component is at most this share of the
 #: ball's largest unknown: there the quadratic model the step minimises holds. Measured over 340 steps of each of
-#: the pitch bearing's five scenarios of ``bench_realtime.py``, table3 heavy and the yaw bearing: the check
+#: the pitch bearing's five scenarios of the ``realtime`` benchmark, table3 heavy and the yaw bearing: the check
 #: refused a step only where it was round-off (at most 1e-16 of the unknowns; 1,259-2,859 balls of some 50,000
 #: in the scenarios of held loads, none elsewhere), and the steps it accepted were at most 1.3e-3 of them. The
 #: check was an evaluation of every ball's power each step: 0.86 of the friction's one call without it (hot)
@@ -359,8 +358,7 @@ def _contact_tractions(c, u0, u1, u2, g10, g12, h1, s0, s1, hs, weight, t2, e2, 
     (:data:`POINT_ROWS`, I), the caller's scratch: ``A``, ``S``, ``A^2``, ``S^2``, ``sum w / s``,
     ``sum w t^2 / s``), each row of the rule along (``t2``) a pass over the points across: a loop without
     a chain of sums, whose square roots and divisions run four points at a time (vector operations,
-    checked in the compiled code; the torque's rule of a pitch bearing's step, hot, 155 -> 123 us;
-    docs/speed.md, "Issue 31, twenty-fourth turn")."""
+    checked in the compiled code; the torque's rule of a pitch bearing's step, hot, 155 -> 123 us)."""
     n_across = g10.shape[1]
     for i in range(n_across):
         a, s_ = _sliding(c, i, u0, u1, u2, g10, g12, h1, s0, s1, hs)
@@ -594,8 +592,7 @@ _HELPERS = ("_sliding", "_contact_sums", "_symmetrise", "_solve3", "_ball_evalua
 #: numba's error model of these loops: numpy's, a division by zero gives inf or NaN (the divisors are lengths,
 #: speeds and pivots that the inputs' checks and the regularisation keep from zero). Python's checks each
 #: division and raises: a branch at every point of :func:`_contact_sums` and :func:`_contact_tractions`, which
-#: kept their divisions from overlapping and the tractions' from becoming vector operations (docs/speed.md,
-#: "Issue 31, twenty-fourth turn")
+#: would keep their divisions from overlapping and the tractions' from becoming vector operations
 ERROR_MODEL = "numpy"
 
 
@@ -609,8 +606,8 @@ _INLINE = ("_sliding", "_contact_sums", "_sine_series", "_ball_evaluate", "_cont
 #: LLVM's fast-math flags of these loops: ``contract``, a product and the sum it enters as one fused
 #: multiply-add (rounded once instead of twice), where the CPU has them. Measured: the friction's one call of
 #: the pitch bearing's NREL steps, hot, alternating with and without it call by call in one process, 0.88
-#: (821 -> 724 us on a slow day; about 4 % of a step, below what the step's own A/B runs resolve here:
-#: docs/speed.md, "Issue 31, twenty-second turn"); torques 3e-16 from the loops without it. Not ``reassoc``
+#: (821 -> 724 us on a slow day; about 4 % of a step, below what the step's own A/B runs resolve here);
+#: torques 3e-16 from the loops without it. Not ``reassoc``
 #: (no faster) nor any flag that assumes no NaN or infinity (the loops look for them)
 FASTMATH = frozenset({"contract"})
 

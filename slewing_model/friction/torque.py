@@ -5,8 +5,8 @@ finite element contact model (hours per case) and proposes to feed the
 Flexible-BIME results to an analytical model instead. This module is that
 model, in the line of Jones (paper ref. [19]), Leblanc & Nelias (refs. [17,
 18]) and Joshi et al. (ref. [20]): slow speed, no inertia, full-sliding
-Coulomb friction in every ball-raceway contact. ``docs/friction.md`` gives the
-derivation, the convergence studies and the limits (full sliding, ref. [21]).
+Coulomb friction in every ball-raceway contact. ``docs/theory/friction.md`` gives the
+derivation, the quadrature and the limits (full sliding, ref. [21]).
 
 The model, one module per idea:
 
@@ -433,8 +433,7 @@ def warm_torque(step: WarmFrictionStep, distribution, initial: np.ndarray, seal_
     bearing, rules, ``mu``, ``omega``, tolerance and sliding regularisation of that call), bit for bit;
     ``seal_torque`` N m (``seal_torque_of``'s). None where :func:`friction_torque` must run instead
     (no warm start of this bearing's shape, a distribution to refuse, no loaded contact). A
-    co-simulation step builds no :class:`FrictionTorque` then (docs/speed.md, "Issue 31, eighteenth
-    turn")."""
+    co-simulation step builds no :class:`FrictionTorque` then."""
     if initial is None or initial.shape != (step.bearing.ball_count, 4):
         return None
     found = step(distribution, initial, max_iterations)

@@ -9,7 +9,7 @@ first whose features that CPU has (:func:`portable_target`):
 - ``x86-64-v3``, the x86-64 psABI's third level (AVX2, FMA, BMI2, ...: Intel's CPUs since Haswell, 2013,
   AMD's since Excavator, 2015): the loops' fused multiply-adds and four-wide vector operations. Measured on
   this machine (an AMD EPYC, znver4), the library's pitch bearing NREL step, three runs of 3-5 alternating
-  processes each (``benchmarks/bench_cpu_targets.py``): 0.90-0.94 of the building CPU's loops' median, the
+  processes each: 0.90-0.94 of the building CPU's loops' median, the
   generic ones 1.07-1.25 (the x86-64-v3 loops' answers are those of the building CPU's loops bit for bit:
   both fuse multiply-adds);
 - ``generic``: any x86-64 CPU (SSE2 only).

@@ -108,7 +108,7 @@ def inverse_product(inverse: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     """``(W^-1 V)^T`` (k, n) for ``V^T = vectors`` (k, n) and a symmetric ``W^-1 = inverse``, summed in
     double. An inverse kept in single precision (:func:`kept_precision`) is converted first: numpy's
     product of the two precisions as they are runs without BLAS (in a bounded step after a moment
-    reversal, 74-628 us for one vector, docs/speed.md, "Issue 31, fifteenth turn")."""
+    reversal, 74-628 us for one vector)."""
     return vectors @ inverse.astype(np.float64, copy=False)
 
 
@@ -213,8 +213,8 @@ def _add_blocks(matrix: np.ndarray, blocks: np.ndarray) -> None:
 #: condition 5.7e3: 4e-5), which the step in increments (:func:`newton_step`) takes as one more
 #: approximation of its modified Newton operator: the equilibrium it converges to is the same. An
 #: inverse too far off, or a ``W`` singular in single precision, is inverted again through its
-#: Cholesky factor, in single precision and if need be in double (:func:`checked_inverse`;
-#: docs/speed.md, "Issue 31, sixth and seventh turns")
+#: Cholesky factor, in single precision and if need be in double (:func:`checked_inverse`; why:
+#: docs/design-decisions.md, "The kept operator in single precision, and what it means")
 OPERATOR_PRECISION = np.float32
 
 
@@ -225,8 +225,7 @@ def kept_precision(inverse: np.ndarray) -> np.ndarray:
     The Newton iterations with a kept operator multiply by it 4-5 times a step, and the product
     reads all of it (the pitch bearing's 368 rows: 1.08 MB in double, from beyond the core's cache
     at a step's first iteration): kept in single precision it reads half, in products that still
-    sum in double (the pitch bearing's complete steps 0.93-0.95 of the time, docs/speed.md, "Issue
-    31, fourteenth turn"). An inverse computed in single precision loses nothing so kept; one bordered
+    sum in double (the pitch bearing's complete steps 0.93-0.95 of the time). An inverse computed in single precision loses nothing so kept; one bordered
     in double from it (:func:`update_operator`) is rounded back, an error of ``6e-8`` relative per
     entry against the ``1e-7 cond(W)`` it already had. An inverse made in double
     (:func:`checked_inverse`: ``W`` too ill-conditioned for single precision) stays double."""
@@ -249,7 +248,7 @@ def spd_inverse(w: np.ndarray) -> np.ndarray:
     instead of 1e-11 on the 592 rows of the pitch bearing's cold start; symmetric, as
     ``np.linalg.inv``'s). The flops are matrix products, which BLAS
     runs near the machine's peak; ``np.linalg.inv`` (LU, then ``n`` triangular solves) is
-    twice as slow on one thread at 380 rows (``docs/speed.md``).
+    twice as slow on one thread at 380 rows (``python -m benchmarks operator``).
 
     The top level is six stages (:data:`STAGES`), which :class:`PendingOperator` spreads over
     steps."""
@@ -317,20 +316,19 @@ def _joined(w, a_inv, x, s_inv, y):
 STAGES = (_a_inverse, _x, _schur, _schur_inverse, _y, _joined)
 #: where the steps of a :class:`PendingOperator` end in a complete solve (one a step): ``A^-1`` and
 #: ``A^-1 B`` on the step that forms ``W`` (with ``W``'s gathering, about half the work), the rest
-#: on the next (measured against three steps and against the split 10/12 | 6/12: docs/speed.md). A
+#: on the next (measured against three steps and against the split 10/12 | 6/12). A
 #: bounded solve runs as many stages as its work allows (:func:`stage_work`).
 SPREAD_STAGES = (2, len(STAGES))
 
 
 #: what a floating-point operation of each stage costs against one of a large product's in double
-#: precision (one BLAS thread, measured: ``benchmarks/bench_operator.py --stages``), in
+#: precision (one BLAS thread, measured: ``python -m benchmarks operator --stages``), in
 #: :data:`OPERATOR_PRECISION`: an inverse of a half recurses down to LAPACK's leaves and runs at
 #: about a third of a double product's rate (single: 1.3 times faster), ``S`` and the join add passes
 #: over the matrix; single precision runs the products 2.2 times, the join 2 times faster than double
-#: (which had 3, 1, 1.5, 3, 1, 1.5). Measured again in issue 31's thirteenth turn (two runs, operators
-#: of 356-424 rows): the stages ran at 39-49 million a millisecond, the join at 25-26, not 55: the
-#: weights were (2.3, 0.45, 0.7, 2.3, 0.45, 0.75), and a bounded step's operator work took 1.3 times the
-#: time its bound said (the join twice)
+#: (whose weights are 3, 1, 1.5, 3, 1, 1.5). On operators of 356-424 rows (two runs) the stages run at
+#: 39-49 million a millisecond, the join at 25-26, not 55: weights of (2.3, 0.45, 0.7, 2.3, 0.45, 0.75)
+#: leave a bounded step's operator work at 1.3 times the time its bound says (the join twice)
 STAGE_WEIGHT = (2.6, 0.63, 0.78, 2.6, 0.63, 1.6)
 
 
@@ -469,7 +467,7 @@ def _factor_joined(w, columns, x22):
 #: is made again, spread over steps where the solve allows (:func:`advance_operator`)
 FACTOR_STAGES = (_half_factor, _coupling_factor, _factor_schur, _schur_factor, _lower_columns, _factor_joined)
 #: :data:`STAGE_WEIGHT` of :data:`FACTOR_STAGES` (in :data:`OPERATOR_PRECISION`; measured so,
-#: ``benchmarks/bench_operator.py --stages --method 1``): the inverse factors of the halves recurse down to
+#: ``python -m benchmarks operator --stages --method 1``): the inverse factors of the halves recurse down to
 #: LAPACK's leaves (the first stage also scales ``W``), and the symmetric products run at about half a
 #: general product's rate a counted flop
 FACTOR_WEIGHT = (6.8, 0.43, 1.0, 3.6, 0.43, 1.1)
@@ -487,7 +485,7 @@ def method_precision(method: int):
 def forming_work(rows: int) -> float:
     """The work of forming ``W`` on ``rows`` rows (gathering ``M_aa``, adding the springs'
     compliance), as :func:`stage_work` counts it: ``85 n^2`` (measured against the stages,
-    ``benchmarks/bench_operator.py --stages``; 80 before the thirteenth turn's measurement)."""
+    ``python -m benchmarks operator --stages``)."""
     return 85.0 * rows * rows
 
 
@@ -506,7 +504,7 @@ class PendingOperator:
     again; ``method`` 2: the same in double, where that missed it too), ``parts`` the last one's
     results (in :func:`method_precision`); ``scaled``: the matrix the stages take, ``matrix`` in
     :data:`OPERATOR_PRECISION` for method 0 (converted once, not at each step of stages: 0.1 ms a step
-    of stages of the pitch bearing's operators, docs/speed.md, "Issue 31, sixteenth turn"), its
+    of stages of the pitch bearing's operators), its
     :func:`scaled_matrix` for methods 1 and 2 (not part of the state: it follows from ``matrix``)."""
 
     rows: np.ndarray
@@ -619,8 +617,7 @@ def checked_inverse(w_mat: np.ndarray, method: int = 0, arithmetic: "OperatorAri
     again by LAPACK in double, 4-19 ms, the slowest steps of the bounded scenarios. Through the factor,
     scaled to a unit diagonal, single precision gives 0.004-0.007 for them (one of condition 1e8:
     0.05) in about twice the time of an inverse by halves, a third to a half of LAPACK's in double;
-    what it misses, double precision gives to about ``1e-16 cond(W)`` (docs/speed.md, "Issue 31,
-    seventh turn"). ``W`` of the preload alone (the yaw bearing at zero loads: condition 4e13) is
+    what it misses, double precision gives to about ``1e-16 cond(W)``. ``W`` of the preload alone (the yaw bearing at zero loads: condition 4e13) is
     singular in single precision; LAPACK's ``inv`` is the last resort for a ``W`` the Cholesky factor
     refuses in double too."""
     for precision in dict.fromkeys(method_precision(m) for m in range(method + 1, 3)):
@@ -677,7 +674,7 @@ def update_operator(op: ReducedOperator, point, compliance, stiffness, jacobian,
     was formed, maybe some steps earlier: where it slows the iteration, the solve's refresh
     rule forms a new operator. Dropping it would cost a pass over ``W^-1`` that, as the ring
     turns, a contact closing again soon after would undo (measured on the pitch bearing's
-    steps: updates 0.93 -> 0.28 a step, docs/speed.md).
+    steps: updates 0.93 -> 0.28 a step).
 
     A diagonal that closed must enter: its force is zero outside the operator's rows. With
     ``B = M`` (kept rows, new rows), ``C = (A^-1 + M)`` on the new rows, ``X = W^-1 B`` and
@@ -718,7 +715,7 @@ def bordering_work(rows: int, kept_rows: int) -> float:
     """The work of bordering ``r = rows`` onto ``n = kept_rows`` (:func:`bordered_inverse`), as
     :func:`stage_work` counts it: ``X = W^-1 B`` and ``X S X^T``, ``2 n^2 r`` each, ``B^T X`` and ``X S``,
     ``2 n r^2`` each, ``S``'s inverse by LAPACK, ``6 r^3``, and the new matrix and coupling, ``120 (n + r)^2``
-    (``benchmarks/bench_operator.py --border``); the ``n^2 r`` products weighted 1.25 (``5 n^2 r``) for the
+    (``python -m benchmarks operator --border``); the ``n^2 r`` products weighted 1.25 (``5 n^2 r``) for the
     passes of ``X S X^T``."""
     n, r = kept_rows, rows
     return 5.0 * n * n * r + 4.0 * n * r * r + 6.0 * r ** 3 + 120.0 * (n + r) ** 2
@@ -727,7 +724,7 @@ def bordering_work(rows: int, kept_rows: int) -> float:
 #: rows of ``W^-1`` :func:`bordered_inverse` converts to double at a time (a buffer of 64 x 400-480 doubles,
 #: 0.2 MB). Inside the pitch bearing's NREL steps 3-6 from the start values (16-30 rows onto 402-476), a
 #: bordering by numpy took 1.2-2.4 ms with the whole inverse converted and the product added whole, 1.1-1.3
-#: ms by blocks (docs/speed.md, "Issue 31, seventeenth turn"; 128 rows: no faster than whole)
+#: ms by blocks (128 rows: no faster than whole)
 BORDER_BLOCK = 64
 
 

@@ -47,7 +47,7 @@ RING_FIELDS = ("pitch_diameter", "ball_diameter", "groove_radius", "contact_angl
 DOF_LABELS = {"outer": ("R1", "z1", "R4", "z4"), "inner": ("R2", "z2", "R3", "z3")}
 
 #: the one default superelement mesh of every command (``slewing superelement``, ``solve``, ``plot``,
-#: a study's ``[simulation] mesh``), and what each mesh is worth (docs/superelement.md, Convergence)
+#: a study's ``[simulation] mesh``), and what each mesh is worth (docs/theory/superelement.md, Accuracy)
 DEFAULT_MESH = "coarse"
 MESH_HELP = ("superelement cross-section mesh: coarse (quick: compliances within 1.2 %%, stiffness entries "
              "within 15 %% of finer), fine (within 0.5 %% of finer, about 4x the build time), finer")
@@ -78,7 +78,7 @@ def ring_fields(bearing) -> dict:
     """The ring-relevant part of ``bearing.to_dict()`` (see :data:`RING_FIELDS`), canonical form."""
     d = bearing.to_dict() if hasattr(bearing, "to_dict") else dict(bearing)
     fields = {k: d[k] for k in RING_FIELDS}
-    if d.get("connection"):     # issue 29: what the rings are bolted to (absent: the hash is unchanged)
+    if d.get("connection"):     # what the rings are bolted to (absent: the hash is unchanged)
         from ..bearing.connection import connection_key
 
         fields["connection"] = {r: connection_key(c) for r, c in d["connection"].items()}

@@ -405,10 +405,10 @@ class BearingSimulator:
     def _checkpoint(self) -> tuple:
         """What a failed :meth:`step` restores (:meth:`_restore`): :meth:`get_state`'s entries as they are
         (none is changed in place), with no dictionary built (:meth:`get_state` took 17-22 us of the pitch
-        bearing's NREL steps; docs/speed.md, "Issue 31, sixteenth turn"). Not the life accumulator's: its
+        bearing's NREL steps). Not the life accumulator's: its
         step is the step's last that can fail (:meth:`_step`), so a step that raises has not touched it
-        (its checkpoint made the raceway map copy itself at every step's update: docs/speed.md, "Issue 31,
-        eighteenth turn"). Nor the held answer: :meth:`step` sets it only after the step succeeded."""
+        (a checkpoint of it would make the raceway map copy itself at every step's update). Nor the held
+        answer: :meth:`step` sets it only after the step succeeded."""
         return (self._warm, self._previous, self._loads, self._warm_converged, self._psi, self.solver.operator,
                 self.solver.pending_operator, self._friction_warm, self._friction_previous, self._friction_converged)
 
@@ -513,7 +513,7 @@ def extrapolated_motion(warm, previous, share: float = 1.0):
     The balls' motions follow the loads as the load distribution does: carried on, the warm start of
     the pitch bearing's NREL series is within the friction's tolerance for most balls at once (one
     Newton iteration where two were usual: the balls' minimisation 241 -> 183 us a step, 243 -> 164
-    us for turbulent loads; docs/speed.md, "Issue 31, eleventh turn"). Where the friction of either
+    us for turbulent loads). Where the friction of either
     step stopped short (a flagged step's, capped) there is no ``previous``: ``warm``."""
     if previous is None or warm is None or previous.shape != warm.shape:
         return warm

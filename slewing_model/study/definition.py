@@ -80,7 +80,7 @@ def case_name_parts(name: str) -> tuple[str, str]:
 
 
 #: bump when a case's numbers change for the same inputs (reruns then recompute)
-CASE_FORMAT = 2                  # 2: issue 28 (life: small-swing exponent, slices, micro-cycles)
+CASE_FORMAT = 2                  # 2: life with the small-swing exponent, slices and micro-cycles
 
 SIMULATION_DEFAULTS = {
     "mesh": "coarse",

@@ -13,7 +13,7 @@
   variant are parts of one duty (their load series, each run once: slice damages add up), while
   different variants are alternative designs, drawn side by side (or, beyond six, their median and
   range), never added; and ``x/2b`` of the rainflow cycles as shares of the cycles and of the
-  damage (``slewing_model.life``; ``docs/life.md``).
+  damage (``slewing_model.life``; ``docs/guide/life-and-wear.md``).
 * ``worst_case.png`` -- the time series of the case with the largest friction torque:
   ring angle and drive moment, friction torque, largest ball load.
 """
@@ -108,7 +108,7 @@ def errors_note(cases) -> str:
 
 
 def psi_note(load: dict) -> str:
-    """Why the ring angle has the sign it has, for an OpenFAST load series (docs/openfast.md):
+    """Why the ring angle has the sign it has, for an OpenFAST load series (docs/guide/openfast-loads.md):
     psi is the blade pitch or nacelle yaw seen along the bearing's +z."""
     if load.get("kind") != "openfast":
         return ""

@@ -21,7 +21,7 @@
  * instance), stress (CYCLES x: load, two instances, a refused step, free, dlclose), bench
  * (FMI 2.0: --inputs FILE, 7 input values a line and step, --integer VR VALUE parameters;
  * prints "instantiate <s>" for loading, instantiation and initialisation, then "step <k> <s>"
- * for each set-inputs, doStep, get-outputs: benchmarks/bench_fmu_runtime.py).
+ * for each set-inputs, doStep, get-outputs: python -m benchmarks fmu_variants).
  */
 #ifdef _WIN32
 /* Windows (cross-compiled with mingw-w64, tests/test_win64.py): LoadLibrary for dlopen */

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the floor-lowered Linux runtime of the standalone FMU (issue 30): a CPython 3.11 and pythonfmu's FMI 2.0
+# Builds the floor-lowered Linux runtime of the standalone FMU: a CPython 3.11 and pythonfmu's FMI 2.0
 # export library compiled in a Debian 11 (bullseye, glibc 2.31, GCC 10) build chroot, so that the FMU's Linux
 # binaries need nothing newer than glibc 2.28 (RHEL 8, Debian 10) and GCC 6's libstdc++ (llvmlite's wheel). As root (debootstrap, chroot), on a Debian machine with
 # debootstrap and curl; after `make .venv/.installed` (the numpy, numba, llvmlite versions are the venv's).

@@ -1,6 +1,6 @@
 """The clamped ring's harmonic compliance at n = 0 and n = 1 against a 3-D CalculiX solve.
 
-Issue 29, item 4. The superelement's clamped ring is the Fourier-harmonic model
+The superelement's clamped ring is the Fourier-harmonic model
 (slewing_model/rings/superelement/harmonic.py) with every displacement of the bolted face
 held at zero (supports.py). This script checks that coupling against an independent 3-D
 solid model of the same ring:
@@ -97,7 +97,7 @@ def write_deck(path, xy, tri, facets, loads_by_case, slabs, face_z, youngs, pois
     thetas = np.linspace(0.0, span, layers)
     node = lambda k, layer: layer * nn2 + k + 1        # noqa: E731
     with open(path, "w") as f:
-        f.write("*HEADING\nclamped ring, half model, harmonic loads (issue 29 item 4)\n*NODE, NSET=NALL\n")
+        f.write("*HEADING\nclamped ring, half model, harmonic loads\n*NODE, NSET=NALL\n")
         for layer, th in enumerate(thetas):
             c, s = math.cos(th), math.sin(th)
             for k in range(nn2 if layer % 2 == 0 else n_vertices):

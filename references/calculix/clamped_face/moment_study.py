@@ -1,15 +1,15 @@
 """Pure tilting moment on a bearing with both rings clamped: what the projection of the ring part does.
 
-Issue 29, item 4. The outer ring is clamped on its lower face, the inner (moving) ring on its
+The outer ring is clamped on its lower face, the inner (moving) ring on its
 upper face (the moment comes in through a rigid plate bolted there). Under a pure moment a
 rigid bearing loads both diagonals alike and does not lift; clamped faces make the diagonal
 whose contacts sit next to them (contacts 4 and 2) stiffer, so it carries more and the moving
 ring rises. Three condensations of the same harmonic FE solves:
 
 * ``v2``: the ring part ``c_n - c_n^HS`` projected onto positive semi-definite matrices per
-  continuous harmonic, before the long-wave give-back (algorithm version 2, until issue 29);
+  continuous harmonic, before the long-wave give-back (algorithm version 2);
 * ``v3``: the long waves whose excess is given back projected per ball harmonic, after the
-  give-back, the other harmonics per harmonic (the code now);
+  give-back, the other harmonics per harmonic (algorithm version 3, the code's);
 * ``none``: not projected at all: negative ring parts kept, i.e. the contacts next to a clamped face
   made *stiffer* than Hertz's half-space, as a solid FE model has them. The superelement cannot
   keep this (its matrix would not be positive definite); shown to size what it leaves out.

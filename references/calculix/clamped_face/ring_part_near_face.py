@@ -1,6 +1,6 @@
 """How much compliance the superelement gives each contact beyond Hertz, next to a clamped face.
 
-Issue 29, item 4. For each ring of a bearing (clamped, and free for comparison) and each
+For each ring of a bearing (clamped, and free for comparison) and each
 contact, along its contact normal, per ball harmonic j (j = 0: every ball pushed alike; long
 waves carry the tilting moment at j = 1):
 

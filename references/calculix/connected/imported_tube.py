@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""An imported CalculiX stiffness of a 3-D tube against the parametric tube adapter (issue 29,
-"the imported matrix of the same adapter gives the parametric result within 1 %"). Outside
+"""An imported CalculiX stiffness of a 3-D tube against the parametric tube adapter: the
+imported matrix of the same adapter must give the parametric result within 1 %. Outside
 `make test`; needs `ccx` (Debian calculix-ccx 2.20).
 
     OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python references/calculix/connected/imported_tube.py [--keep DIR]

@@ -1,6 +1,6 @@
 """Build-time ring superelement: scikit-fem model of each ring condensed to the groove centres.
 
-Paper section 2.2, eqs 12-15; issue 3. Needs scipy and scikit-fem (the
+Paper section 2.2, eqs 12-15. Needs scipy and scikit-fem (the
 ``build`` extra); the result is read at run time by
 :mod:`slewing_model.rings.stiffness` with numpy only.
 

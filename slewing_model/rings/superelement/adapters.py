@@ -1,4 +1,4 @@
-"""Connected structures condensed onto a ring's bolted face, per harmonic (issue 29, item 1).
+"""Connected structures condensed onto a ring's bolted face, per harmonic.
 
 A ring's bolted face can be bolted to a **tube** (a blade root, a tower top) or a **plate** (a hub
 or bedplate flange), both bodies of revolution (:class:`~slewing_model.bearing.connection.Adapter`),

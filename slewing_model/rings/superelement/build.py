@@ -1,4 +1,4 @@
-"""Build the precomputed superelement of a bearing, with a cache (issue 3, items 2-5).
+"""Build the precomputed superelement of a bearing, with a cache.
 
 :func:`build_superelement` runs, for each ring, the steps of the other modules:
 
@@ -31,7 +31,7 @@ from .adapters import CONNECTED, connect
 from .supports import BOUNDARY_CONDITIONS, NULL_SPACE, SUPPORT_REMOVES, Support
 
 #: bump when the numbers a build produces change for the same inputs (invalidates caches)
-ALGORITHM_VERSION = 3          # 3: the given-back long waves are projected after the give-back (issue 29)
+ALGORITHM_VERSION = 3          # 3: the given-back long waves are projected after the give-back
 
 #: expert options and their defaults (see :func:`build_superelement`)
 DEFAULT_OPTIONS = {
@@ -82,7 +82,7 @@ def _bcs(bc) -> dict:
 def auto_harmonics(bearing: Bearing, ring: str, factor: float) -> int:
     """Default highest harmonic: ``factor * r_max / w`` with ``w`` the smaller side of the
     section. Above a few ``r / w`` the ring answers a patch load like a half-space (Hertz's
-    part), so the ring part ``c_n - c_n^HS`` has died out (docs/superelement.md)."""
+    part), so the ring part ``c_n - c_n^HS`` has died out (docs/theory/superelement.md)."""
     s = bearing.outer_section if ring == "outer" else bearing.inner_section
     w = min(s.height, s.outer_radius - s.inner_radius)
     return int(math.ceil(factor * s.outer_radius / w))
@@ -114,7 +114,7 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
     bearing : Bearing
     mesh : str or MeshSize or dict
         ``"coarse"`` (tests, quick studies), ``"fine"`` (within 1 % of ``"finer"``, see
-        docs/superelement.md) or ``"finer"``; or explicit :class:`MeshSize` fields.
+        docs/theory/superelement.md) or ``"finer"``; or explicit :class:`MeshSize` fields.
     bc : str or dict
         ``"free"``, ``"clamped"`` or ``"frictionless"`` for both rings, or
         ``{"outer": ..., "inner": ...}``. A ring the bearing connects (``bearing.connection``,
@@ -147,7 +147,7 @@ def build_superelement(bearing: Bearing, mesh="coarse", bc="free", *, cache: boo
     opts = {**DEFAULT_OPTIONS, **expert_options}
     mesh_name, size = _mesh_size(mesh)
     bcs = _bcs(bc)
-    for ring in bearing.connection or {}:      # issue 29: a connected ring's support is its connection
+    for ring in bearing.connection or {}:      # a connected ring's support is its connection
         bcs[ring] = CONNECTED
     harmonics = {r: int(opts["harmonics"]) if opts["harmonics"] is not None
                  else auto_harmonics(bearing, r, opts["harmonic_factor"]) for r in ("outer", "inner")}
@@ -231,7 +231,7 @@ def ring_harmonics(bearing: Bearing, ring: str, size: MeshSize, bc: str, n_max: 
     patches = cp.ring_patches(bearing, ring, sizes)
     loads, lams = cp.master_loads(model, sm.patch_facets, patches)
     connection_info = None
-    if bc == CONNECTED:                    # issue 29: the bolted face joined to a tube, plate or matrix
+    if bc == CONNECTED:                    # the bolted face joined to a tube, plate or matrix
         model, support, connection_info = connect(model, sm, bearing.connection[ring], size)
         loads = model.pad(loads)
     else:

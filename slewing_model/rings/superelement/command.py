@@ -1,6 +1,6 @@
 """``slewing superelement BEARING.toml [--mesh coarse|fine|finer] [--bc free|clamped|frictionless] -o FILE``.
 
-Issue 3, item 6. Builds the condensed ring stiffness of both rings (with a
+Builds the condensed ring stiffness of both rings (with a
 progress bar over the harmonic solves), writes it to one ``.npz`` and prints a
 summary: matrix size, time, and the convergence figures of the build.
 """

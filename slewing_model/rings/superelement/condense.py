@@ -1,6 +1,6 @@
 """Condensation of the harmonic ring model to the groove centres of B discrete balls.
 
-Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
+Paper eqs 12-15. The steps, each a function below:
 
 1. :func:`harmonic_compliances` -- per continuous harmonic n the 4x4 compliance
    of the master loads (:mod:`.coupling`), ``c_n = L^T K(n)^-1 L``, with the
@@ -31,7 +31,7 @@ Issue 3, items 2-4; paper eqs 12-15. The steps, each a function below:
    rigid modes.
 5. :func:`first_row` -- ``C_k = 1/B sum_j K_hat_j exp(-2 pi i j k / B)``.
 
-Why the projection and the floor (docs/superelement.md): beyond a few times
+Why the projection and the floor (docs/theory/superelement.md): beyond a few times
 ``r / section`` harmonics the ring answers a patch load like a half-space, and
 the concave groove slightly *stiffer* than the flat one Hertz assumes, so
 ``c_n - c_n^HS`` becomes a small negative number; next to a clamped face the
@@ -40,8 +40,8 @@ the groove and the fixed face is a layer on a rigid base). Such directions have
 no compliance beyond Hertz's: they are given the floor, a small fraction of the
 Hertz (half-space) compliance of the patch, which keeps the matrix finite and
 well conditioned. The long waves whose half-space excess is given back are
-projected once per ball harmonic, after the give-back (issue 29, item 4:
-projecting them per continuous harmonic first gave the excess back twice).
+projected once per ball harmonic, after the give-back (projecting them per
+continuous harmonic first would give the excess back twice).
 """
 from __future__ import annotations
 
@@ -155,11 +155,11 @@ def ring_part(c_fe: np.ndarray, c_hs: np.ndarray, patches, free: bool,
     ball harmonic (:func:`halfspace_addback`, :func:`given_back_harmonics`): those stay as they are
     and are projected with the give-back, per ball harmonic (:func:`stiffness_blocks`).
 
-    Why (issue 29, item 4): at low n, ``c_n^HS`` is the compliance of a *row* of patches, which
+    Why: at low n, ``c_n^HS`` is the compliance of a *row* of patches, which
     grows without bound as n -> 0 (n = 0 takes the value of n = 1) and exceeds what a finite ring
     holds, most of all next to a clamped face. Clipping that negative part here and then giving
-    the excess back gave the same compliance back twice and softened the contacts next to a
-    clamped face (docs/superelement.md, "The clamped face"). At the other harmonics the negative
+    the excess back would give the same compliance back twice and soften the contacts next to a
+    clamped face (docs/validation/calculix-tilting.md). At the other harmonics the negative
     directions are the concave groove's (slightly stiffer than the flat half-space); clipping them
     per harmonic keeps the sum over harmonics convergent in N.
 

@@ -1,6 +1,6 @@
 """Coupling of a groove centre to its raceway, and the half-space part it must not count.
 
-Issue 3, item 3. The master of contact ``i`` is the groove centre ``O_i`` with
+The master of contact ``i`` is the groove centre ``O_i`` with
 a radial and an axial degree of freedom. Its force is passed to the raceway
 as a **normal pressure over a patch** around the nominal contact point, the
 way the ball passes it (frictionless contact: every pressure line goes
@@ -39,7 +39,7 @@ computed here in closed form up to a 1-D or 2-D quadrature. Per circumferential
 harmonic the FE compliance tends to the half-space one (:func:`halfspace_harmonic`),
 so harmonics above the FE cut-off are summed with the half-space value; what is
 left converges fast in both the number of harmonics and the mesh, and depends
-little on the patch size (docs/superelement.md, patch study).
+little on the patch size (less than 0.5 % over a fourfold range: docs/theory/superelement.md).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Fourier-harmonic finite element model of an axisymmetric ring (issue 3, item 2).
+"""Fourier-harmonic finite element model of an axisymmetric ring.
 
 The ring is a solid of revolution about z. A displacement field of harmonic
 ``n`` of the *symmetric family* is

@@ -1,4 +1,4 @@
-"""A face stiffness imported from another FE tool, projected onto the harmonic model (issue 29, item 1).
+"""A face stiffness imported from another FE tool, projected onto the harmonic model.
 
 The file holds the stiffness of the structure a ring is bolted to, condensed to nodes on the
 ring's bolted face, three translations per node in the global Cartesian axes (z the bearing
@@ -9,7 +9,7 @@ axis, origin the bearing centre in the ball plane):
   user element (:func:`_read_calculix_user_element`); with ``OUTPUT FILE=MATRIX`` (later
   manuals) one entry per line ``row node, row dof, column node, column dof, value`` (dof 1..3 =
   x, y, z), one triangle or both. The nodes' coordinates come from ``nodes_csv``. (CalculiX
-  2.20 writes the retained block without condensing the interior: docs/connected_structures.md.)
+  2.20 writes the retained block without condensing the interior: docs/guide/connected-structures.md.)
 * ``format = "matrix_market"``: ``%%MatrixMarket matrix coordinate real symmetric`` (or
   ``general``); DOF ``3 k + c`` (0-based) is component c (x, y, z) of the k-th row of ``nodes_csv``.
 

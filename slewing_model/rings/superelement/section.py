@@ -1,6 +1,6 @@
 """Ring cross-sections with the gothic-arch groove, and their structured mesh.
 
-Issue 3, item 1. A ring section is the rectangle of :class:`~slewing_model.bearing.geometry.RingSection`
+A ring section is the rectangle of :class:`~slewing_model.bearing.geometry.RingSection`
 (ring width, height and bore from the bearing definition, or the documented
 defaults of :func:`~slewing_model.bearing.geometry.default_sections`) with the groove
 cut out of the side that faces the other ring. The groove is the
@@ -172,7 +172,7 @@ class MeshSize:
     smoothing: int = 20
 
 
-#: the named mesh settings of the command line (see docs/superelement.md for the study)
+#: the named mesh settings of the command line (what each is worth: docs/theory/superelement.md, Accuracy)
 MESH_PRESETS = {
     "coarse": MeshSize(patch_elements=4, growth=0.45, max_size=0.25),
     "fine": MeshSize(patch_elements=8, growth=0.25, max_size=0.12),

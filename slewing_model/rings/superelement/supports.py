@@ -1,4 +1,4 @@
-"""Boundary conditions of a ring, per harmonic (issue 3, item 4).
+"""Boundary conditions of a ring, per harmonic.
 
 * ``free`` -- no support, as in the paper's idling model. The rigid-body modes
   have no stiffness: X, Y (translation), Z, rx, ry (tilts). They are removed

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What CalculiX's substructure export holds (issue 29): run outside `make test`, needs `ccx`
+"""What CalculiX's substructure export holds: run outside `make test`, needs `ccx`
 (Debian calculix-ccx).
 
     .venv/bin/python tests/data/calculix/check_substructure.py
