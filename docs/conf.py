@@ -22,12 +22,7 @@ extensions = [
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = [
-    "_build",
-    # the former pages, condensed into the site's sections
-    "speed.md", "history.md", "superelement.md", "friction.md", "life.md", "openfast.md",
-    "connected_structures.md", "fmu_hosts.md", "standalone_fmu.md",
-]
+exclude_patterns = ["_build"]
 
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3

@@ -32,6 +32,8 @@ SKIPPED = (
     (r"\.venv/bin/python examples/", "a full example (seconds to a minute); examples/timings.py times each"),
     (r"\.venv/bin/python (-m )?benchmarks", "a benchmark (minutes)"),
     (r"\.venv/bin/slewing batch examples/studies/", "a study of minutes (2,000 or 10 long cases); tests/test_study.py"),
+    (r"OMP_NUM_THREADS=1 nice ", "runs a CalculiX reference again (minutes, needs ccx); its results are stored in "
+                                 "references/validation/data/, from which the redraw commands run here"),
     (r"ECOS=|chmod \+x \"\$ECOS\"|mkdir -p results && cd results", "ecos needs the SSP built (minutes)"),
     (r"export |dask ", "environment or cluster set-up for another machine"),
     (r".*\b(STUDY\.toml|DIR|HOST)\b", "a placeholder to fill in"),

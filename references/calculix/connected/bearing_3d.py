@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A 3-D CalculiX reference of both rings bolted to tubes, the balls as nonlinear Hertz springs,
-against slewing_model's superelement with the same adapters (issue 29, "What must be shown").
+against slewing_model's superelement with the same adapters.
 Outside `make test`; needs `ccx` (Debian calculix-ccx 2.20).
 
     OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python references/calculix/connected/bearing_3d.py \
@@ -421,6 +421,8 @@ def main() -> int:
     p.add_argument("--middle-slabs", type=int, default=MIDDLE_SLABS, help="slabs between neighbouring patches")
     p.add_argument("--patch-mm", type=float, default=PATCH_CIRC * 1e3,
                    help="half-width of the coupling patch along the circumference, mm")
+    p.add_argument("--csv", help="write every ball's contact load, 3-D and model, to this CSV file "
+                                 "(references/validation/bolted_tubes.py draws it)")
     args = p.parse_args()
     if args.section:
         SECTION_SIZE = MeshSize(int(args.section[0]), args.section[1], args.section[2])
@@ -433,6 +435,7 @@ def main() -> int:
     assert B % 2 == 0 and bearing.first_ball_angle == 0.0
     tmp = tempfile.TemporaryDirectory()
     t_start = time.perf_counter()
+    csv_rows = []
     for e_gpa in args.tube_modulus_gpa:
         e_tube = e_gpa * 1e9
         work = Path(args.keep) / f"tube_{e_gpa:g}gpa" if args.keep else Path(tmp.name) / f"tube_{e_gpa:g}"
@@ -455,6 +458,10 @@ def main() -> int:
                 zone_mod = [int(np.sum(qm_half[d] > 0.01 * peak_mod)) for d in range(2)]
                 diff = np.abs(q - qm_half).max() / peak_ref
                 tag = "corrected" if hs else "uncorrected"
+                for d in range(2):
+                    for b in range(B // 2 + 1):
+                        csv_rows.append(f"{e_gpa:g},{name},{tag},{d + 1},{b},{360.0 * b / B:g},"
+                                        f"{q[d, b]:.6e},{qm_half[d, b]:.6e}")
                 print(f"  {name:20} ({tag:11}): peak 3-D {peak_ref / 1e3:8.3f} kN, model {peak_mod / 1e3:8.3f} kN "
                       f"({100 * (peak_mod / peak_ref - 1):+.2f} %); balls 0..{B // 2} loaded (> 1 % of the peak) on "
                       f"diagonals 1, 2: 3-D {zone_ref}, model {zone_mod}; largest per-contact difference "
@@ -464,6 +471,11 @@ def main() -> int:
                     for d in range(2):
                         print(f"    ball loads 0..{B // 2} [kN], diagonal {d + 1}: 3-D   {np.round(q[d] / 1e3, 2).tolist()}\n"
                               f"                                 model {np.round(qm_half[d] / 1e3, 2).tolist()}", flush=True)
+    if args.csv:
+        Path(args.csv).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.csv).write_text("tube_modulus_gpa,case,halfspace,diagonal,ball,angle_deg,load_3d_n,load_model_n\n"
+                                  + "\n".join(csv_rows) + "\n")
+        print(f"wrote {args.csv}")
     print(f"\ntotal {time.perf_counter() - t_start:.0f} s")
     return 0
 
