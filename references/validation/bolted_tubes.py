@@ -25,6 +25,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from slewing_model import load_bearing  # noqa: E402
+from references.validation.figure import pyplot, save  # noqa: E402
 
 DATA = Path(__file__).resolve().parent / "data" / "bolted_tubes.csv"
 DIAGONALS = ((1, 3), (4, 2))
@@ -89,11 +90,8 @@ def main(argv=None) -> int:
             if drift > 1e-6:
                 print(f"  note: the live model differs from the model stored with the reference by {drift:.1e} of its peak")
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(len(tubes), len(cases), figsize=(11, 3.6 * len(tubes)), squeeze=False)
     ang = 360.0 * np.arange(B // 2 + 1) / B
     for i, e in enumerate(tubes):
@@ -116,10 +114,7 @@ def main(argv=None) -> int:
             ax.legend(fontsize=7)
     fig.suptitle(f"{bearing.name}: both rings bolted to 300 mm tubes, balls 0..{B // 2} (the other half mirrors them)",
                  fontsize=10)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    print(f"figure: {out}")
-    return 0
+    return save(fig, out)
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ sys.path.insert(0, str(ROOT))
 
 from slewing_model import Loads, load_bearing, solve  # noqa: E402
 from slewing_model.friction import catalogue_torque, friction_torque  # noqa: E402
+from references.validation.figure import pyplot, save  # noqa: E402
 
 CASES = [("axial Fa 1000 kN", Loads(Fz=1000e3)),
          ("moment Mk 1000 kN m", Loads(My=1000e3)),
@@ -60,11 +61,8 @@ def main(argv=None) -> int:
         print(f"{label} sweep: analytical / catalogue from {ana[0] / cat[0]:.2f} at {s[0] / 1e6:g} to "
               f"{ana[-1] / cat[-1]:.2f} at {s[-1] / 1e6:g} (MN m or MN)")
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.6), gridspec_kw={"width_ratios": [1.3, 1]})
     x = np.arange(len(CASES))
     for k, preload in enumerate((0.0, 20e-6)):
@@ -91,10 +89,7 @@ def main(argv=None) -> int:
     a2.set_title("sweep, no preload (band: catalogue +-25 %)", fontsize=10)
     a2.legend(fontsize=8)
     a2.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    print(f"figure: {out}")
-    return 0
+    return save(fig, out)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from slewing_model import load_bearing  # noqa: E402
+from references.validation.figure import pyplot, save  # noqa: E402
 
 DATA = Path(__file__).resolve().parent / "data" / "clamped_ring_ccx.csv"
 CASES = {  # name: (ring, sector in deg or None, slabs)
@@ -119,11 +120,8 @@ def main(argv=None) -> int:
         print(f"| {name} | {n} | {np.abs(ch).max() * 1e12:.3f} | {rel:.1e} | "
               + ", ".join(f"contact {c}: {d:+.1e}" for c, d in normals) + " |")
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
     iu = np.triu_indices(4)
     lim = 0.0
@@ -144,10 +142,7 @@ def main(argv=None) -> int:
     axes[1].set_ylabel("largest entry difference / largest entry")
     axes[1].set_title("difference (n = 0: axial pattern, n = 1: tilting pattern)", fontsize=10)
     axes[1].grid(axis="y", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    print(f"figure: {out}")
-    return 0
+    return save(fig, out)
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 import slewing_model.life as life  # noqa: E402
+from references.validation.figure import pyplot, save  # noqa: E402
 
 Z, DW, DM = 7, 11.5e-3, 43.5e-3
 RI, RE, C = 0.52 * DW, 0.53 * DW, 23400.0
@@ -74,11 +75,8 @@ def main(argv=None) -> int:
         print(f"| Qc {ring} from the geometry (Lundberg-Palmgren, bm 1.3) [N] | {ref:g} | {val:.5g} | "
               f"{val / ref - 1:+.1%} |")
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(8, 4.6))
     names = [n for n, _, _ in PUBLISHED]
     # the published value's last digit: half a unit of it, relative
@@ -95,10 +93,7 @@ def main(argv=None) -> int:
     ax.set_title("ISO/TS 16281 check case: radial ball bearing, Z 7, Dw 11.5 mm, C 23.4 kN", fontsize=10)
     ax.legend(loc="upper center", bbox_to_anchor=(0.4, -0.14), ncol=2, fontsize=8)
     ax.grid(axis="x", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    print(f"figure: {out}")
-    return 0
+    return save(fig, out)
 
 
 if __name__ == "__main__":

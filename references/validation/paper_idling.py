@@ -24,6 +24,7 @@ sys.path.insert(0, str(ROOT))
 
 from slewing_model import load_bearing, solve  # noqa: E402
 from slewing_model.rings.superelement import build_superelement  # noqa: E402
+from references.validation.figure import pyplot, save  # noqa: E402
 
 #: the paper's section 4.1 text, um: (preload, rings) -> (mean, max - min or None)
 PAPER = {(0, "rigid"): (5.0, 14.0), (0, "flexible"): (3.0, 12.0),
@@ -50,11 +51,8 @@ def main(argv=None) -> int:
         print(f"flexible / rigid at +{preload} um: mean paper {PAPER[preload, 'flexible'][0] / PAPER[preload, 'rigid'][0]:.2f}"
               f", model {ours[preload, 'flexible'][0] / ours[preload, 'rigid'][0]:.2f}")
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     keys = list(PAPER)
     labels = [f"+{k[0]} um\n{k[1]}" for k in keys]
@@ -74,10 +72,7 @@ def main(argv=None) -> int:
         ax.grid(axis="y", alpha=0.3)
     axes[0].legend(fontsize=8)
     fig.suptitle(f"{bearing.name}: idling, rigid and flexible (free) rings, paper section 4.1", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    print(f"figure: {out}")
-    return 0
+    return save(fig, out)
 
 
 if __name__ == "__main__":

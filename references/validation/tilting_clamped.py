@@ -29,6 +29,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from slewing_model import Loads, load_bearing, solve  # noqa: E402
+from references.validation.figure import pyplot, save  # noqa: E402
 
 REF_NEAR_FACE = (0.032, 0.034)        # contacts next to the fixed face, over the rigid-ring value - 1
 REF_LIFT = 14.2e-6                    # m
@@ -78,11 +79,8 @@ def main(argv=None) -> int:
     rigid = solve(bearing, Loads(My=m_ref))
     flex = solve(bearing, Loads(My=m_ref), model="flexible", superelement=ses["v3"])
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.4))
     for variant, style, label in (("v3", "o-", "model (superelement)"), ("none", "s--", "model, no projection")):
         a1.plot(MOMENTS / 1e6, rows[variant][:, 1] * 100, style, color="C0", ms=4,
@@ -107,10 +105,7 @@ def main(argv=None) -> int:
                  fontsize=9)
     a2.legend(fontsize=7)
     a2.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    print(f"figure: {out}")
-    return 0
+    return save(fig, out)
 
 
 if __name__ == "__main__":
