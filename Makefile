@@ -75,7 +75,7 @@ screenshots: docs
 	  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; }
 	mkdir -p results/screenshots
 	for page in $(SHOTS); do \
-	  chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1400,1800 \
+	  chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --virtual-time-budget=5000 --window-size=1400,1800 \
 	    --screenshot=results/screenshots/$$(echo $$page | tr / -).png "file://$(CURDIR)/docs/_build/html/$$page.html" 2>/dev/null; \
 	done
 	@ls results/screenshots
