@@ -142,3 +142,26 @@ def test_the_repository_root_holds_what_the_design_names():
                "examples", "benchmarks", "references", "docs", "README.md", "LICENSE", "CHANGELOG.md", "Makefile",
                ".gitignore", ".ci"}
     assert top <= allowed, sorted(top - allowed)
+
+
+def test_the_fmu_variables_page_says_what_the_fmu_says():
+    """Every variable of the FMU stands on the variables page with its unit and its description as the
+    FMU's modelDescription.xml gives them (fmu_src/bearing_variables.py writes both)."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "fmu_src"))
+    import bearing_variables as variables
+
+    rows = {}
+    for line in (DOCS / "fmu" / "variables.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) > 2 and re.fullmatch(r"`[^`]+`", cells[0]):
+            rows[cells[0].strip("`")] = cells
+    named = [(name, unit, text) for name, unit, text in variables.INPUTS + variables.OUTPUTS]
+    named += [(name, unit, text) for name, unit, text, *_ in variables.REAL_PARAMETERS]
+    assert named and all(name in rows for name, _, _ in named), sorted({n for n, _, _ in named} - set(rows))
+    for name, unit, text in named:
+        assert unit in rows[name], (name, unit)
+        assert any(cell.startswith(text) for cell in rows[name]), (name, text)
+    for name, choices, text in variables.INTEGER_PARAMETERS:
+        assert any(cell.startswith(text) for cell in rows[name]), (name, text)
