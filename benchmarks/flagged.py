@@ -4,8 +4,8 @@ A bounded step (``step_work`` = "bounded") that cannot reach the equilibrium wit
 with its last iterate, flagged by ``distribution.converged`` False (the FMU: ``equilibrium_residual``
 above ``tolerance``). This runs the pitch bearing's five real-time scenarios (``realtime``)
 through the library's simulator twice, bounded and complete, step by step side by side (flexible
-rings, friction and life on), and compares the flagged steps' friction torque and largest ball load
-with the complete steps': as answered (the iterate) and, for comparison, as the last equilibrium of
+rings, friction and life on), and compares the flagged steps' friction torque, largest ball load and
+ring displacements (axial ``z``, tilt ``(rx, ry)``) with the complete steps': as answered (the iterate) and, for comparison, as the last equilibrium of
 the bounded run would give them (held) and as a rigid-ring simulator stepped alongside gives them (the
 cheap approximate answer such a step could give instead). Accuracy, not time: the figures do not depend
 on the machine.
@@ -23,8 +23,9 @@ from .suite import print_table
 def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
     """Per flagged step: (residual, friction torque error of the iterate, of the held equilibrium,
     largest ball load error of the iterate, of the held equilibrium, friction torque error of the rigid
-    rings, largest ball load error of the rigid rings), relative to the complete step; and the flexible
-    runs' life damage at the end."""
+    rings, largest ball load error of the rigid rings, axial displacement error of the iterate, its tilt
+    error), relative to the complete step (the tilt's: the norm of the difference of ``(rx, ry)`` over
+    the complete step's); and the flexible runs' life damage at the end."""
     from slewing_model import Loads, load_bearing
     from slewing_model.rings.superelement import build_superelement
     from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
@@ -54,10 +55,13 @@ def flagged_errors(name: str) -> tuple[np.ndarray, dict]:
 
         (torque_iterate, peak_iterate), (torque_held, peak_held), (torque_rigid, peak_rigid) = map(
             errors, (bounded, held, out["rigid"]))
+        moved, reached = bounded.distribution.displacement, complete.distribution.displacement
+        axial = moved[2] / reached[2] - 1.0
+        tilt = float(np.linalg.norm(moved[3:5] - reached[3:5]) / np.linalg.norm(reached[3:5]))
         rows.append((bounded.distribution.residual, torque_iterate, torque_held, peak_iterate, peak_held,
-                     torque_rigid, peak_rigid))
+                     torque_rigid, peak_rigid, axial, tilt))
     damage = {work: sims[work].life.worst_damage for work in ("complete", "bounded")}
-    return np.array(rows).reshape(-1, 7), damage
+    return np.array(rows).reshape(-1, 9), damage
 
 
 def _spread(errors: np.ndarray) -> str:
@@ -78,11 +82,13 @@ def main(args) -> None:
         residual = f"{np.median(errors[:, 0]):.1e} / {errors[:, 0].max():.1e}" if errors.size else "–"
         rows.append([name, str(len(errors)), residual, _spread(errors[:, 1]), _spread(errors[:, 2]),
                      _spread(errors[:, 3]), _spread(errors[:, 4]), _spread(errors[:, 5]), _spread(errors[:, 6]),
+                     _spread(errors[:, 7]), _spread(errors[:, 8]),
                      f"{damage['bounded'] / damage['complete']:.4f}" if damage["complete"] > 0 else "–"])
     print_table("Flagged bounded steps against the complete steps (pitch bearing, library); errors relative, "
                 "median / 90th percentile / largest",
                 ["scenario", "flagged steps", "residual (median / largest)", "friction torque: iterate",
                  "friction torque: last equilibrium", "largest ball load: iterate", "largest ball load: last equilibrium",
-                 "friction torque: rigid rings", "largest ball load: rigid rings",
+                 "friction torque: rigid rings", "largest ball load: rigid rings", "axial displacement: iterate",
+                 "tilt: iterate",
                  "life damage, bounded / complete"], rows)
 

@@ -510,3 +510,78 @@ def test_a_series_without_quantisation_keeps_the_tolerance_as_micro_swing(kind):
     r = life.analyse_run(acc)
     assert r.micro_swing == model.settings.reversal_tolerance
     assert r.micro_cycles == 0 and r.count.sum() >= 3
+
+
+# ---- flagged steps (a bounded step's iterate): counted with the next equilibrium --------------------
+def ball_pattern_step(bearing, psi, diagonal, converged=True):
+    """A load distribution at rotation ``psi`` whose ball loads go with the balls, the same at every
+    ``psi``: ball j carries 1e5 (1 + 0.5 cos 2πj/Z) N on ``diagonal`` (1: contacts 1 and 3, 2: contacts 2
+    and 4). A flagged one (``converged`` False) carries NaN for every load and patch, an iterate that
+    must not enter any sum."""
+    step = synthetic_step(BEARING, psi, lambda phi: np.zeros_like(phi))
+    j = np.arange(bearing.ball_count)
+    q = np.zeros((bearing.ball_count, 4))
+    q[:, [diagonal - 1, diagonal + 1]] = (1e5 * (1 + 0.5 * np.cos(2 * np.pi * j / bearing.ball_count)))[:, None]
+    if not converged:
+        q = np.full_like(q, np.nan)
+    step.contact_load, step.contact_pressure, step.converged = q, q * 1e3, converged
+    step.semi_axis_b = np.where(q > 0, 1e-3, 0.0) if converged else np.full_like(q, np.nan)
+    return step
+
+
+@pytest.mark.parametrize("record", [False, True])
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_flagged_steps_are_counted_with_the_next_equilibrium(kernel, record):
+    """The loads switch from diagonal 1 to diagonal 2 at step 30 and the next 25 steps are flagged (NaN
+    loads): the ring swings on in them, forward, back past the reversal tolerance, back by less than it,
+    and forward over a long stretch. Their rolling is counted with the next equilibrium's loads
+    (diagonal 2): the map, the half-cycles, the rolled angle and the recorded rows equal those of a run
+    whose every step is the equilibrium of the loads it carries (diagonal 2 from step 30 on), with no
+    damage added while the steps are flagged. A state taken among the flagged steps (through JSON, as an
+    FMU's serialized state) goes on to the same end. Without recording, a monotone stretch of flagged
+    steps is kept as its ends."""
+    from conftest import through_json
+
+    tol = life.LifeSettings().reversal_tolerance
+    psis = np.concatenate([np.linspace(0.0, 0.01, 30),                         # converged, diagonal 1
+                           0.01 + np.linspace(0.0, 0.004, 5)[1:],              # flagged from step 30 ...
+                           0.014 - np.linspace(0.0, 0.006, 5)[1:],             # ... a reversal
+                           0.008 + np.array([0.001, 0.002, 0.002 - 0.3 * tol]),   # a step back below tol
+                           0.0102 + np.linspace(0.0, 0.02, 14)[1:],            # a long monotone stretch
+                           0.0302 - np.linspace(0.0, 0.03, 41)[1:]])           # converged, diagonal 2
+    flagged = np.zeros(psis.size, bool)
+    flagged[30:55] = True
+    model = life.LifeModel(BEARING, "inner", "fixed")
+    reference, tested = (life.LifeAccumulator(model, record=record, kernel=kernel) for _ in range(2))
+    resumed = None
+    for k, psi in enumerate(psis):
+        loads = (0.0, 0.0, 1e6, 0.0, float(k))
+        diagonal = 1 if k < 30 else 2
+        reference.step(0.1 * k, psi, ball_pattern_step(BEARING, psi, diagonal), loads)
+        before = tested.worst_damage
+        for acc in (tested, resumed):
+            if acc is not None:
+                acc.step(0.1 * k, psi, ball_pattern_step(BEARING, psi, diagonal, not flagged[k]), loads)
+        if flagged[k]:
+            assert tested.worst_damage == before and tested.pending_steps == k - 29
+        if k == 40:
+            resumed = life.LifeAccumulator(model, record=record, kernel=kernel)
+            resumed.rows = list(tested.rows)
+            resumed.set_state(through_json(tested.get_state()))
+        if k == 54 and not record:
+            assert len(tested._pending) == 7          # its 5 reversals of psi and its 2 ends
+    assert tested.pending_steps == 0
+    for acc in (tested, resumed):
+        assert acc.track_damage[[1, 3]].min() > 0 and acc.track_damage[0] > 0
+        np.testing.assert_allclose(acc.map.damage_map, reference.map.damage_map, rtol=1e-12, atol=0.0)
+        np.testing.assert_allclose(acc.track_damage, reference.track_damage, rtol=1e-12)
+        assert acc.map.rolled == pytest.approx(reference.map.rolled, rel=1e-12)
+        assert acc.map.rolled == pytest.approx(np.sum(np.abs(np.diff(psis))), rel=1e-12)
+        assert (acc.half.completed, acc.half.direction) == (reference.half.completed, reference.half.direction)
+        assert acc.last_ratio == pytest.approx(reference.last_ratio, rel=1e-12)
+        assert acc.half.last_swing == pytest.approx(reference.half.last_swing, rel=1e-12)
+        if record:
+            mine, theirs = acc.records(), reference.records()
+            for name in theirs:
+                np.testing.assert_allclose(mine[name], theirs[name], rtol=1e-12, err_msg=name)
+    assert reference.half.completed >= 3

@@ -113,3 +113,64 @@ def test_library_life_state_round_trip():
         sim.step(Loads(u["Fx"], u["Fy"], u["Fz"], u["Mx"], u["My"]), u["psi"], u["omega"])
         assert sim.life.worst_damage == d and sim.life.last_ratio == r
         np.testing.assert_array_equal(sim.life.map.damage_map, m)
+
+
+def test_fmu_life_counts_no_damage_from_a_flagged_step(table3_fmu):
+    """step_work = 2 (bounded), a tilting moment turned by a quarter turn in one step while the ring
+    turns: the steps flagged by equilibrium_residual add no damage (life_damage holds over them) and the
+    next converged step counts their rolling, as the library does (to 1e-7, as above); a state serialized
+    right after a flagged step, its rolling not yet counted, repeats the run's outputs bit for bit."""
+    from slewing_model.rings.superelement import build_superelement
+
+    md = read_model_description(str(table3_fmu))
+    unzipped = extract(str(table3_fmu))
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="flagged")
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    names, outputs = ["Fz", "Mx", "My", "psi", "omega"], ["life_damage", "equilibrium_residual"]
+
+    def values(k):                  # the moment turned by a quarter turn at step 4, the ring turning
+        moment = (1.5e4, 5e4) if k < 4 else (-5e4, 1.5e4)
+        return [1e5, *moment, 0.4 + 0.01 * k, 1.0]
+
+    bearing = load_bearing(BEARING)
+    sim = BearingSimulator(bearing, build_superelement(bearing, mesh="coarse", bc="free"),
+                           SimulatorSettings(step_work="bounded", life=True))
+    try:
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setInteger([refs["step_work"]], [2])
+        fmu.setReal([refs[n] for n in names], values(0))
+        fmu.exitInitializationMode()
+        first = values(0)
+        sim.step(Loads(Fz=first[0], Mx=first[1], My=first[2]), first[3], first[4])
+
+        def run(steps):
+            out = []
+            for k in steps:
+                fmu.setReal([refs[n] for n in names], values(k))
+                fmu.doStep(k * DT, DT)
+                out.append(tuple(fmu.getReal([refs[n] for n in outputs])))
+            return out
+
+        seen, state = [], None
+        for k in range(12):
+            if k == 5:                  # after the flagged step 4
+                state = fmu.serializeFMUstate(fmu.getFMUstate())
+            seen += run([k])
+            v = values(k)
+            sim.step(Loads(Fz=v[0], Mx=v[1], My=v[2]), v[3], v[4])
+            assert seen[-1][0] == pytest.approx(sim.life.worst_damage, rel=1e-7, abs=0.0)
+        flagged = [k for k, (_, residual) in enumerate(seen) if residual > 1e-7]   # above the tolerance
+        assert 4 in flagged and seen[-1][1] <= 1e-7
+        for k in flagged:
+            assert seen[k][0] == seen[k - 1][0]
+        assert seen[5][0] > seen[4][0]
+        assert seen[-1][0] > seen[3][0] > 0
+        fmu.setFMUstate(fmu.deSerializeFMUstate(state))
+        assert run(range(5, 12)) == seen[5:]
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)

@@ -266,10 +266,28 @@ class LifeAccumulator:
         self.half = HalfCycles()
         self.record = record
         self.rows: list = []
+        #: the flagged steps not yet counted (:meth:`step`): ``[time, psi, ball_angle, loads]`` each
+        self._pending: list = []
+        self._waiting = 0               # flagged steps behind them (a monotone stretch is kept as its ends)
 
     # ---- one step ------------------------------------------------------------------------
     def step(self, time: float, psi: float, distribution, loads=None) -> None:
         """Add a step.
+
+        A step whose load distribution is not an equilibrium (``distribution.converged`` False: a
+        bounded step's iterate, ``step_work="bounded"``) adds no damage from its loads: its ring angle
+        and ball places are kept, and the next converged step counts the rolling of the flagged steps
+        with its own load distribution (:meth:`_count`), before its own.
+
+        Why the next equilibrium and not the last one: the flagged steps follow a sudden change of the
+        loads (a moment reversed, a load switched), and the bearing carries the new loads in them, the
+        solver only lags behind. The next converged step is the equilibrium of those new loads (of the
+        same loads where they hold, as after a reversal: then the damage is the complete steps'); the
+        last equilibrium is that of the loads before the change: after a reversal it loads the
+        opposite diagonal, so it would put the flagged steps' damage on the wrong tracks. The balls
+        roll over the raceway in the flagged steps either way: their rolled angle is counted, not
+        dropped. An iterate is no load to count: after a moment reversal its largest ball load is up
+        to several times the equilibrium's, and its damage goes with the cube of that.
 
         Parameters
         ----------
@@ -284,8 +302,20 @@ class LifeAccumulator:
             (``record`` only).
         """
         d = distribution
-        self.map.update(d.ball_angle, psi, d.contact_load)
+        if not getattr(d, "converged", True):
+            self._defer(time, psi, d.ball_angle, loads)
+            return
         widest, widest_angle = self._widest_contacts(d.semi_axis_b, d.contact_angle)
+        if self._pending:
+            for when, angle, balls, given in self._pending:
+                self._count(when, angle, balls, d, widest, widest_angle, given)
+            self._pending, self._waiting = [], 0
+        self._count(time, psi, d.ball_angle, d, widest, widest_angle, loads)
+
+    def _count(self, time, psi, ball_angle, d, widest, widest_angle, loads) -> None:
+        """Add the passes up to the ring angle ``psi`` and ball places ``ball_angle`` with the loads of the
+        equilibrium ``d`` (its widest patches ``widest``, ``widest_angle``), and the half-cycles of ``psi``."""
+        self.map.update(ball_angle, psi, d.contact_load)
         self._half_cycle(psi, widest, widest_angle)
         if self.record:
             pea = float(equivalent_axial_load(np.asarray(loads, float)[:5], self.model.bearing.pitch_diameter)[0]) \
@@ -293,6 +323,32 @@ class LifeAccumulator:
             self.rows.append((time, psi, self.model.track_equivalent_loads(d.contact_load),
                               self.model.track_standing_loads(d.contact_load), widest,
                               widest_angle, d.contact_pressure.max(axis=0), pea))
+
+    def _defer(self, time, psi, ball_angle, loads) -> None:
+        """Keep a flagged step's ring angle and ball places for the next converged step (:meth:`step`).
+
+        Where ``psi`` goes on the same way as over the last two kept steps (and every ball's place on
+        both rings with it), the last kept step is replaced, not added to: under one load the passes
+        and half-cycles of a monotone stretch are those of its ends, so a long flagged stretch keeps
+        only its reversals. The first kept step stays: the pass to it carries the mean of the last
+        equilibrium's ``Q^3`` and the next one's, as in the complete steps. Not while recording (a row
+        a step)."""
+        angle = np.array(ball_angle, dtype=float)
+        point = [time, float(psi), angle, None if loads is None else np.array(loads, dtype=float)]
+        self._waiting += 1
+        pending = self._pending
+        if not self.record and len(pending) >= 2:
+            (_, psi0, angle0, _), (_, psi1, angle1, _) = pending[-2], pending[-1]
+            if ((psi1 - psi0) * (psi - psi1) >= 0.0 and np.all((angle1 - angle0) * (angle - angle1) >= 0.0)
+                    and np.all((angle1 - psi1 - angle0 + psi0) * (angle - psi - angle1 + psi1) >= 0.0)):
+                pending[-1] = point
+                return
+        pending.append(point)
+
+    @property
+    def pending_steps(self) -> int:
+        """Flagged steps whose rolling waits for the next converged step (:meth:`step`); 0 after it."""
+        return self._waiting
 
     def _widest_contacts(self, semi_b, contact_angle):
         """The widest patch of each track this step (4,) and its contact angle (4,)."""
@@ -355,13 +411,14 @@ class LifeAccumulator:
 
     # ---- state ---------------------------------------------------------------------------
     def get_state(self) -> dict:
-        """The accumulator's state: the raceway map's, the half-cycle detector's and the number of recorded rows."""
+        """The accumulator's state: the raceway map's, the half-cycle detector's, the number of recorded rows and
+        the flagged steps not yet counted (:meth:`step`)."""
         h = self.half
         return {"map": self.map.get_state(),
                 "half": {"direction": h.direction, "turn": h.turn, "extreme": h.extreme, "b_max": h.b_max,
                          "angle": h.angle, "last_ratio": h.last_ratio, "last_swing": h.last_swing,
                          "completed": h.completed},
-                "rows": len(self.rows)}
+                "rows": len(self.rows), "pending": [list(p) for p in self._pending], "waiting": self._waiting}
 
     def set_state(self, state: dict) -> None:
         """Restore a state of :meth:`get_state`; recorded rows after it are dropped."""
@@ -371,6 +428,9 @@ class LifeAccumulator:
                                np.array(s["b_max"], dtype=float), np.array(s["angle"], dtype=float),
                                float(s["last_ratio"]), float(s["last_swing"]), int(s["completed"]))
         del self.rows[int(state.get("rows", len(self.rows))):]
+        self._pending = [[None if t is None else float(t), float(p), np.array(a, dtype=float),
+                          None if f is None else np.array(f, dtype=float)] for t, p, a, f in state.get("pending") or []]
+        self._waiting = int(state.get("waiting", len(self._pending)))
 
     def records(self) -> dict:
         """The recorded steps as arrays.

@@ -131,6 +131,9 @@ class RacewayMap:
     ----------
     damage_map : ndarray, shape (4, slices)
         Damage ``d_j`` of every slice of contacts 1..4.
+    rolled : float
+        Rotation of the rings relative to each other counted into the map, ``Σ |Δψ|`` over the
+        updates, rad.
 
     Raises
     ------
@@ -159,6 +162,7 @@ class RacewayMap:
         self._angle = None                              # ball angles of the last step (B,), rad
         self._psi = 0.0
         self._q3 = None                                 # Q^3 of the last step (B, 4)
+        self.rolled = 0.0                               # Σ |Δψ| of the steps counted, rad
 
     def update(self, ball_angle, psi: float, contact_load) -> None:
         """Add the passes from the last step to this one (the first call only records).
@@ -175,6 +179,8 @@ class RacewayMap:
         contact_load : ndarray, shape (B, 4)
             Contact loads ``Q`` of contacts 1..4, N.
         """
+        if self._angle is not None:
+            self.rolled += abs(float(psi) - self._psi)
         if self._angle is not None and self._compiled:     # Q^3 and the passes in one compiled loop
             self._own_map()
             q3 = compiled_map_update()(self.damage_map, self._power, self.scale, self.moving, self._angle,
@@ -242,13 +248,14 @@ class RacewayMap:
         Returns
         -------
         dict
-            The map, its sums, the last ball angles (rad), ring angle (rad) and ``Q^3`` (N^3).
+            The map, its sums, the last ball angles (rad), ring angle (rad), ``Q^3`` (N^3) and
+            rolled angle (rad).
             The map is not copied: the next update copies it before a change; the others are
             replaced, not changed, by an update.
         """
         self._shared = True
         return {"map": self.damage_map, "power": self._power.copy(), "angle": self._angle, "psi": self._psi,
-                "q3": self._q3}
+                "q3": self._q3, "rolled": self.rolled}
 
     def set_state(self, state: dict) -> None:
         """Restore a state of :meth:`get_state` (or its JSON form decoded)."""
@@ -260,6 +267,7 @@ class RacewayMap:
         self._angle = None if state["angle"] is None else np.array(state["angle"], dtype=float)
         self._psi = float(state["psi"])
         self._q3 = None if state["q3"] is None else np.array(state["q3"], dtype=float)
+        self.rolled = float(state.get("rolled", 0.0))
 
 
 def track_damage(damage_map) -> np.ndarray:

@@ -103,7 +103,8 @@ class SimulatorSettings:
         more answers with its last iterate, ``distribution.converged`` False and its
         ``distribution.residual``, and carries the rest over to the next steps; the friction
         torque of such a step is an iterate too (at most 4 iterations of the ball
-        equilibrium). The first step is complete.
+        equilibrium), and the life accumulator counts no damage from it: the rolling of such
+        steps is counted with the next converged step's load distribution. The first step is complete.
     life : bool
         Accumulate the raceway life and wear step by step (:class:`slewing_model.life.LifeAccumulator`
         as ``BearingSimulator.life``, default :class:`slewing_model.life.LifeSettings`): the
@@ -390,6 +391,8 @@ class BearingSimulator:
             self._friction_warm, self._friction_converged = friction.state, converged
         signed = regularised_torque(magnitude, omega, self.settings.omega_regularisation)
         if self.life is not None:       # the last that can fail: a step that raises leaves life as it was
+            # a flagged step (an iterate) adds no damage: the accumulator keeps its ring angle and ball places
+            # and counts their rolling with the next converged step's loads (LifeAccumulator.step says why)
             self.life.step(None, psi, distribution)
         # an iterate on its way (a bounded step) is no point of the trajectory to extrapolate from or to
         keep = distribution.converged and self._warm_converged
