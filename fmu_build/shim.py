@@ -4,7 +4,8 @@ and :mod:`fmu_build.drive`).
 :func:`install_python_shim` compiles the layer (``fmu_src/shim/``) into a built FMU, in front of pythonfmu's
 binary, and writes ``resources/python_runtime.txt``, the file that names the Python the FMU runs in: the
 runtime a standalone FMU carries (:mod:`fmu_build.runtime`, with :mod:`fmu_build.win64` for its Windows
-binary) or, for a host FMU, the building Python.
+binary) or, for a host FMU, the building Python. It also writes ``resources/fmi_variables.tsv``
+(:func:`variables_table`), the table of model variables the layer checks every get and set against.
 """
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import sys
 import sysconfig
 import tempfile
 import warnings
+import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
@@ -33,6 +35,12 @@ INNER_BINARY = "pythonfmu-export.so"
 #: the one file of the FMU that names the Python it needs (read by the layer and by the slave)
 PYTHON_RUNTIME_FILE = "python_runtime.txt"
 PYTHON_HOME_VARIABLE = "SLEWING_FMU_PYTHONHOME"
+#: the FMU's table of model variables (read by the layer: fmu_src/shim/shim_rules.h)
+VARIABLES_FILE = "fmi_variables.tsv"
+#: FMI 2.0's type elements of a ScalarVariable
+FMI2_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
+#: the default causality and variability of a variable that states none (FMI 2.0 and 3.0)
+DEFAULT_CAUSALITY, DEFAULT_VARIABILITY = "local", "continuous"
 
 
 def c_compiler() -> str:
@@ -67,6 +75,45 @@ def compile_shim(output, fmi_version=2) -> Path:
     if run.returncode != 0:
         raise RuntimeError(f"compiling the FMU's Linux binary failed ({' '.join(command)}):\n{run.stderr}")
     return output
+
+
+def variables_table(model_description: bytes | str) -> str:
+    """``resources/fmi_variables.tsv`` of an FMU, from its ``modelDescription.xml`` (FMI 2.0 or 3.0).
+
+    One line per model variable, ``value_reference<TAB>type<TAB>causality<TAB>variability<TAB>initial<TAB>name``,
+    the type as the modelDescription names it (FMI 2.0: Real, Integer, Boolean, String, Enumeration;
+    FMI 3.0: Float64, Int32, Boolean, ...), ``initial`` empty where the description states none, and the
+    standard's defaults where a variable states none: causality local, variability continuous for a Real
+    (FMI 2.0) or float (FMI 3.0) variable and discrete for the others; lines starting with
+    ``#`` are comments. Raises ValueError where the description has no model variables or a variable
+    lacks its name or value reference."""
+    root = ET.fromstring(model_description)
+    version = root.get("fmiVersion", "")
+    variables = root.find("ModelVariables")
+    if variables is None:
+        raise ValueError("the modelDescription has no ModelVariables")
+    lines = [f"# model variables of {root.get('modelName', '')} (FMI {version}), written by build_fmu.py from "
+             "modelDescription.xml\n",
+             "# value_reference\ttype\tcausality\tvariability\tinitial\tname\n"]
+    for element in variables:
+        if element.tag == "ScalarVariable":                       # FMI 2.0
+            typed = next((child for child in element if child.tag in FMI2_TYPES), None)
+            if typed is None:
+                raise ValueError(f"variable {element.get('name')!r} has no type element")
+            kind = typed.tag
+            default_variability = DEFAULT_VARIABILITY if kind == "Real" else "discrete"
+        else:                                                     # FMI 3.0: the element is the type
+            kind = element.tag
+            default_variability = DEFAULT_VARIABILITY if kind.startswith("Float") else "discrete"
+        name, reference = element.get("name"), element.get("valueReference")
+        if not name or reference is None or not reference.isdigit():
+            raise ValueError(f"model variable {name!r}: no name or no valid valueReference ({reference!r})")
+        if any(c in name for c in "\t\r\n"):
+            raise ValueError(f"model variable {name!r}: a tab or line break in its name")
+        lines.append("\t".join((reference, kind, element.get("causality", DEFAULT_CAUSALITY),
+                                element.get("variability", default_variability), element.get("initial", ""),
+                                name)) + "\n")
+    return "".join(lines)
 
 
 def python_runtime() -> dict[str, str]:
@@ -118,6 +165,7 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
         with zipfile.ZipFile(fmu) as src:
             if binary not in src.namelist():
                 raise RuntimeError(f"{fmu} has no {binary}: is it a pythonfmu FMU of {model_identifier}?")
+            table = variables_table(src.read("modelDescription.xml"))
             inner = tmp / INNER_BINARY
             inner.write_bytes(Path(export_library).read_bytes() if export_library else src.read(binary))
             needs = [version_needs(inner), version_needs(shim), *extra_needs]
@@ -168,13 +216,14 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                         dst.write(inner, f"{folder}/{INNER_BINARY}")
                     elif win64 and info.filename in windows:
                         continue                          # pythonfmu's DLL: written below, behind our layer
-                    elif not info.filename.endswith(PYTHON_RUNTIME_FILE):
+                    elif not info.filename.endswith((PYTHON_RUNTIME_FILE, VARIABLES_FILE)):
                         dst.writestr(info, src.read(info.filename))
                 dst.write(shim, binary)
                 for name, path in (windows.items() if win64 else ()):
                     dst.write(path, name)
                 dst.writestr(f"resources/{PYTHON_RUNTIME_FILE}",
                              header + "".join(f"{k}={v}\n" for k, v in described.items()))
+                dst.writestr(f"resources/{VARIABLES_FILE}", table)
         shutil.move(str(rewritten), fmu)
     return described
 

@@ -1,0 +1,515 @@
+/* What the FMI 2.0 and FMI 3.0 layers (fmi2_shim.c, fmi3_shim.c) share to enforce the standard:
+ * the FMU's table of variables, the header of a serialized FMU state, the tracking of state
+ * pointers, the step-time tolerance and message formatting. Header only (every function is
+ * static), plain C types only (no FMI types), Linux (gcc) and Windows (mingw-w64) alike: include
+ * it after shim_platform.h.
+ *
+ * API
+ *
+ * Variables table: resources/fmi_variables.tsv, written by fmu_build/shim.py from the FMU's own
+ * modelDescription.xml, one line per model variable:
+ *     value_reference TAB type TAB causality TAB variability TAB initial TAB name
+ * (type as the modelDescription names it: Real/Integer/Boolean/String in FMI 2.0, Float64/Int32/...
+ * in FMI 3.0; initial may be empty; lines starting with '#' and empty lines are skipped).
+ *
+ *   typedef struct { unsigned int vr; char type[16]; char causality[24]; char variability[16];
+ *                    char initial[16]; char *name; } ShimVariable;
+ *   typedef struct { ShimVariable *items; size_t n; } ShimVariables;
+ *
+ *   int shim_variables_load(ShimVariables *t, const char *resource_location, char *err, size_t size);
+ *       Reads <resources>/fmi_variables.tsv. resource_location: FMI 2.0's fmuResourceLocation (a URI:
+ *       file:///path, file:/path, file://localhost/path, file:///C:/path, on Windows file://server/share/path;
+ *       %-escapes decoded) or
+ *       FMI 3.0's resourcePath (a plain path, with or without its trailing separator).
+ *       0, or -1 with a message in err (the file's path and what is wrong); *t is then empty.
+ *   int shim_resource_path(const char *resource_location, const char *file, char *path, size_t size);
+ *       The path of `file` in the resources folder (what shim_variables_load opens). 0, or -1.
+ *   const ShimVariable *shim_variable_find(const ShimVariables *t, const char *type, unsigned int vr);
+ *       The variable with value reference vr and that type ("Real", "Float64", ...; NULL: any type,
+ *       as in FMI 3.0 where value references are unique across types), or NULL.
+ *   void shim_variables_free(ShimVariables *t);
+ *
+ *   enum { SHIM_BEFORE_INITIALIZATION, SHIM_INITIALIZING, SHIM_RUNNING };
+ *   int shim_may_set(const ShimVariable *v, int phase, const char *exit_initialization,
+ *                    char *why, size_t size);
+ *       1 where the variable may be set in that phase (before initialization: FMI 2.0's Instantiated,
+ *       FMI 3.0's Instantiated; initializing: InitializationMode; running: StepComplete/StepMode and
+ *       the like). 0 with the reason in why, e.g. "is an output: it cannot be set" or "is a fixed
+ *       parameter: it can be set only before fmi2ExitInitializationMode" (exit_initialization names
+ *       that function). Rules: inputs and parameters (fixed or tunable) may be set before and during
+ *       initialization; once running, inputs and tunable parameters only; outputs, locals,
+ *       calculated parameters, independents and constants never.
+ *
+ * Serialized state header (SHIM_STATE_HEADER_SIZE = 40 bytes, little-endian whatever the machine):
+ *     8 bytes magic "SLWFMUST", 4 bytes format version (SHIM_STATE_FORMAT), 4 bytes reserved (0),
+ *     8 bytes FNV-1a 64-bit hash of the FMU's GUID / instantiation token, 8 bytes the communication
+ *     time (IEEE double), 8 bytes the payload length; then the payload (pythonfmu's bytes).
+ *
+ *   size_t shim_state_header_size(void);
+ *   void shim_state_header_write(unsigned char *bytes, const char *token, double time, size_t payload);
+ *   int shim_state_header_check(const unsigned char *bytes, size_t size, const char *token,
+ *                               double *time, const unsigned char **payload, size_t *payload_size,
+ *                               char *why, size_t why_size);
+ *       SHIM_STATE_OK (0), or the first check that failed, with a sentence in why:
+ *       SHIM_STATE_SHORT   "no header: N bytes are fewer than the header's 40"
+ *       SHIM_STATE_MAGIC   "no header: wrong magic"
+ *       SHIM_STATE_VERSION "another format version: V, this FMU reads version 1"
+ *       SHIM_STATE_TOKEN   "another FMU's state: its GUID / instantiation token differs"
+ *       SHIM_STATE_LENGTH  "wrong length: the header announces P bytes of state, N follow it"
+ *
+ * FMU state pointers handed to the host (each layer's own small struct, not the inner binary's):
+ *   typedef struct ShimState { unsigned int magic; double time; void *inner; struct ShimState *next; } ShimState;
+ *   ShimState *shim_state_add(ShimState **list, void *inner, double time);    NULL: out of memory
+ *   ShimState *shim_state_lookup(ShimState *list, const void *pointer);      NULL: not one of ours
+ *       (compares pointers only: never reads memory a foreign pointer points to)
+ *   void shim_state_remove(ShimState **list, ShimState *s);                   frees the wrapper only
+ *
+ * Time and messages:
+ *   int shim_same_time(double expected, double got);
+ *       1 where |got - expected| <= 1e-9 * max(1, |expected|) + 1e-12 (the step continuity rule).
+ *   const char *shim_double(char buf[32], double x);
+ *       x with 15 significant digits, as people write it ("5", "0.1", "2.3" for 2.3000000000000003,
+ *       "1e-05"): enough to tell apart two times shim_same_time tells apart.
+ *   void shim_format(char *buf, size_t size, const char *format, ...);
+ *       snprintf that always terminates (truncates). Use %u/%lu/%s/%g, not %zu (old msvcrt).
+ */
+#ifndef SLEWING_SHIM_RULES_H
+#define SLEWING_SHIM_RULES_H
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SHIM_VARIABLES_FILE "fmi_variables.tsv"
+
+/* ---- messages --------------------------------------------------------------------------- */
+static void shim_format(char *buf, size_t size, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4), unused))
+#endif
+    ;
+static void shim_format(char *buf, size_t size, const char *format, ...)
+{
+    if (!buf || size == 0)
+        return;
+    va_list ap;
+    va_start(ap, format);
+    vsnprintf(buf, size, format, ap);
+    va_end(ap);
+    buf[size - 1] = '\0';
+}
+
+#if defined(__GNUC__)
+#define SHIM_UNUSED __attribute__((unused))
+#else
+#define SHIM_UNUSED
+#endif
+
+static SHIM_UNUSED const char *shim_double(char buf[32], double x)
+{
+    snprintf(buf, 32, "%.15g", x);
+    return buf;
+}
+
+static SHIM_UNUSED int shim_same_time(double expected, double got)
+{
+    double scale = expected < 0 ? -expected : expected, gap = got - expected;  /* no libm */
+    if (scale < 1.0)
+        scale = 1.0;
+    if (gap < 0)
+        gap = -gap;
+    return gap <= 1e-9 * scale + 1e-12;  /* false for NaN */
+}
+
+/* ---- variables table -------------------------------------------------------------------- */
+typedef struct {
+    unsigned int vr;
+    char type[16];
+    char causality[24];
+    char variability[16];
+    char initial[16];
+    char *name;
+} ShimVariable;
+
+typedef struct {
+    ShimVariable *items;  /* sorted by vr, then as in the file */
+    size_t n;
+} ShimVariables;
+
+static int shim_hex_digit(char c)
+{
+    if (c >= '0' && c <= '9')
+        return c - '0';
+    if (c >= 'a' && c <= 'f')
+        return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F')
+        return c - 'A' + 10;
+    return -1;
+}
+
+static SHIM_UNUSED int shim_resource_path(const char *location, const char *file, char *path, size_t size)
+{
+    if (!location || !file || !path || size == 0)
+        return -1;
+    const char *p = location;
+    int uri = strncmp(p, "file:", 5) == 0;
+    size_t n = 0;
+    if (uri) {
+        p += 5;
+        if (strncmp(p, "//", 2) == 0) {           /* file://authority/path */
+            p += 2;
+            const char *slash = strchr(p, '/');
+            if (!slash)
+                return -1;
+#ifdef _WIN32
+            if (slash != p && strncmp(p, "localhost/", 10) != 0) {
+                if (size < 3)
+                    return -1;
+                path[n++] = '/';                  /* file://server/share -> //server/share */
+                path[n++] = '/';
+                slash = p;
+            }
+#endif
+            p = slash;                            /* an empty authority or localhost: dropped */
+        }
+#ifdef _WIN32
+        if (p[0] == '/' && p[1] && (p[2] == ':' || p[2] == '|'))
+            p++;                                  /* file:///C:/dir -> C:/dir */
+#endif
+        for (; *p && n + 1 < size; p++) {
+            int hi, lo;
+            if (*p == '%' && (hi = shim_hex_digit(p[1])) >= 0 && (lo = shim_hex_digit(p[2])) >= 0) {
+                path[n++] = (char)(hi * 16 + lo);
+                p += 2;
+            } else {
+                path[n++] = *p;
+            }
+        }
+        if (*p)
+            return -1;
+    } else {
+        n = strlen(p);
+        if (n + 1 > size)
+            return -1;
+        memcpy(path, p, n);
+    }
+    if (n > 0 && path[n - 1] != '/' && path[n - 1] != '\\') {
+        if (n + 2 > size)
+            return -1;
+        path[n++] = '/';
+    }
+    size_t f = strlen(file);
+    if (n + f + 1 > size)
+        return -1;
+    memcpy(path + n, file, f + 1);
+    return 0;
+}
+
+static int shim_variable_compare(const void *a, const void *b)
+{
+    const ShimVariable *x = (const ShimVariable *)a, *y = (const ShimVariable *)b;
+    if (x->vr != y->vr)
+        return x->vr < y->vr ? -1 : 1;
+    return x < y ? -1 : (x > y);
+}
+
+static void shim_variables_free(ShimVariables *t)
+{
+    if (!t)
+        return;
+    for (size_t i = 0; i < t->n; i++)
+        free(t->items[i].name);
+    free(t->items);
+    t->items = NULL;
+    t->n = 0;
+}
+
+static void shim_copy_field(char *dst, size_t size, const char *src)
+{
+    size_t n = strlen(src);
+    if (n >= size)
+        n = size - 1;
+    memcpy(dst, src, n);
+    dst[n] = '\0';
+}
+
+static SHIM_UNUSED int shim_variables_load(ShimVariables *t, const char *resource_location, char *err, size_t size)
+{
+    char path[4096];
+    t->items = NULL;
+    t->n = 0;
+    if (!resource_location || shim_resource_path(resource_location, SHIM_VARIABLES_FILE, path, sizeof path) != 0) {
+        shim_format(err, size, "the FMU's resource location (%s) is not a folder this FMU can read %s from",
+                    resource_location ? resource_location : "none given", SHIM_VARIABLES_FILE);
+        return -1;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        shim_format(err, size, "the FMU's table of variables %s is missing (was the FMU unpacked whole, and built by "
+                    "build_fmu.py?)", path);
+        return -1;
+    }
+    size_t capacity = 1 << 16, length = 0;
+    char *text = (char *)malloc(capacity + 1);
+    while (text) {
+        size_t got = fread(text + length, 1, capacity - length, f);
+        length += got;
+        if (length < capacity)
+            break;
+        char *bigger = (char *)realloc(text, 2 * capacity + 1);
+        if (!bigger) {
+            free(text);
+            text = NULL;
+            break;
+        }
+        text = bigger;
+        capacity *= 2;
+    }
+    fclose(f);
+    if (!text) {
+        shim_format(err, size, "out of memory reading %s", path);
+        return -1;
+    }
+    text[length] = '\0';
+    size_t lines = 1;
+    for (size_t i = 0; i < length; i++)
+        lines += text[i] == '\n';
+    t->items = (ShimVariable *)calloc(lines, sizeof(ShimVariable));
+    if (!t->items) {
+        free(text);
+        shim_format(err, size, "out of memory reading %s", path);
+        return -1;
+    }
+    int status = 0;
+    size_t number = 0;
+    for (char *line = text; line && *line && status == 0;) {
+        char *next = strchr(line, '\n');
+        if (next)
+            *next++ = '\0';
+        number++;
+        size_t n = strlen(line);
+        if (n > 0 && line[n - 1] == '\r')
+            line[--n] = '\0';
+        if (n == 0 || line[0] == '#') {
+            line = next;
+            continue;
+        }
+        char *field[6];
+        int k = 0;
+        field[k++] = line;
+        for (char *q = line; *q && k < 6; q++)
+            if (*q == '\t') {
+                *q = '\0';
+                field[k++] = q + 1;
+            }
+        char *end = NULL;
+        unsigned long vr = k == 6 ? strtoul(field[0], &end, 10) : 0;
+        if (k != 6 || end == field[0] || *end != '\0') {
+            shim_format(err, size, "%s, line %lu: not value_reference<TAB>type<TAB>causality<TAB>variability<TAB>"
+                        "initial<TAB>name", path, (unsigned long)number);
+            status = -1;
+            break;
+        }
+        ShimVariable *v = &t->items[t->n];
+        v->vr = (unsigned int)vr;
+        shim_copy_field(v->type, sizeof v->type, field[1]);
+        shim_copy_field(v->causality, sizeof v->causality, field[2]);
+        shim_copy_field(v->variability, sizeof v->variability, field[3]);
+        shim_copy_field(v->initial, sizeof v->initial, field[4]);
+        v->name = (char *)malloc(strlen(field[5]) + 1);
+        if (!v->name) {
+            shim_format(err, size, "out of memory reading %s", path);
+            status = -1;
+            break;
+        }
+        strcpy(v->name, field[5]);
+        t->n++;
+        line = next;
+    }
+    free(text);
+    if (status != 0) {
+        shim_variables_free(t);
+        return -1;
+    }
+    qsort(t->items, t->n, sizeof(ShimVariable), shim_variable_compare);
+    return 0;
+}
+
+static SHIM_UNUSED const ShimVariable *shim_variable_find(const ShimVariables *t, const char *type, unsigned int vr)
+{
+    if (!t || t->n == 0)
+        return NULL;
+    size_t lo = 0, hi = t->n;  /* first item with items[i].vr >= vr */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t->items[mid].vr < vr)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    for (size_t i = lo; i < t->n && t->items[i].vr == vr; i++)
+        if (!type || !strcmp(t->items[i].type, type))
+            return &t->items[i];
+    return NULL;
+}
+
+enum { SHIM_BEFORE_INITIALIZATION, SHIM_INITIALIZING, SHIM_RUNNING };
+
+static SHIM_UNUSED int shim_may_set(const ShimVariable *v, int phase, const char *exit_initialization, char *why,
+                                    size_t size)
+{
+    const char *c = v->causality, *var = v->variability;
+    if (!strcmp(var, "constant")) {
+        shim_format(why, size, "is a constant: it cannot be set");
+        return 0;
+    }
+    if (!strcmp(c, "input"))
+        return 1;
+    if (!strcmp(c, "parameter")) {
+        if (phase != SHIM_RUNNING || !strcmp(var, "tunable"))
+            return 1;
+        shim_format(why, size, "is a %s parameter: it can be set only before %s", var[0] ? var : "fixed",
+                    exit_initialization);
+        return 0;
+    }
+    if (!strcmp(c, "output"))
+        shim_format(why, size, "is an output: it cannot be set");
+    else if (!strcmp(c, "calculatedParameter"))
+        shim_format(why, size, "is a calculated parameter: it cannot be set");
+    else if (!strcmp(c, "independent"))
+        shim_format(why, size, "is the independent variable: it cannot be set");
+    else if (!strcmp(c, "structuralParameter")) {
+        if (phase != SHIM_RUNNING)
+            return 1;
+        shim_format(why, size, "is a structural parameter: it can be set only before %s", exit_initialization);
+    } else
+        shim_format(why, size, "is a %s variable: it cannot be set", c[0] ? c : "local");
+    return 0;
+}
+
+/* ---- serialized state header ------------------------------------------------------------ */
+#define SHIM_STATE_HEADER_SIZE 40
+#define SHIM_STATE_MAGIC_TEXT "SLWFMUST"
+#define SHIM_STATE_FORMAT 1u
+enum { SHIM_STATE_OK = 0, SHIM_STATE_SHORT, SHIM_STATE_MAGIC, SHIM_STATE_VERSION, SHIM_STATE_TOKEN, SHIM_STATE_LENGTH };
+
+static SHIM_UNUSED size_t shim_state_header_size(void) { return SHIM_STATE_HEADER_SIZE; }
+
+static unsigned long long shim_token_hash(const char *token)
+{
+    unsigned long long h = 14695981039346656037ull;  /* FNV-1a 64 */
+    for (const unsigned char *p = (const unsigned char *)(token ? token : ""); *p; p++) {
+        h ^= *p;
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static void shim_put_u64(unsigned char *p, unsigned long long x)
+{
+    for (int i = 0; i < 8; i++)
+        p[i] = (unsigned char)(x >> (8 * i));
+}
+
+static unsigned long long shim_get_u64(const unsigned char *p)
+{
+    unsigned long long x = 0;
+    for (int i = 0; i < 8; i++)
+        x |= (unsigned long long)p[i] << (8 * i);
+    return x;
+}
+
+static SHIM_UNUSED void shim_state_header_write(unsigned char *bytes, const char *token, double time, size_t payload)
+{
+    unsigned long long bits;
+    memcpy(bytes, SHIM_STATE_MAGIC_TEXT, 8);
+    shim_put_u64(bytes + 8, SHIM_STATE_FORMAT);  /* format version (4 bytes), then 4 reserved */
+    shim_put_u64(bytes + 16, shim_token_hash(token));
+    memcpy(&bits, &time, 8);
+    shim_put_u64(bytes + 24, bits);
+    shim_put_u64(bytes + 32, (unsigned long long)payload);
+}
+
+static SHIM_UNUSED int shim_state_header_check(const unsigned char *bytes, size_t size, const char *token,
+                                               double *time, const unsigned char **payload, size_t *payload_size,
+                                               char *why, size_t why_size)
+{
+    if (!bytes || size < SHIM_STATE_HEADER_SIZE) {
+        shim_format(why, why_size, "no header: %lu bytes are fewer than the header's %d", (unsigned long)size,
+                    SHIM_STATE_HEADER_SIZE);
+        return SHIM_STATE_SHORT;
+    }
+    if (memcmp(bytes, SHIM_STATE_MAGIC_TEXT, 8) != 0) {
+        shim_format(why, why_size, "no header: wrong magic");
+        return SHIM_STATE_MAGIC;
+    }
+    unsigned long long version = shim_get_u64(bytes + 8) & 0xffffffffull;
+    if (version != SHIM_STATE_FORMAT) {
+        shim_format(why, why_size, "another format version: %lu, this FMU reads version %u", (unsigned long)version,
+                    SHIM_STATE_FORMAT);
+        return SHIM_STATE_VERSION;
+    }
+    if (shim_get_u64(bytes + 16) != shim_token_hash(token)) {
+        shim_format(why, why_size, "another FMU's state: its GUID / instantiation token differs");
+        return SHIM_STATE_TOKEN;
+    }
+    unsigned long long announced = shim_get_u64(bytes + 32);
+    if (announced != (unsigned long long)(size - SHIM_STATE_HEADER_SIZE)) {
+        shim_format(why, why_size, "wrong length: the header announces %.0f bytes of state, %lu follow it",
+                    (double)announced, (unsigned long)(size - SHIM_STATE_HEADER_SIZE));
+        return SHIM_STATE_LENGTH;
+    }
+    unsigned long long bits = shim_get_u64(bytes + 24);
+    if (time)
+        memcpy(time, &bits, 8);
+    if (payload)
+        *payload = bytes + SHIM_STATE_HEADER_SIZE;
+    if (payload_size)
+        *payload_size = size - SHIM_STATE_HEADER_SIZE;
+    return SHIM_STATE_OK;
+}
+
+/* ---- FMU state pointers ----------------------------------------------------------------- */
+#define SHIM_STATE_WRAPPER_MAGIC 0x53544154u  /* "STAT" */
+
+typedef struct ShimState {
+    unsigned int magic;
+    double time;            /* the communication time the state was taken at */
+    void *inner;            /* the inner binary's state */
+    struct ShimState *next;
+} ShimState;
+
+static SHIM_UNUSED ShimState *shim_state_add(ShimState **list, void *inner, double time)
+{
+    ShimState *s = (ShimState *)calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    s->magic = SHIM_STATE_WRAPPER_MAGIC;
+    s->time = time;
+    s->inner = inner;
+    s->next = *list;
+    *list = s;
+    return s;
+}
+
+static SHIM_UNUSED ShimState *shim_state_lookup(ShimState *list, const void *pointer)
+{
+    for (ShimState *s = list; s && pointer; s = s->next)
+        if ((const void *)s == pointer)
+            return s->magic == SHIM_STATE_WRAPPER_MAGIC ? s : NULL;
+    return NULL;
+}
+
+static SHIM_UNUSED void shim_state_remove(ShimState **list, ShimState *s)
+{
+    for (ShimState **p = list; *p; p = &(*p)->next)
+        if (*p == s) {
+            *p = s->next;
+            s->magic = 0;
+            free(s);
+            return;
+        }
+}
+
+#endif
