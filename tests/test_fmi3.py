@@ -6,6 +6,7 @@ import sys
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
@@ -209,14 +210,15 @@ def test_bad_input_is_refused_as_by_the_fmi2_fmu(table3_fmu, fmu3, inputs, messa
     try:
         pair.set(**inputs)
         for version, f in ((2, pair.f2), (3, pair.f3)):
-            with pytest.raises(Exception) as info:
+            with pytest.raises(FMICallException) as info:
                 f.doStep(0.0, 0.01)
-            assert "Discard" in str(info.value) or "status 2" in str(info.value) or "fmi3Discard" in str(info.value)
+            assert info.value.status == 2, (version, info.value)  # Discard: the state kept
             assert any(message in m for m in pair.messages[version]), (version, pair.messages[version])
-        # both instances are still alive: a good input steps again, and to the same outputs
+        # both instances are still alive: a good input steps again from the refused step's start, to the
+        # same outputs
         pair.set(Fz=1e4, omega=0.1)
-        pair.f2.doStep(0.01, 0.01)
-        pair.f3.doStep(0.01, 0.01)
+        pair.f2.doStep(0.0, 0.01)
+        pair.f3.doStep(0.0, 0.01)
         a, b = pair.scalars()
         assert np.all(np.abs(b - a) <= 1e-12 * np.abs(a))
     finally:
@@ -224,8 +226,8 @@ def test_bad_input_is_refused_as_by_the_fmi2_fmu(table3_fmu, fmu3, inputs, messa
 
 
 def _refused_parameter(path, version, name, value):
-    """Instantiate one FMU with a bad integer parameter, initialise and step it: the log and whether
-    it was refused (at the end of initialisation or at the first step)."""
+    """Instantiate one FMU with a bad integer parameter, initialise and step it: the call that was
+    refused (its fmpy method name), its status, and the log."""
     messages = []
     md = read_model_description(str(path))
     unzipped = extract(str(path))
@@ -246,25 +248,122 @@ def _refused_parameter(path, version, name, value):
         f.instantiate(loggingOn=True, logMessage=lambda env, status, cat, m: messages.append(m.decode()))
         f.setInt32([ref], [value])
         enter = lambda: f.enterInitializationMode(startTime=0.0)  # noqa: E731
-    refused = False
+    refused = None
     try:
-        enter()
-        f.exitInitializationMode()
-        f.doStep(0.0, 0.01)
-    except Exception:
-        refused = True
+        for call, function in (("enterInitializationMode", enter), ("exitInitializationMode", f.exitInitializationMode),
+                               ("doStep", lambda: f.doStep(0.0, 0.01))):
+            try:
+                function()
+            except FMICallException as e:
+                refused = (call, e.status)
+                break
     finally:
         f.freeInstance()
         shutil.rmtree(unzipped, ignore_errors=True)
     return refused, messages
 
 
-def test_unknown_parameter_value_is_refused(table3_fmu, fmu3):
+def test_unknown_parameter_value_is_an_error_at_the_end_of_initialization(table3_fmu, fmu3):
     for version, path in ((2, table3_fmu), (3, fmu3)):
         refused, messages = _refused_parameter(path, version, "ring_model", 7)
-        assert refused, version
+        assert refused == ("exitInitializationMode", 3), (version, refused)  # fmi2Error / fmi3Error
         assert any("parameter ring_model = 7: must be one of 1 (rigid), 2 (flexible)" in m for m in messages), \
             (version, messages)
+
+
+def test_same_step_refused_twice_is_an_error(table3_fmu, fmu3):
+    pair = _Pair(table3_fmu, fmu3)
+    try:
+        pair.set(Fz=float("nan"))
+        for version, f in ((2, pair.f2), (3, pair.f3)):
+            statuses = []
+            for _ in range(2):
+                with pytest.raises(FMICallException) as info:
+                    f.doStep(0.0, 0.01)
+                statuses.append(info.value.status)
+            assert statuses == [2, 3], (version, statuses)  # Discard, then Error
+            assert any("refused again with the same inputs" in m for m in pair.messages[version]), version
+        # FMI 3.0: after the Error only getters, the FMU state functions, reset and freeInstance
+        with pytest.raises(FMICallException) as info:
+            pair.f3.doStep(0.0, 0.01)
+        assert info.value.status == 3
+        assert "fmi3DoStep: not allowed in state Error (allowed: StepMode)" in pair.messages[3][-1]
+        pair.f3.reset()
+        pair.f3.enterInitializationMode(startTime=0.0)
+        pair.f3.exitInitializationMode()
+        pair.f3.setFloat64([pair.refs3["Fz"]], [1e4])
+        pair.f3.doStep(0.0, 0.01)
+    finally:
+        pair.f2.freeInstance()
+        pair.f3.freeInstance()
+        for d in pair.dirs:
+            shutil.rmtree(d, ignore_errors=True)
+
+
+def _fresh3(fmu3, messages):
+    md = read_model_description(str(fmu3))
+    unzipped = extract(str(fmu3))
+    f = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName="rules")
+    f.instantiate(loggingOn=False, logMessage=lambda env, status, cat, m: messages.append((status, m.decode())))
+    return f, unzipped, {v.name: v.valueReference for v in md.modelVariables}
+
+
+@pytest.mark.parametrize("misuse,text", [
+    (lambda f, r: f.doStep(0.0, 0.01), "fmi3DoStep: not allowed in state Instantiated (allowed: StepMode)"),
+    (lambda f, r: f.setFloat64([r["z"]], [1.0]), "fmi3SetFloat64: z (value reference 20) is an output"),
+    (lambda f, r: f.setFloat64([999], [1.0]), "fmi3SetFloat64: value reference 999 is not a variable of this FMU"),
+    (lambda f, r: f.setFloat64([r["ring_model"]], [1.0]), "is of type Int32, not Float64"),
+    (lambda f, r: f.getFloat64([r["contact_load"]], nValues=3), "fmi3GetFloat64: nValues = 3"),
+    (lambda f, r: f.deserializeFMUState(b"garbage" * 10), "(no header: wrong magic)"),
+    (lambda f, r: f.enterEventMode(), "fmi3EnterEventMode: not allowed"),
+])
+def test_a_call_the_standard_forbids_is_an_error_that_changes_nothing(fmu3, misuse, text):
+    messages = []
+    f, unzipped, refs = _fresh3(fmu3, messages)
+    try:
+        with pytest.raises(FMICallException) as info:
+            misuse(f, refs)
+        assert info.value.status == 3  # fmi3Error, not forwarded
+        assert any(status == 3 and text in m for status, m in messages), messages  # logged with logging off
+        # the instance runs on as a fresh one
+        f.enterInitializationMode(startTime=0.0)
+        f.exitInitializationMode()
+        f.setFloat64([refs["Fz"]], [1e4])
+        f.doStep(0.0, 0.01)
+        assert f.getFloat64([refs["z"]])[0] != 0
+    finally:
+        f.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+
+
+def test_steps_continue_where_the_last_one_ended(fmu3):
+    messages = []
+    f, unzipped, refs = _fresh3(fmu3, messages)
+    try:
+        f.enterInitializationMode(startTime=1.0)
+        f.exitInitializationMode()
+        f.setFloat64([refs["Fz"]], [1e4])
+        for t, h, text in ((0.0, 0.01, "currentCommunicationPoint = 0 but the instance is at t = 1"),
+                           (1.0, 0.0, "communicationStepSize = 0 must be > 0")):
+            with pytest.raises(FMICallException) as info:
+                f.doStep(t, h)
+            assert info.value.status == 3 and text in messages[-1][1], messages
+        f.doStep(1.0, 0.01)
+        state = f.getFMUState()
+        f.doStep(1.01, 0.01)
+        with pytest.raises(FMICallException):
+            f.doStep(1.01, 0.01)  # back in time without a state
+        f.setFMUState(state)  # the state's time: 1.01
+        f.doStep(1.01, 0.01)
+        f.freeFMUState(state)
+        f.terminate()
+        with pytest.raises(FMICallException):
+            f.doStep(1.02, 0.01)
+        assert "fmi3DoStep: not allowed in state Terminated" in messages[-1][1]
+    finally:
+        f.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
 
 
 def test_array_setter_reshapes_without_numpy_2_refusal(fmu3, tmp_path):
