@@ -45,7 +45,7 @@ demo: $(STAMP)
 # for this CPU and, side by side, for the CPUs build_fmu.py adds to the FMU (an x86-64-v3 one and any
 # x86-64: slewing_model/numerics/targets.py)
 TEST_WORKERS ?= 2
-COMPILE_LOOPS := import build_fmu; build_fmu.compiled_kernel_files()
+COMPILE_LOOPS := import build_fmu, fmu_build.aot; build_fmu.compiled_kernel_files(); fmu_build.aot.prepare_cache()
 
 test: $(STAMP)
 	$(call debian_packages,$(TEST_PACKAGES))

@@ -2,7 +2,7 @@
 """Build the slewing bearing FMU (FMI 2.0 or 3.0 co-simulation) for one bearing definition.
 
     python build_fmu.py BEARING.toml [-o FILE.fmu] [--bc free|clamped|frictionless] [--mesh coarse|fine]
-                        [--fmi-version 2|3] [--runtime standalone|host] [--numba | --no-numba | --aot]
+                        [--fmi-version 2|3] [--runtime standalone|host] [--aot | --numba | --no-numba]
 
 Builds (or takes from the cache) the ring superelement, then packages with
 pythonfmu (FMI 2.0) or pythonfmu3 (FMI 3.0): the slave ``fmu_src/SlewingBearing.py``,
@@ -12,12 +12,20 @@ compiles the FMU's Linux binary (``fmu_src/shim/``, needs a C compiler), a layer
 front of pythonfmu's that starts Python in a C host:
 
 * ``--runtime standalone`` (default): the FMU carries its own Python
-  (``fmu_build/runtime.py``: libpython, the standard library, numpy and, with ``--numba``,
-  numba and the compiled loops; with ``--aot``, the loops compiled ahead of time instead,
-  ``fmu_build/aot.py``), found relative to the unpacked FMU. The target
-  needs nothing but Linux x86-64 with the glibc floor the build prints.
+  (``fmu_build/runtime.py``: libpython, the part of the standard library and of numpy the FMU
+  imports), found relative to the unpacked FMU. The target needs nothing but Linux x86-64 with
+  the glibc floor the build prints.
 * ``--runtime host``: the light "tool coupling" FMU, which runs in the Python named in
   ``resources/python_runtime.txt`` (the building one) or by ``SLEWING_FMU_PYTHONHOME``.
+
+The loops (load distribution, friction, life), one of:
+
+* ``--aot`` (default where numba is installed here): compiled ahead of time by numba's ``pycc``
+  (``fmu_build/aot.py``) into two extension modules that need numpy only, one for an x86-64-v3
+  CPU and one for any x86-64; no numba, no LLVM, no compilation in the FMU;
+* ``--numba``: numba and llvmlite in the runtime, and numba's cache of the compiled loops
+  (steps as fast as ``--aot``'s, the FMU three times as large, a slower start);
+* ``--no-numba``: numpy's loops (the default where numba is not installed; steps about 6 times slower).
 
 What the target machine needs, and the hosts tried: ``docs/fmu/hosts.md``.
 """
@@ -43,7 +51,7 @@ from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing
 
 
 def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=False, fmi_version=2,
-              runtime="standalone", numba=None, aot=False, win64=True, win64_numba=False, stage=None,
+              runtime="standalone", numba=None, aot=None, win64=True, win64_numba=False, stage=None,
               runtime_python=None, export_library=None) -> Path:
     """Build the FMU of ``bearing_file``; returns the path of the ``.fmu``.
 
@@ -65,14 +73,17 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         "standalone" (default): the FMU carries its Python runtime and runs where there is no
         Python; "host": it runs in the building Python (or one named on the target).
     numba : bool, optional
-        Carry numba and the compiled loops (steps about 4 times faster, the FMU about 4 times
-        larger: 87 MB against 22 MB for the pitch bearing). Default: where numba is installed here.
-    aot : bool
-        Carry the loops compiled ahead of time (:mod:`fmu_build.aot`: two extension modules of 1.9 MB that
-        need numpy only, one for an x86-64-v3 CPU and one for any x86-64 CPU; the FMU takes the first its
-        CPU runs) instead of numba: the same numbers and step time as numba's, without
-        numba and llvmlite in the runtime (about a quarter of the size) and without loading
-        numba's cache at instantiation. Default False; not with ``numba=True``.
+        True: carry numba, llvmlite and numba's cache of the compiled loops (the JIT FMU).
+        False: numpy's loops (steps about 6 times slower), unless ``aot``. Default: see ``aot``.
+    aot : bool, optional
+        Carry the loops compiled ahead of time (:mod:`fmu_build.aot`: two extension modules of about
+        2 MB that need numpy only, one for an x86-64-v3 CPU and one for any x86-64 CPU; the FMU takes
+        the first its CPU runs): the same numbers and step time as numba's, without numba and
+        llvmlite in the runtime and without loading numba's cache at instantiation. Default
+        (``aot`` and ``numba`` None): True where numba (its ``pycc``) is installed here, else numpy's
+        loops; ``aot=False`` alone: numba's JIT where numba is installed (:func:`resolve_loops`), also
+        the default with ``runtime_python`` (``--linux-floor``: the modules need glibc 2.29, above its
+        floor). Not with ``numba=True``.
     win64 : bool
         Also carry a standalone Windows binary (``binaries/win64``, FMI 3.0 ``binaries/x86_64-windows``:
         :mod:`fmu_build.win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops,
@@ -82,7 +93,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         Windows CPU (under wine, here: :func:`fmu_build.win64.compile_kernels`, about three minutes each once per
         version of the loops): its steps as fast as the Linux half's instead of numpy's, for about 45 MB
         more zipped.
-        Default False; needs ``numba``, ``win64`` and wine.
+        Default False; needs ``win64`` and wine, and numba's loops in the Linux half (``numba=True``, which
+        it implies where ``numba`` and ``aot`` are not given).
     stage : callable, optional
         Called with one line as each stage of the build begins (e.g. ``print``): the build is
         silent for minutes otherwise on a fresh machine (the superelement, numba's compilation).
@@ -98,10 +110,12 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     say = stage or (lambda line: None)
     if fmi_version not in (2, 3):
         raise ValueError(f"fmi_version = {fmi_version!r}: must be 2 or 3")
-    if aot and numba:
-        raise ValueError("aot = True and numba = True: an FMU carries its loops compiled ahead of time or numba, "
-                         "not both")
-    numba = False if aot else resolve_numba(runtime, numba)
+    if win64_numba and numba is None and not aot:    # both halves with numba's loops
+        numba = True
+    if runtime_python is not None and numba is None and aot is None:
+        aot = False         # a floor-lowered runtime (--linux-floor): numba's loops, the modules need glibc 2.29
+    loops = resolve_loops(runtime, numba, aot)
+    numba, aot = loops == "numba", loops == "aot"
     if win64_numba and not (numba and win64 and runtime == "standalone"):
         raise ValueError(f"win64_numba = True needs numba, win64 and a standalone runtime (numba = {numba}, "
                          f"win64 = {win64}, runtime = {runtime!r}): the win64 half shares the Linux half's "
@@ -143,6 +157,8 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
             import fmu_build.aot
 
             modules = fmu_build.aot.build_all_kernels(tmp, stage=say)
+            for module in modules:        # the sources' paths in their error texts, the building Python's RUNPATH
+                scrub_paths(module, building_machine_paths())
             files.extend(modules)
             extra_needs.extend(version_needs(module) for module in modules)
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
@@ -153,6 +169,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                 canGetAndSetFMUstate=True, canSerializeFMUstate=True,
                 needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
             )
+    deflate(built)
     install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64,
                         win64_numba=win64_numba, stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
                         export_library=export_library)
@@ -166,10 +183,42 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
     return Path(built)
 
 
+def deflate(fmu) -> None:
+    """Rewrite ``fmu`` with every entry compressed: pythonfmu stores its entries uncompressed (the modules of
+    the loops compiled ahead of time, 3.5 MB, zip to 1.1 MB; the model description, 0.44 MB, to 0.02 MB), and
+    the FMU's Linux layer keeps each entry's compression."""
+    fmu = Path(fmu)
+    partial = fmu.with_suffix(".deflating")
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            data = src.read(info)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            dst.writestr(info, data)
+    os.replace(partial, fmu)
+
+
 #: the file of the FMU's resources that names the loops it runs (fmu_src/bearing_variables.py reads it)
 KERNELS_FILE = "kernels.txt"
 #: the CPU of the compiled loops besides the portable ones (fmu_src/bearing_variables.py reads it)
 NUMBA_TARGET_FILE = "numba_target.txt"
+
+
+def resolve_loops(runtime: str, numba=None, aot=None) -> str:
+    """The loops an FMU of ``runtime`` carries: "aot" (compiled ahead of time, :mod:`fmu_build.aot`), "numba"
+    (numba's JIT and its cache) or "numpy". ``aot=True``: "aot"; ``numba=True``: "numba"; ``numba=False``
+    (and ``aot`` not True): "numpy"; both None (the default): "aot" where numba is installed here (its
+    ``pycc`` compiles them), else "numpy"; ``aot=False`` and ``numba`` None: "numba" where numba is
+    installed, else "numpy". ValueError for an unknown runtime or for both True; RuntimeError where
+    numba is needed and not installed."""
+    if aot and numba:
+        raise ValueError("aot = True and numba = True: an FMU carries its loops compiled ahead of time or numba, "
+                         "not both")
+    if aot is None:
+        aot = numba is None and resolve_numba(runtime, None)
+    if aot:
+        resolve_numba(runtime, True)            # numba's pycc compiles them
+        return "aot"
+    return "numba" if resolve_numba(runtime, numba) else "numpy"
 
 
 def resolve_numba(runtime: str, numba=None) -> bool:
@@ -323,15 +372,21 @@ def main(argv=None) -> int:
     parser.add_argument("--runtime", choices=RUNTIMES, default="standalone",
                         help="standalone (default): the FMU carries its Python and runs where there is none; "
                              "host: it runs in this Python, or one named on the target by " + PYTHON_HOME_VARIABLE)
-    parser.add_argument("--numba", action=argparse.BooleanOptionalAction, default=None,
-                        help="carry numba and the compiled loops: steps about 4x faster, the FMU about 4x larger "
-                             "(default: yes where numba is installed here)")
-    parser.add_argument("--aot", action="store_true",
-                        help="carry the loops compiled ahead of time (fmu_build/aot.py) instead of numba: the same "
-                             "numbers and step time, about a quarter of the size, no JIT at instantiation")
+    loops = parser.add_mutually_exclusive_group()
+    loops.add_argument("--aot", dest="loops", action="store_const", const="aot",
+                       help="the loops compiled ahead of time (fmu_build/aot.py; numba's pycc, once per change of the "
+                            "loops, about a minute a target): extension modules that need numpy only, no numba in "
+                            "the FMU (default where numba is installed here)")
+    loops.add_argument("--numba", dest="loops", action="store_const", const="numba",
+                       help="carry numba, llvmlite and numba's cache of the compiled loops (the JIT FMU): the same "
+                            "step time as --aot's, three times the size, a slower start")
+    loops.add_argument("--no-numba", dest="loops", action="store_const", const="numpy",
+                       help="numpy's loops: no compiled code (steps about 6x slower; default where numba is not "
+                            "installed here)")
     parser.add_argument("--win64-numba", action="store_true",
                         help="the win64 half carries numba and the loops compiled under wine for x86-64-v3 and "
-                             "generic x86-64 Windows CPUs (about 45 MB more zipped; needs wine; six minutes once per "
+                             "generic x86-64 Windows CPUs, the Linux half numba's (--numba, which it implies; about "
+                             "45 MB more than --numba zipped; needs wine; six minutes once per "
                              "version of the loops): steps as fast as the Linux half's instead of numpy's")
     parser.add_argument("--win64", action=argparse.BooleanOptionalAction, default=True,
                         help="carry a standalone Windows (win64) binary beside the Linux one, built here with "
@@ -339,7 +394,8 @@ def main(argv=None) -> int:
     parser.add_argument("--linux-floor", metavar="DIR",
                         help="carry the Python and pythonfmu export library that tests/linux_floor/build.sh built on "
                              "Debian 11 in DIR (e.g. /var/cache/slewing-chroots/linux-floor): the FMU then runs on "
-                             "glibc 2.31 (Debian 11, Ubuntu 20.04) instead of this machine's Python's floor")
+                             "glibc 2.31 (Debian 11, Ubuntu 20.04) instead of this machine's Python's floor; with numba's "
+                             "loops unless --aot or --no-numba is given (the --aot modules need glibc 2.29)")
     parser.add_argument("--runtime-python", metavar="PATH",
                         help="the interpreter whose runtime a standalone FMU carries (default: this one)")
     parser.add_argument("--pythonfmu-export", metavar="PATH",
@@ -363,7 +419,8 @@ def main(argv=None) -> int:
     lowered.update({k: v for k, v in (("runtime_python", args.runtime_python),
                                       ("export_library", args.pythonfmu_export)) if v})
     path = build_fmu(args.bearing, args.output, bc=args.bc, mesh=args.mesh, progress=True,
-                     fmi_version=args.fmi_version, runtime=args.runtime, numba=args.numba, aot=args.aot,
+                     fmi_version=args.fmi_version, runtime=args.runtime,
+                     numba={"numba": True, "numpy": False}.get(args.loops), aot=args.loops == "aot" or None,
                      win64=args.win64, win64_numba=args.win64_numba, stage=lambda line: print(line, flush=True),
                      **lowered)
     print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")

@@ -5,13 +5,13 @@ all made in this run by this checkout's ``build_fmu.py``:
 
 - ``host + numba``: ``--runtime host``, the FMU without a runtime of its own: it runs in this
   machine's Python and venv, with numba and its shipped cache. The baseline.
-- ``standalone``: ``--no-numba``; it carries its Python and numpy, and runs the numpy loops.
-- ``standalone + numba``: the default; it also carries numba and llvmlite, and the compiled loops' cache.
-- ``standalone + aot``: ``--aot``; it carries the loops compiled ahead of time (``fmu_build/aot.py``)
-  instead of numba, a module for an x86-64-v3 CPU and one for any x86-64, and takes the first this CPU
-  runs: its cold build includes their compilation (the modules' cache emptied);
+- ``standalone + aot``: the default (``--aot``); it carries its Python, numpy and the loops compiled ahead
+  of time (``fmu_build/aot.py``), a module for an x86-64-v3 CPU and one for any x86-64, and takes the first
+  this CPU runs: its cold build includes their compilation (the modules' cache emptied);
 - ``standalone + aot, generic``: the same FMU without its x86-64-v3 module (removed from the unpacked
-  folder), as a CPU without AVX2 or FMA runs it: the generic loops.
+  folder), as a CPU without AVX2 or FMA runs it: the generic loops;
+- ``standalone + numba``: ``--numba``; it carries numba and llvmlite instead, and the compiled loops' cache;
+- ``standalone``: ``--no-numba``; it carries its Python and numpy, and runs the numpy loops.
 
 Each FMU is run by our C host (``tests/c_host/host.c``, scenario ``bench``) in the environment of
 a desktop session (``PATH=/usr/bin:/bin``, nothing else), as a user's C host would run it: a fresh
@@ -23,7 +23,8 @@ each communication step: set the 7 inputs, ``fmi2DoStep``, get 5 outputs. The fi
 
 Build time: with the runtime staged anew (its cache emptied) and with the runtime cached; the
 superelement is cached in both (built before the timing). Instantiation: loading the binary,
-``fmi2Instantiate``, the parameters and initialisation, in the C host.
+``fmi2Instantiate``, the parameters and initialisation, in the C host. Memory: the C host's resident set
+(VmRSS) after the initialisation less before loading the FMU's binary.
 
 Run: .venv/bin/python -m benchmarks fmu_variants [--steps 1000] [--runs 3]
 """
@@ -46,13 +47,13 @@ RUNS = 3
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
 VARIANTS = {"host + numba": {"runtime": "host", "numba": True},
-            "standalone": {"runtime": "standalone", "numba": False},
+            "standalone + aot (default)": {"runtime": "standalone", "numba": False, "aot": True},
+            "standalone + aot, generic": {"runtime": "standalone", "numba": False, "aot": True},
             "standalone + numba": {"runtime": "standalone", "numba": True},
-            "standalone + aot": {"runtime": "standalone", "numba": False, "aot": True},
-            "standalone + aot, generic": {"runtime": "standalone", "numba": False, "aot": True}}
+            "standalone": {"runtime": "standalone", "numba": False}}
 #: a variant's modules removed from its unpacked folder after the build
 DROPPED = {"standalone + aot, generic": "resources/slewing_kernels_v3.*"}
-BASELINE = "host + numba"
+REFERENCE = "host + numba"
 WARM = 20
 
 
@@ -70,7 +71,7 @@ def build(variant: dict, output: Path, cold: bool) -> float:
     from fmu_build import runtime as build_runtime
 
     if cold and variant["runtime"] == "standalone":
-        key = build_runtime.runtime_key(variant["numba"], build_fmu.LINUX_BINARIES[2])
+        key = build_runtime.runtime_key(variant.get("numba", False), build_fmu.LINUX_BINARIES[2])
         for f in build_runtime.runtime_cache_dir().glob(f"runtime-{key}.*"):
             f.unlink()
     if cold and variant.get("aot"):
@@ -82,9 +83,10 @@ def build(variant: dict, output: Path, cold: bool) -> float:
     return time.perf_counter() - start
 
 
-def bench_output(stdout: str) -> tuple[float, np.ndarray, list]:
-    """What the C host's ``bench`` scenario prints: (instantiation s, step times s, final outputs)."""
-    steps, instantiation, final = [], None, None
+def bench_output(stdout: str) -> tuple[float, np.ndarray, list, float]:
+    """What the C host's ``bench`` scenario prints: (instantiation s, step times s, final outputs, resident set
+    after the initialisation less before loading, MB)."""
+    steps, instantiation, final, memory = [], None, None, float("nan")
     for line in stdout.splitlines():
         word, *rest = line.split() or [""]
         if word == "instantiate":
@@ -93,11 +95,13 @@ def bench_output(stdout: str) -> tuple[float, np.ndarray, list]:
             steps.append(float(rest[1]))
         elif word == "final":
             final = [float(x) for x in rest[1:]]
-    return instantiation, np.array(steps), final
+        elif word == "rss":
+            memory = (int(rest[1]) - int(rest[0])) / 1024
+    return instantiation, np.array(steps), final, memory
 
 
-def run_host(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) -> tuple[float, np.ndarray, list]:
-    """One run of the C host: (instantiation s, step times s, final outputs)."""
+def run_host(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dict) -> tuple:
+    """One run of the C host: :func:`bench_output`."""
     integers = sum((["--integer", str(refs[k]), str(v)] for k, v in parameters.items()), [])
     command = [str(host), str(folder), "SlewingBearing", refs["guid"], "bench",
                *(str(refs[n]) for n in INPUTS + OUTPUTS), "--inputs", str(inputs), *integers]
@@ -146,29 +150,39 @@ def main(args) -> None:
                                f"{warm:.1f} s"])
         times = {name: [] for name in VARIANTS}
         starts = {name: [] for name in VARIANTS}
+        memory = {name: [] for name in VARIANTS}
         finals = {}
         for r in range(args.runs):
             for name in VARIANTS:
                 folder, refs = built[name]
-                instantiation, steps, final = run_host(host, folder, refs, inputs, case.parameters)
+                instantiation, steps, final, resident = run_host(host, folder, refs, inputs, case.parameters)
                 starts[name].append(instantiation)
+                memory[name].append(resident)
                 times[name].append(steps[WARM:])
                 finals[name] = final
     note(f"pitch case: {case.description}; {args.steps} steps of 10 ms, {args.runs} runs per FMU, "
           f"C host, PATH=/usr/bin:/bin")
     print_table("FMU variants: size and build", ["FMU", "zipped", "unpacked", "build, runtime staged",
                                                    "build, runtime cached"], rows_build)
-    base = np.median(np.concatenate(times[BASELINE]))
+    base = np.median(np.concatenate(times[REFERENCE]))
     rows = []
     for name in VARIANTS:
         s = spread(np.concatenate(times[name]) * 1e3)
         record(f"{name} [ms]", s)
-        rows.append([name, f"{np.median(starts[name]):.2f} s", f"{s['median']:.2f} ms", f"{s['p95']:.2f} ms",
-                     f"{s['p99']:.2f} ms", f"{s['median'] / (base * 1e3):.2f}"])
+        record(f"{name} instantiation [s]", float(np.median(starts[name])))
+        record(f"{name} resident set after instantiation [MB]", float(np.median(memory[name])))
+        rows.append([name, f"{np.median(starts[name]):.2f} s", f"{np.median(memory[name]):.0f} MB",
+                     f"{s['median']:.2f} ms", f"{s['p95']:.2f} ms", f"{s['p99']:.2f} ms",
+                     f"{s['median'] / (base * 1e3):.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",
-                ["FMU", "instantiation", "median", "95th pct", "99th pct", f"median / {BASELINE}"], rows)
-    reference = np.array(finals[BASELINE])
+                ["FMU", "instantiation", "memory after instantiation", "median", "95th pct", "99th pct",
+                 f"median / {REFERENCE}"], rows)
+    numba_median = np.median(np.concatenate(times["standalone + numba"]))
+    for name in ("standalone + aot (default)", "standalone"):
+        note(f"median step of {name} / standalone + numba: "
+             f"{np.median(np.concatenate(times[name])) / numba_median:.3f}")
+    reference = np.array(finals[REFERENCE])
     for name, final in finals.items():
         deviation = np.max(np.abs(np.array(final) - reference) / np.maximum(np.abs(reference), 1e-300))
-        note(f"final outputs of {name}: largest relative difference to {BASELINE}: {deviation:.1e}")
+        note(f"final outputs of {name}: largest relative difference to {REFERENCE}: {deviation:.1e}")
 

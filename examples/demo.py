@@ -9,8 +9,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-# a line as each stage begins: on a fresh, loaded machine the FMU's build (superelement, numba's
-# compilation of the loops, the FMU's Python runtime) takes minutes before the first progress bar
+# a line as each stage begins: on a fresh, loaded machine the FMU's build (superelement, the loops
+# compiled ahead of time, the FMU's Python runtime) takes minutes before the first progress bar
 print("make demo: loading the model (numpy, numba) ...", flush=True)
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 

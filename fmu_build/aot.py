@@ -1,4 +1,4 @@
-"""The compiled loops ahead of time (build time only; used by ``build_fmu.py --aot``).
+"""The loops compiled ahead of time (build time only; used by ``build_fmu.py``, whose default they are: ``--aot``).
 
 The load distribution's, the friction's and the life map's loops (``slewing_model/distribution/kernel.py``,
 ``slewing_model/friction/kernel.py``, ``slewing_model/life/kernel.py``: every entry of their ``KERNELS``) are compiled once here, by
@@ -12,9 +12,11 @@ error model; ``source_hash()`` returns the hash of the sources it was compiled f
 registry checks before it takes the module (:func:`slewing_model.numerics.compiled.aot_kernels`).
 
 The compilation (about a minute a target) runs in a child process, since it compiles the kernels'
-helpers in place in their modules; its product is cached under
-``$SLEWING_CACHE_DIR/aot/<key>/`` (key: the sources' hash, numba's version, the Python ABI; the file name
-says the target).
+helpers in place in their modules; its product is cached under ``<cache>/<key>/`` (:func:`aot_cache_dir`;
+key: the sources' hash, numba's version, the Python ABI; the file name says the target). A process
+that finds the module missing compiles it under a lock (a ``.lock`` file beside it): another one that needs it
+meanwhile (two test workers, two builds) waits and takes it from the cache. ``make test`` compiles
+them first (the Makefile's ``COMPILE_LOOPS``: :func:`prepare_cache`).
 
 numba's ``pycc`` is pending deprecation ("replacement technology is being developed"); it is in
 the pinned numba 0.68.1 and gives the same numbers as numba's JIT, bit for bit, on the benchmark
@@ -25,6 +27,7 @@ Run: .venv/bin/python -m fmu_build.aot [-o FOLDER] [--target x86-64-v3|generic] 
 from __future__ import annotations
 
 import argparse
+import fcntl
 import importlib
 import os
 import shutil
@@ -56,18 +59,36 @@ def cache_key() -> str:
     return f"{kernel_source_hash():016x}-numba{numba.__version__}-{sysconfig.get_config_var('SOABI')}"
 
 
+#: the environment variable that names the modules' cache (the tests set it to the user's, which ``make test``
+#: fills before they start, while their other caches are private)
+CACHE_VARIABLE = "SLEWING_AOT_CACHE_DIR"
+
+
 def aot_cache_dir() -> Path:
-    """``$SLEWING_CACHE_DIR/aot``, else ``~/.cache/slewing_model/aot``."""
+    """``$SLEWING_AOT_CACHE_DIR``, else ``$SLEWING_CACHE_DIR/aot``, else ``~/.cache/slewing_model/aot``."""
     from slewing_model.rings.superelement.build import default_cache_dir
 
-    return Path(default_cache_dir()) / "aot"
+    return Path(os.environ.get(CACHE_VARIABLE) or Path(default_cache_dir()) / "aot")
+
+
+def prepare_cache(stage=None) -> list:
+    """Compile the modules of every target into the cache where they are missing, the targets side by side (one
+    child process each; :func:`build_kernels`): what ``make test`` runs before the tests. Returns their paths."""
+    import concurrent.futures
+
+    from slewing_model.numerics.compiled import AOT_MODULES
+
+    with concurrent.futures.ThreadPoolExecutor(len(AOT_MODULES)) as pool:
+        return list(pool.map(lambda target: build_kernels(None, stage, target), AOT_MODULES))
 
 
 def build_all_kernels(output_dir=None, stage=None) -> list:
-    """:func:`build_kernels` for every target (:data:`~slewing_model.numerics.compiled.AOT_MODULES`): the
-    modules an ``--aot`` FMU carries. Returns their paths."""
+    """:func:`build_kernels` for every target (:data:`~slewing_model.numerics.compiled.AOT_MODULES`), those
+    missing from the cache compiled side by side (:func:`prepare_cache`): the modules an FMU with the loops
+    compiled ahead of time carries. Returns their paths."""
     from slewing_model.numerics.compiled import AOT_MODULES
 
+    prepare_cache(stage)
     return [build_kernels(output_dir, stage, target) for target in AOT_MODULES]
 
 
@@ -78,28 +99,36 @@ def build_kernels(output_dir=None, stage=None, target: str = "generic") -> Path:
     say = stage or (lambda line: None)
     cached = aot_cache_dir() / cache_key() / module_file_name(target)
     if not cached.exists():
-        say(f"compiling the loops ahead of time for {target} with numba's pycc (about a minute, once per change "
-            "of the kernels) ...")
-        with tempfile.TemporaryDirectory(prefix="slewing_aot_") as tmp:
-            # TMPDIR: numba's check of the C compiler leaves a folder in the temporary directory
-            # (numba.pycc.platform._gentmpfile removes neither file nor folder); here it goes with ``tmp``
-            run = subprocess.run([sys.executable, "-m", "fmu_build.aot", "--compile", tmp,
-                                  "--target", target], cwd=ROOT, capture_output=True, text=True,
-                                 env={**os.environ, "TMPDIR": tmp})
-            built = Path(tmp) / module_file_name(target)
-            if run.returncode != 0 or not built.exists():
-                raise RuntimeError(f"compiling the loops ahead of time failed (exit {run.returncode}):\n"
-                                   f"{run.stdout[-3000:]}\n{run.stderr[-3000:]}")
-            cached.parent.mkdir(parents=True, exist_ok=True)
-            partial = cached.with_suffix(".partial")
-            shutil.copy2(built, partial)
-            os.replace(partial, cached)
+        cached.parent.mkdir(parents=True, exist_ok=True)
+        with open(cached.with_suffix(".lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)            # another process compiling it: wait for its module
+            if not cached.exists():
+                _compile_into(cached, target, say)
     if output_dir is None:
         return cached
     Path(output_dir).mkdir(parents=True, exist_ok=True)
     target = Path(output_dir) / cached.name
     shutil.copy2(cached, target)
     return target
+
+
+def _compile_into(cached: Path, target: str, say) -> None:
+    """Compile the module for ``target`` in a child process and put it at ``cached`` (whole: ``os.replace``)."""
+    say(f"compiling the loops ahead of time for {target} with numba's pycc (about a minute, once per change "
+        "of the kernels) ...")
+    with tempfile.TemporaryDirectory(prefix="slewing_aot_") as tmp:
+        # TMPDIR: numba's check of the C compiler leaves a folder in the temporary directory
+        # (numba.pycc.platform._gentmpfile removes neither file nor folder); here it goes with ``tmp``
+        run = subprocess.run([sys.executable, "-m", "fmu_build.aot", "--compile", tmp,
+                              "--target", target], cwd=ROOT, capture_output=True, text=True,
+                             env={**os.environ, "TMPDIR": tmp})
+        built = Path(tmp) / module_file_name(target)
+        if run.returncode != 0 or not built.exists():
+            raise RuntimeError(f"compiling the loops ahead of time failed (exit {run.returncode}):\n"
+                               f"{run.stdout[-3000:]}\n{run.stderr[-3000:]}")
+        partial = cached.with_suffix(".partial")
+        shutil.copy2(built, partial)
+        os.replace(partial, cached)
 
 
 def _compile(output_dir: str, target: str = "generic") -> None:

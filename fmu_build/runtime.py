@@ -59,6 +59,78 @@ DYNLOAD_EXCLUDED = re.compile(r"^(_test|_xx|xxlimited|_ctypes_test|_tkinter|_cur
                               r"_sqlite3|_crypt|ossaudiodev|spwd|audioop|_dbm|_gdbm)")
 #: files left out of the packages: tests, type stubs, C headers and sources
 PACKAGE_EXCLUDED = re.compile(r"(^|/)(tests?|__pycache__|include|_pyinstaller)(/|$)|\.(pyi|pxd|h|c|cpp)$")
+
+# ---- what the runtime without numba keeps: the import audit --------------------------------------
+# ``python -m fmu_build.import_audit`` runs the FMUs built on this runtime (bearing FMI 2.0 and 3.0 with the loops
+# compiled ahead of time, drive, time table) with the runtime untrimmed in C hosts under strace, through their
+# paths (steps, the state got, set and serialized, refused steps, unloads and reloads, the life accumulators,
+# the rotating frame, bounded steps, rigid rings, a bad parameter's error), and records every file of the runtime
+# they open. What it found (CPython 3.11.7, numpy 2.4.6) is in the *_IMPORTED sets; the runtime keeps those, whole
+# packages where a package is imported, and a margin (*_MARGIN, with its reasons), and leaves the rest out
+# (the pitch bearing FMU's Linux half: 16.8 MB zipped, 56 MB unpacked; 21.1 MB and 70 MB untrimmed). The runtime with numba
+# (``--numba``) keeps the standard library and numpy whole but for the exclusions above: numba's JIT imports much
+# of both. After a change of Python, numpy or the FMUs' imports, run the audit again: it fails, naming the files,
+# where a run opens one that these lists leave out.
+#: the standard library's top-level modules and packages the runs import (the audit)
+STDLIB_IMPORTED = frozenset({
+    "__future__", "_compat_pickle", "_compression", "_weakrefset", "argparse", "ast", "bisect", "bz2", "collections",
+    "contextlib", "contextvars", "copy", "copyreg", "csv", "ctypes", "dataclasses", "datetime", "dis", "encodings",
+    "enum", "fnmatch", "functools", "gettext", "hashlib", "importlib", "inspect", "ipaddress", "json", "keyword",
+    "linecache", "logging", "lzma", "numbers", "opcode", "operator", "pathlib", "pickle", "platform", "random", "re",
+    "reprlib", "shutil", "string", "struct", "tempfile", "textwrap", "threading", "token", "tokenize", "tomllib",
+    "traceback", "types", "typing", "urllib", "uuid", "warnings", "weakref", "xml", "zipfile"})
+#: ... and kept besides (the margin): the modules CPython 3.11 has frozen into libpython (read from files where
+#: an interpreter runs with ``-X frozen_modules=off``), sysconfig and its data, locale (gettext's path when a
+#: message is translated), and modules the imported ones import lazily (datetime's strptime, decimal, heapq, pprint)
+STDLIB_MARGIN = frozenset({
+    "abc", "codecs", "io", "os", "site", "stat", "posixpath", "genericpath", "ntpath", "_collections_abc",
+    "_sitebuiltins", "zipimport", "runpy", "sysconfig", "locale", "_strptime", "calendar", "decimal", "_pydecimal",
+    "fractions", "heapq", "pprint", "_threading_local", "signal", "selectors", "subprocess"})
+#: the extension modules of lib-dynload the runs load (the audit)
+DYNLOAD_IMPORTED = frozenset({
+    "_bisect", "_blake2", "_bz2", "_contextvars", "_csv", "_ctypes", "_datetime", "_elementtree", "_json", "_lzma",
+    "_md5", "_opcode", "_pickle", "_random", "_sha1", "_sha256", "_sha3", "_sha512", "_struct", "_typing", "_uuid",
+    "binascii", "math", "pyexpat", "zlib"})
+#: ... and kept besides (the margin): those of the margin's modules
+DYNLOAD_MARGIN = frozenset({"_heapq", "_decimal", "array", "fcntl", "select", "_posixsubprocess"})
+#: numpy's subpackages the runs import (the audit), kept whole; numpy's top-level modules are all kept. Not
+#: imported, so left out: random, ma, polynomial, testing, f2py, distutils, typing, doc, _pyinstaller
+#: (numpy 2 imports its subpackages when first named; the FMU names none of those)
+NUMPY_IMPORTED = frozenset({"_core", "_typing", "_utils", "fft", "lib", "linalg", "matrixlib"})
+#: ... and kept besides (the margin): numpy 1's module names that numpy 2 answers (numpy.core, for pickles
+#: of numpy 1), and its small namespaces
+NUMPY_MARGIN = frozenset({"core", "ctypeslib", "char", "rec", "strings"})
+#: numpy's extension modules for its own tests (``numpy._core._multiarray_tests`` ...), never imported by the runs
+NUMPY_TEST_MODULES = re.compile(r"^_core/_(multiarray_tests|umath_tests|rational_tests|struct_ufunc_tests|"
+                                r"operand_flag_tests|simd)\.")
+
+
+def _module_name(name: str) -> str:
+    """The module a file of a folder names: ``json`` for ``json``, ``json.py`` and
+    ``__pycache__/json.cpython-311.pyc`` (written by a run)."""
+    return name.split(".")[0]
+
+
+def kept(relative: str, minor: str) -> bool:
+    """Whether the runtime without numba (trimmed) keeps the file ``relative`` (a path below the runtime's
+    prefix, ``lib/python3.11/json/decoder.py``) of the untrimmed one: by the lists above."""
+    stdlib = f"lib/python{minor}/"
+    if not relative.startswith(stdlib):
+        return True                                         # libpython and the libraries beside it
+    parts = relative[len(stdlib):].split("/")
+    if parts[0] == "lib-dynload":
+        return _module_name(parts[-1]) in DYNLOAD_IMPORTED | DYNLOAD_MARGIN
+    if parts[:2] == ["site-packages", "numpy"]:
+        inside = parts[2:]
+        if len(inside) == 1 or inside[0] == "__pycache__":
+            return True                                     # numpy's own modules (__init__, _globals ...)
+        return inside[0] in NUMPY_IMPORTED | NUMPY_MARGIN and not NUMPY_TEST_MODULES.match("/".join(inside))
+    if parts[0] == "site-packages":
+        return True                                         # numpy.libs, the distribution's metadata
+    name = _module_name(parts[-1] if parts[0] == "__pycache__" else parts[0])
+    return name in STDLIB_IMPORTED | STDLIB_MARGIN or name.startswith("_sysconfigdata")
+
+
 #: libraries of the system that are not bundled: glibc's and the C++ runtime (which a C++ host loads itself)
 SYSTEM_LIBRARIES = re.compile(r"^(libc|libm|libdl|libpthread|librt|libutil|libresolv|libcrypt|ld-linux[-\w]*|"
                               r"libstdc\+\+|libgcc_s)\.so")
@@ -343,9 +415,10 @@ def bundled_packages(numba: bool, python: dict | None = None) -> dict[str, str]:
     return versions
 
 
-def stage_runtime(target: Path, numba: bool, python=None) -> dict:
+def stage_runtime(target: Path, numba: bool, python=None, trim: bool = True) -> dict:
     """Copy the runtime of the interpreter ``python`` (a path; default this one) into ``target`` (a
-    Python prefix); returns its description (python, packages, glibc, glibcxx, library)."""
+    Python prefix); returns its description (python, packages, glibc, glibcxx, library). ``trim``
+    (without numba): only what the import audit found imported, and its margin (:func:`kept`)."""
     python = interpreter(python) if python is None or isinstance(python, (str, os.PathLike)) else python
     minor = python["minor"]
     packages = bundled_packages(numba, python)
@@ -379,6 +452,12 @@ def stage_runtime(target: Path, numba: bool, python=None) -> dict:
             destination = site_packages / relative
             destination.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(source, destination)
+    if trim and not numba:                  # what the import audit found unused (before the libraries they need)
+        for f in sorted(target.rglob("*"), reverse=True):
+            if f.is_file() and not kept(f.relative_to(target).as_posix(), minor):
+                f.unlink()
+            elif f.is_dir() and not any(f.iterdir()):
+                f.rmdir()
     # ELF files: strip, search paths relative to $ORIGIN, the libraries they need beyond glibc
     elves = [p for p in target.rglob("*") if p.is_file() and p.read_bytes()[:4] == b"\x7fELF"]
     bundled = {p.name for p in elves}
@@ -415,12 +494,13 @@ def stage_runtime(target: Path, numba: bool, python=None) -> dict:
             "glibc": newest_version(needs, "GLIBC_"), "glibcxx": newest_version(needs, "GLIBCXX_")}
 
 
-def runtime_key(numba: bool, platform_folder: str, python=None) -> str:
+def runtime_key(numba: bool, platform_folder: str, python=None, trim: bool = True) -> str:
     """Cache key of a runtime: interpreter (``python``, a path or :func:`interpreter`'s answer; default this
     one), package versions, platform folder and this file's layout."""
     python = interpreter(python) if python is None or isinstance(python, (str, os.PathLike)) else python
     text = json.dumps([LAYOUT, python["sys_version"], python["base_prefix"], bundled_packages(numba, python),
-                       platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()])
+                       platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()]
+                      + ([] if trim or numba else ["untrimmed"]))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -430,7 +510,7 @@ def runtime_cache_dir() -> Path:
     return Path(base) / "fmu_runtime"
 
 
-def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=None) -> Runtime:
+def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=None, trim: bool = True) -> Runtime:
     """The runtime for an FMU's ``binaries/<platform>`` folder, staged and zipped once (cached).
 
     Parameters
@@ -445,15 +525,18 @@ def runtime(platform_folder: str, numba: bool = False, cache_dir=None, python=No
         The interpreter whose runtime is carried (it must have numpy, and numba where asked; its
         libraries beyond glibc beside its libpython): default the running one. An interpreter built
         on an older system lowers the FMU's glibc floor (``tests/linux_floor/build.sh``).
+    trim : bool
+        Without numba: only the files the import audit found used, and their margin (:func:`kept`);
+        False for the audit itself (``fmu_build/import_audit.py``).
     """
     if not sys.platform.startswith("linux"):
         raise RuntimeError(f"a standalone FMU is built on Linux only (this is {sys.platform}); its Windows "
                            "binary is built there too (docs/fmu/hosts.md, 'Windows: the win64 half')")
     cache = Path(cache_dir) if cache_dir else runtime_cache_dir()
     python = interpreter(python)
-    key = runtime_key(numba, platform_folder, python)
+    key = runtime_key(numba, platform_folder, python, trim)
     archive = cache / f"runtime-{key}.zip"
-    info = zipped_once(archive, lambda prefix: stage_runtime(prefix, numba, python), platform_folder)
+    info = zipped_once(archive, lambda prefix: stage_runtime(prefix, numba, python, trim), platform_folder)
     return Runtime(archive=archive, **info)
 
 

@@ -94,7 +94,15 @@ def _private_tmpdir(tmp_path_factory):
 
 @pytest.fixture(autouse=True, scope="session")
 def _cache_dir(tmp_path_factory):
-    # superelements built by the tests go to a private cache, not the user's
+    # superelements built by the tests go to a private cache, not the user's; the loops compiled ahead of time
+    # are taken from the user's (keyed by their sources, numba and the Python ABI), which `make test` fills
+    # first (the Makefile's COMPILE_LOOPS), so that the test workers do not each compile them (a minute a target)
+    import sys
+
+    sys.path.insert(0, str(ROOT))
+    from fmu_build.aot import CACHE_VARIABLE, aot_cache_dir
+
+    os.environ.setdefault(CACHE_VARIABLE, str(aot_cache_dir()))
     os.environ.setdefault("SLEWING_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
 
 
@@ -111,8 +119,8 @@ def _build_table3(tmp_path_factory, name, **options):
 @pytest.fixture(scope="session")
 def table3_fmu(tmp_path_factory):
     """The bearing FMU of table3 with synthetic errors (coarse superelement, free rings), built once:
-    FMI 2.0, standalone (it carries its Python runtime), with numpy's loops (``--no-numba``: 22 MB
-    instead of 87; tests/test_standalone.py runs the default build, with numba, on its own)."""
+    FMI 2.0, standalone (it carries its Python runtime), with numpy's loops (``--no-numba``; the default
+    build, with the loops compiled ahead of time, is :func:`table3_aot_fmu`)."""
     return _build_table3(tmp_path_factory, "SlewingBearing_table3.fmu", numba=False)
 
 
@@ -122,22 +130,35 @@ def table3_fmu3(tmp_path_factory):
     return _build_table3(tmp_path_factory, "SlewingBearing3_table3.fmu", fmi_version=3, numba=False)
 
 
-@pytest.fixture(scope="session")
-def table3_numba_fmu(tmp_path_factory):
-    """table3_fmu's bearing as build_fmu.py builds it by default where numba is installed: standalone,
-    with numba and its compiled loops (for this CPU, an x86-64-v3 one and a generic x86-64)."""
+def _needs_numba():
     from slewing_model.numerics import compiled
 
-    if not compiled.AVAILABLE:
+    if not compiled._numba_installed():
         pytest.skip("numba is not installed here")
-    return _build_table3(tmp_path_factory, "SlewingBearing_table3_numba.fmu")
+
+
+@pytest.fixture(scope="session")
+def table3_numba_fmu(tmp_path_factory):
+    """table3_fmu's bearing built with ``--numba``: standalone, with numba, llvmlite and numba's cache of
+    the compiled loops (for this CPU, an x86-64-v3 one and a generic x86-64)."""
+    _needs_numba()
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3_numba.fmu", numba=True)
+
+
+@pytest.fixture(scope="session")
+def table3_aot_fmu(tmp_path_factory):
+    """table3_fmu's bearing as build_fmu.py builds it by default where numba is installed (``--aot``):
+    standalone, with the loops compiled ahead of time (fmu_build/aot.py) and no numba."""
+    _needs_numba()
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3_aot.fmu", aot=True)
 
 
 @pytest.fixture(scope="session")
 def table3_host_fmu(tmp_path_factory):
     """The light "tool coupling" FMU of table3_fmu's bearing (``--runtime host``): it runs in this
-    machine's Python, or one named by SLEWING_FMU_PYTHONHOME."""
-    return _build_table3(tmp_path_factory, "SlewingBearing_table3_host.fmu", runtime="host")
+    machine's Python, or one named by SLEWING_FMU_PYTHONHOME; with numba's cache of the compiled loops
+    where numba is installed here (``aot=False``: numba's JIT, not the default's modules)."""
+    return _build_table3(tmp_path_factory, "SlewingBearing_table3_host.fmu", runtime="host", aot=False)
 
 
 def benchmark_case(name: str, steps: int):

@@ -91,6 +91,33 @@ def test_a_cpu_takes_the_first_module_its_features_allow():
     assert set(compiled.AOT_MODULES) == {name for name, _ in PORTABLE_TARGETS}
 
 
+def test_the_loops_compiled_ahead_of_time_are_the_default(monkeypatch, tmp_path, capsys):
+    sys.path.insert(0, str(ROOT))
+    import build_fmu
+
+    for runtime in ("standalone", "host"):
+        assert build_fmu.resolve_loops(runtime) == "aot"
+    assert build_fmu.resolve_loops("standalone", numba=True) == "numba"
+    assert build_fmu.resolve_loops("standalone", numba=False) == "numpy"
+    assert build_fmu.resolve_loops("standalone", aot=False) == "numba"          # numba's JIT, as asked
+    assert build_fmu.resolve_loops("standalone", numba=False, aot=True) == "aot"
+    with pytest.raises(ValueError, match="not both"):
+        build_fmu.resolve_loops("standalone", numba=True, aot=True)
+    # the command: no option, --aot, --numba, --no-numba (one of them)
+    asked = []
+    built = tmp_path / "t.fmu"
+    built.write_bytes(b"")
+    monkeypatch.setattr(build_fmu, "build_fmu", lambda *a, **k: asked.append(k) or built)
+    monkeypatch.setattr(build_fmu, "describe_fmu", lambda fmu: "")
+    for options in ([], ["--aot"], ["--numba"], ["--no-numba"]):
+        assert build_fmu.main(["b.toml", *options]) == 0
+    assert [build_fmu.resolve_loops(k["runtime"], k["numba"], k["aot"]) for k in asked] == \
+        ["aot", "aot", "numba", "numpy"]
+    with pytest.raises(SystemExit):
+        build_fmu.main(["b.toml", "--aot", "--numba"])
+    capsys.readouterr()
+
+
 def test_a_module_of_other_sources_is_not_used(aot_folder, monkeypatch):
     monkeypatch.syspath_prepend(str(aot_folder))
     compiled.aot_kernels.cache_clear()

@@ -1,6 +1,6 @@
 """`make demo` and build_fmu.py say what they are doing: without it `make demo` would be silent
 for about 11 minutes on a loaded machine before its first progress bar (the superelement, the
-FMU's packaging and Linux binary, its Python runtime, numba's compilation of the loops)."""
+FMU's packaging and Linux binary, its Python runtime, the compilation of the loops)."""
 import sys
 import zipfile
 from pathlib import Path
@@ -17,7 +17,8 @@ def _stages(lines):
     """The stage each line names, by its first words."""
     names = {"building the ring superelement": "superelement", "packaging the FMU": "package",
              "compiling the FMU's Linux binary": "binary", "staging the FMU's Python runtime": "runtime",
-             "compiling the loops with numba": "numba", "adding the Windows (win64) binary": "win64"}
+             "compiling the loops with numba": "numba", "compiling the loops ahead of time": "aot",
+             "adding the Windows (win64) binary": "win64"}
     return [next((v for k, v in names.items() if line.startswith(k)), line) for line in lines]
 
 

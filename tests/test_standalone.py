@@ -139,7 +139,7 @@ def fmusim(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def standalone(table3_fmu, table3_fmu3):
-    """The standalone FMUs of table3 (the default build), per FMI version."""
+    """The standalone FMUs of table3 with numpy's loops (``--no-numba``), per FMI version."""
     return {2: table3_fmu, 3: table3_fmu3}
 
 
@@ -441,7 +441,7 @@ def test_the_stated_floor_is_the_newest_glibc_any_binary_of_the_fmu_needs(versio
 
 @pytest.fixture(scope="module")
 def numba_fmu(table3_numba_fmu):
-    """The default build where numba is installed: standalone, with numba and the compiled loops' cache."""
+    """The ``--numba`` build: standalone, with numba, llvmlite and the compiled loops' cache."""
     return table3_numba_fmu
 
 
@@ -450,7 +450,26 @@ def _cache_files(system, inside):
     return sorted(p.relative_to(package).as_posix() for p in package.glob("*/__pycache__/*.nb*"))
 
 
-def test_the_default_build_carries_numba_and_runs_its_compiled_loops_in_a_bare_system(hosts, numba_fmu):
+def test_the_default_build_carries_the_loops_compiled_ahead_of_time_and_runs_them_in_a_bare_system(hosts,
+                                                                                                    table3_aot_fmu):
+    packages = runtime_of(table3_aot_fmu)["packages"]
+    assert "numpy==" in packages and "numba" not in packages and "llvmlite" not in packages
+    assert validate_fmu(str(table3_aot_fmu)) == []
+    assert_no_building_paths(table3_aot_fmu)
+    system = bare_system("bookworm")
+    reference = fmpy_steps(table3_aot_fmu, 2, 6)
+    code, values, _, logs, output = run_host(system, hosts[2], table3_aot_fmu, 2, "basic")
+    assert code == 0, output[-3000:]
+    # the bare system has no /proc mounted: the FMU cannot read the CPU's features there and takes its generic module
+    target = "x86-64-v3" if has_x86_64_v3() and (system / "proc" / "cpuinfo").exists() else "generic"
+    assert any(f"loops compiled ahead of time for {target}" in line for line in logs), logs
+    for k in range(6):
+        assert values["run"][k] == pytest.approx(reference[k], rel=SAME_FMU, abs=1e-300), k
+    for k in range(3, 6):
+        assert values["replay"][k] == values["run"][k]
+
+
+def test_the_numba_build_carries_numba_and_runs_its_compiled_loops_in_a_bare_system(hosts, numba_fmu):
     assert validate_fmu(str(numba_fmu)) == []
     assert "numba==" in runtime_of(numba_fmu)["packages"]
     assert_no_building_paths(numba_fmu)
