@@ -80,13 +80,17 @@ def compile_shim(output, fmi_version=2) -> Path:
 def variables_table(model_description: bytes | str) -> str:
     """``resources/fmi_variables.tsv`` of an FMU, from its ``modelDescription.xml`` (FMI 2.0 or 3.0).
 
-    One line per model variable, ``value_reference<TAB>type<TAB>causality<TAB>variability<TAB>initial<TAB>name``,
+    One line per model variable,
+    ``value_reference<TAB>type<TAB>causality<TAB>variability<TAB>initial<TAB>name<TAB>n_values``,
     the type as the modelDescription names it (FMI 2.0: Real, Integer, Boolean, String, Enumeration;
     FMI 3.0: Float64, Int32, Boolean, ...), ``initial`` empty where the description states none, and the
     standard's defaults where a variable states none: causality local, variability continuous for a Real
-    (FMI 2.0) or float (FMI 3.0) variable and discrete for the others; lines starting with
-    ``#`` are comments. Raises ValueError where the description has no model variables or a variable
-    lacks its name or value reference."""
+    (FMI 2.0) or float (FMI 3.0) variable and discrete for the others. ``n_values`` is the variable's
+    number of values: 1 for a scalar, the product of the ``start`` of its ``Dimension`` elements for an
+    FMI 3.0 array, 0 where a structural parameter sizes a dimension (not known before run time). Lines
+    starting with ``#`` are comments. Raises ValueError where the description has no model variables or a
+    variable lacks its name or value reference, or a dimension has neither a valid start nor a value
+    reference."""
     root = ET.fromstring(model_description)
     version = root.get("fmiVersion", "")
     variables = root.find("ModelVariables")
@@ -94,7 +98,7 @@ def variables_table(model_description: bytes | str) -> str:
         raise ValueError("the modelDescription has no ModelVariables")
     lines = [f"# model variables of {root.get('modelName', '')} (FMI {version}), written by build_fmu.py from "
              "modelDescription.xml\n",
-             "# value_reference\ttype\tcausality\tvariability\tinitial\tname\n"]
+             "# value_reference\ttype\tcausality\tvariability\tinitial\tname\tn_values\n"]
     for element in variables:
         if element.tag == "ScalarVariable":                       # FMI 2.0
             typed = next((child for child in element if child.tag in FMI2_TYPES), None)
@@ -110,9 +114,20 @@ def variables_table(model_description: bytes | str) -> str:
             raise ValueError(f"model variable {name!r}: no name or no valid valueReference ({reference!r})")
         if any(c in name for c in "\t\r\n"):
             raise ValueError(f"model variable {name!r}: a tab or line break in its name")
+        n_values = 1
+        for dimension in element.findall("Dimension"):                 # FMI 3.0 arrays
+            start = dimension.get("start")
+            if start is not None and start.isdigit():
+                n_values *= int(start)
+            elif start is None and dimension.get("valueReference") is not None:
+                n_values = 0                                          # sized by a structural parameter
+                break
+            else:
+                raise ValueError(f"model variable {name!r}: a Dimension without a valid start ({start!r}) "
+                                 "or valueReference")
         lines.append("\t".join((reference, kind, element.get("causality", DEFAULT_CAUSALITY),
                                 element.get("variability", default_variability), element.get("initial", ""),
-                                name)) + "\n")
+                                name, str(n_values))) + "\n")
     return "".join(lines)
 
 

@@ -20,6 +20,13 @@ Start: the drive starts at rest, holding the load moment it gets at its
 first step (motor torque and speed integrator in equilibrium with it), as
 ``run_manoeuvre`` does with the series' first load moment
 (:meth:`ElectricDrive.hold`).
+
+Refused steps: an input that is not finite (NaN or infinite) refuses the step,
+as the bearing FMU does: the reason (the input and the rule) is logged as
+Discard, the step returns fmi2Discard and the state stays the one before the
+step, so the master may retry the step from its start with other inputs or
+restore a state. The same step refused again with the same inputs (a master
+that retries unchanged) is an Error: it cannot succeed.
 """
 from __future__ import annotations
 
@@ -106,6 +113,7 @@ class SlewingDrive(Fmi2Slave):
             self._real(name, unit, text, Fmi2Causality.output, Fmi2Variability.continuous)
         self.drive: ElectricDrive | None = None
         self._started = False
+        self._refused = None  # (time, inputs) of the last refused step
 
     def _real(self, name, unit, description, causality, variability):
         initial = {Fmi2Causality.parameter: Fmi2Initial.exact, Fmi2Causality.output: Fmi2Initial.calculated}
@@ -167,11 +175,20 @@ class SlewingDrive(Fmi2Slave):
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self.drive is None and not self._build():
             return False
+        inputs = [getattr(self, name) for name, _, _ in INPUTS]
+        bad = next(((name, value) for (name, _, _), value in zip(INPUTS, inputs) if not math.isfinite(value)), None)
+        if bad is not None:  # refused before the drive moves: the state is the one before the step
+            reason = f"input {bad[0]} = {bad[1]!r}: must be finite (not NaN or infinite)"
+            key = repr((current_time, inputs))  # repr: NaN equals NaN
+            if key == self._refused:
+                self.log(f"{self.instance_name}: step at t = {current_time} refused again with the same inputs, "
+                         f"so it cannot succeed (change an input, or stop): {reason}", Fmi2Status.error)
+            else:
+                self.log(f"{self.instance_name}: step refused, state kept: {reason}", Fmi2Status.discard)
+            self._refused = key
+            return False
+        self._refused = None
         try:
-            for name, _, _ in INPUTS:
-                value = getattr(self, name)
-                if not math.isfinite(value):
-                    raise ValueError(f"input {name} = {value!r}: must be finite (not NaN or infinite)")
             if not self._started:  # at rest, holding the load moment of the first step
                 self.drive.hold(self.load_moment)
                 self._started = True
@@ -200,6 +217,7 @@ class SlewingDrive(Fmi2Slave):
     def _set_fmu_state(self, state):
         state = dict(state)
         drive, started = state.pop("_drive"), state.pop("_started")
+        self._refused = None
         for v in self.vars.values():
             if v.name in state:
                 setattr(self, v.name, state[v.name])

@@ -187,12 +187,38 @@ def test_bad_parameter_is_refused_with_a_logged_reason(drive_fmus, values, messa
 
 
 def test_nan_input_is_refused_with_a_logged_reason(drive_fmus):
+    # refused as the bearing FMU refuses a bad input: fmi2Discard, the reason logged, the state kept;
+    # the step retried from its start with a valid input, and the run after it, give what an
+    # instance that never saw the NaN gives, to the last bit
+    path = drive_fmus[DriveParameters.from_toml(ROOT / DRIVES[0]).name]
+    fmu, undisturbed = _Drive(path), _Drive(path)
+    try:
+        before = [fmu.step(0.01 * k, 0.01, 0.05, 3e4, 1e4) for k in range(3)]
+        with pytest.raises(Exception, match="status 2"):
+            fmu.step(0.03, 0.01, float("nan"), 3e4, 1e4)
+        refusals = [m for m in fmu.messages if "input command = nan: must be finite (not NaN or infinite)" in m]
+        assert refusals and all("step refused, state kept" in m for m in refusals), fmu.messages
+        assert fmu.fmu.getReal(fmu._out) == before[-1]   # the state of before the step
+        assert not fmu.fmu.getBooleanStatus(3)           # fmi2Terminated: false, the run goes on
+        after = [fmu.step(0.01 * k, 0.01, 0.05, 3e4, 1e4) for k in range(3, 8)]
+        reference = [undisturbed.step(0.01 * k, 0.01, 0.05, 3e4, 1e4) for k in range(8)]
+        assert before + after == reference
+    finally:
+        fmu.close()
+        undisturbed.close()
+
+
+def test_a_nan_input_refused_again_unchanged_is_an_error(drive_fmus):
+    # a master that retries the refused step with the same inputs (fmpy's simulate_fmu) gets fmi2Error
     fmu = _Drive(drive_fmus[DriveParameters.from_toml(ROOT / DRIVES[0]).name])
     try:
-        with pytest.raises(Exception):
-            fmu.step(0.0, 0.01, float("nan"), 0.0, 0.0)
-        assert any("input command = nan: must be finite" in m for m in fmu.messages), fmu.messages
-        fmu.step(0.0, 0.01, 0.1, 0.0, 0.0)  # still alive
+        with pytest.raises(Exception, match="status 2"):
+            fmu.step(0.0, 0.01, 0.1, float("inf"), 0.0)
+        with pytest.raises(Exception, match="status 3"):
+            fmu.step(0.0, 0.01, 0.1, float("inf"), 0.0)
+        assert any("refused again with the same inputs, so it cannot succeed" in m and "input load_moment = inf" in m
+                   for m in fmu.messages), fmu.messages
     finally:
+        fmu.initialised = False  # in the state Error: fmi2FreeInstance, not fmi2Terminate
         fmu.close()
 

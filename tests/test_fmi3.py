@@ -2,6 +2,7 @@
 import math
 import shutil
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -332,6 +333,57 @@ def test_a_call_the_standard_forbids_is_an_error_that_changes_nothing(fmu3, misu
         f.setFloat64([refs["Fz"]], [1e4])
         f.doStep(0.0, 0.01)
         assert f.getFloat64([refs["z"]])[0] != 0
+    finally:
+        f.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+
+
+def test_a_corrupted_serialized_state_is_refused_before_it_reaches_python(fmu3):
+    # the header holds the payload's CRC-32: one byte changed in the content is fmi3Error, and the
+    # instance runs on (its own serialized state, intact, is read back and stepped from)
+    messages = []
+    f, unzipped, refs = _fresh3(fmu3, messages)
+    try:
+        f.enterInitializationMode(startTime=0.0)
+        f.exitInitializationMode()
+        for k in range(2):
+            f.setFloat64([refs[n] for n in _inputs(k)], list(_inputs(k).values()))
+            f.doStep(0.01 * k, 0.01)
+        state = f.getFMUState()
+        serialized = f.serializeFMUState(state)
+        corrupted = bytearray(serialized)
+        corrupted[-2] ^= 0x01
+        with pytest.raises(FMICallException) as info:
+            f.deserializeFMUState(bytes(corrupted))
+        assert info.value.status == 3
+        assert any(status == 3 and "fmi3DeserializeFMUState" in m and "checksum does not match: corrupted" in m
+                   for status, m in messages), messages
+        f.setFMUState(f.deserializeFMUState(serialized))
+        f.doStep(0.02, 0.01)
+        f.freeFMUState(state)
+    finally:
+        f.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+
+
+def test_nvalues_is_checked_without_the_model_description(fmu3):
+    # the number of values of each variable comes from resources/fmi_variables.tsv: a host that unpacks
+    # only the binaries and resources (fmpy's simulate_fmu may) gets the same check
+    messages = []
+    md = read_model_description(str(fmu3))
+    unzipped = extract(str(fmu3))
+    (Path(unzipped) / "modelDescription.xml").unlink()
+    f = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName="no_description")
+    f.instantiate(loggingOn=False, logMessage=lambda env, status, cat, m: messages.append((status, m.decode())))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        f.enterInitializationMode(startTime=0.0)
+        f.exitInitializationMode()
+        with pytest.raises(FMICallException):
+            f.getFloat64([refs["contact_load"]], nValues=3)
+        assert any(status == 3 and f"has {4 * BALLS} values" in m for status, m in messages), messages
+        assert len(f.getFloat64([refs["contact_load"]], nValues=4 * BALLS)) == 4 * BALLS
     finally:
         f.freeInstance()
         shutil.rmtree(unzipped, ignore_errors=True)

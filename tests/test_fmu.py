@@ -245,6 +245,24 @@ def test_rollback_repeats_steps_exactly(slave):
     fmu.freeFMUstate(state)
 
 
+def test_a_corrupted_serialized_state_is_refused_and_the_instance_runs_on(slave):
+    # the header holds the payload's CRC-32: one byte changed in the content is fmi2Error before
+    # pythonfmu reads it, and the intact state is read back and stepped from
+    fmu, refs, messages = slave
+    for k in range(2):
+        _step(fmu, refs, 0.01 * k, Fz=1e4 * (k + 1), omega=0.1)
+    state = fmu.getFMUstate()
+    serialized = fmu.serializeFMUstate(state)
+    corrupted = bytearray(serialized)
+    corrupted[-2] ^= 0x01
+    with pytest.raises(Exception, match="status 3"):
+        fmu.deSerializeFMUstate(bytes(corrupted))
+    assert any("fmi2DeSerializeFMUstate" in m and "checksum does not match: corrupted" in m for m in messages), messages
+    fmu.setFMUstate(fmu.deSerializeFMUstate(serialized))
+    _step(fmu, refs, 0.02, Fz=3e4, omega=0.1)
+    fmu.freeFMUstate(state)
+
+
 def test_two_instances_run_independently(table3_fmu):
     runs = {}
     for loads in ({"Fz": 2e4}, {"Fz": 5e4, "My": 3e3}):
@@ -286,9 +304,56 @@ def test_bad_input_is_refused_with_a_logged_reason(slave, inputs, message):
         fmu.doStep(0.0, 0.01)
     assert "fmi2Discard" in str(info.value) or "status 2" in str(info.value)
     assert any(message in m for m in messages), messages
-    # the instance is still alive: a good input steps again
+    # the instance is still alive: the step retried from its start with a good input succeeds
     fmu.setReal([refs["Fz"], refs["omega"]], [1e4, 0.1])
+    fmu.doStep(0.0, 0.01)
     fmu.doStep(0.01, 0.01)
+
+
+def test_a_step_must_start_at_the_instance_time(slave):
+    # a later currentCommunicationPoint would skip an interval: fmi2Error, nothing changed; after a
+    # refused step, the next starts at the refused step's start, not at its end
+    fmu, refs, messages = slave
+    _step(fmu, refs, 0.0, Fz=1e4, omega=0.1)
+    with pytest.raises(Exception, match="status 3"):
+        fmu.doStep(0.02, 0.01)
+    assert any("fmi2DoStep: currentCommunicationPoint = 0.02 but the last step ended at 0.01" in m
+               for m in messages), messages
+    fmu.setReal([refs["Fz"]], [float("nan")])
+    with pytest.raises(Exception, match="status 2"):
+        fmu.doStep(0.01, 0.01)
+    fmu.setReal([refs["Fz"]], [2e4])
+    with pytest.raises(Exception, match="status 3"):
+        fmu.doStep(0.02, 0.01)
+    assert any("fmi2DoStep: currentCommunicationPoint = 0.02 but the refused step started at 0.01" in m
+               for m in messages), messages
+    fmu.doStep(0.01, 0.01)
+    fmu.doStep(0.02, 0.01)
+
+
+def test_the_error_state_allows_what_the_standard_allows(slave):
+    # the same step refused twice is an Error of the model: the state Error allows the getters, the
+    # status and FMU state functions (FMI 2.0 section 4.2.4); fmi2SetFMUstate leaves it
+    fmu, refs, messages = slave
+    _step(fmu, refs, 0.0, Fz=1e4, omega=0.1)
+    state = fmu.getFMUstate()
+    before = fmu.getReal([refs["z"]])
+    fmu.setReal([refs["Fz"]], [float("nan")])
+    for status in (2, 3):
+        with pytest.raises(Exception, match=f"status {status}"):
+            fmu.doStep(0.01, 0.01)
+    assert fmu.getBooleanStatus(3)                                   # fmi2Terminated
+    assert fmu.getReal([refs["z"]]) == before                         # getters answer
+    for call, name in ((lambda: fmu.setReal([refs["Fz"]], [1e4]), "fmi2SetReal"),
+                       (lambda: fmu.doStep(0.01, 0.01), "fmi2DoStep"),
+                       (lambda: fmu.terminate(), "fmi2Terminate")):
+        with pytest.raises(Exception, match="status 3"):
+            call()
+        assert any(f"{name}: not allowed in state Error" in m for m in messages), (name, messages)
+    fmu.setFMUstate(state)                                           # back to StepComplete at t = 0.01
+    assert not fmu.getBooleanStatus(3)
+    _step(fmu, refs, 0.01, Fz=2e4, omega=0.1)
+    fmu.freeFMUstate(state)
 
 
 def test_bad_input_is_explained_in_the_log(slave):

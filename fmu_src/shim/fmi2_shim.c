@@ -16,8 +16,8 @@
  *    status of each call is the worst status the slave logged during it (the slave logs a
  *    refused step as Discard, an instance that cannot continue as Error), and fmi2Terminated
  *    is true only in the error state: after a Discard the state is the one before the step,
- *    fmi2LastSuccessfulTime is the start of the refused step, and the master may retry
- *    (fmi2SetFMUstate) or go on with other inputs.
+ *    fmi2LastSuccessfulTime is the start of the refused step, and the master may retry that
+ *    step from its start, with other inputs, or restore a state (fmi2SetFMUstate).
  *
  * 3. Logging. pythonfmu drops every message, errors included, when logging is off. Here
  *    pythonfmu always logs to this layer, which passes Error and Fatal messages to the host
@@ -28,12 +28,18 @@
  *    Terminated, Error) is tracked and every call checked against FMI 2.0's co-simulation table
  *    (section 4.2.4), every value reference against resources/fmi_variables.tsv (the FMU's variables:
  *    type, causality, variability; shim_rules.h), and fmi2DoStep's arguments (a step size > 0, a
- *    currentCommunicationPoint not before the end of the last step: STEP_GAPS_ALLOWED). A call the standard forbids returns
- *    fmi2Error with one Error line in the log, is not forwarded and changes nothing. FMU states are
- *    pythonfmu's wrapped with their communication time; a serialized state starts with a header
- *    (shim_rules.h) that fmi2DeSerializeFMUstate checks. pythonfmu returns fmi2Fatal for any Python
- *    exception it catches (and clears): here that is the call's fmi2Error, logged with the exception.
- *    StepFailed (after a Discard) allows what StepComplete allows (see 2.).
+ *    currentCommunicationPoint at the instance's time: the start time, the end of the last
+ *    successful step, the start of a refused step, or the time of the state set last). A call the
+ *    standard forbids returns fmi2Error with one Error line in the log, is not forwarded and changes
+ *    nothing. FMU states are pythonfmu's wrapped with their communication time; a serialized state
+ *    starts with a header (shim_rules.h: magic, format version, the payload's CRC-32, the GUID's hash,
+ *    the time, the length) that fmi2DeSerializeFMUstate checks before pythonfmu reads the payload.
+ *    pythonfmu returns fmi2Fatal for any Python exception it catches (and clears): here that is the
+ *    call's fmi2Error, logged with the exception. StepFailed (after a Discard) allows what StepComplete
+ *    allows (see 2.). The state Error (after an Error of the model) allows what the standard's table
+ *    allows there: the getters, fmi2GetStatus and the like, the FMU state functions, fmi2Reset,
+ *    fmi2FreeInstance and fmi2SetDebugLogging; fmi2SetFMUstate leaves it for the state the Error
+ *    came in (StepComplete for a step).
  *
  * Our own declarations of the FMI 2.0 types (the standard's ABI, fmi2TypesPlatform "default").
  */
@@ -149,10 +155,10 @@ static int load_inner(char *err, size_t size)
 /* The states of FMI 2.0 co-simulation (section 4.2.4) this layer tracks. StepInProgress never
  * exists (steps are synchronous). StepFailed is the state after a Discard'ed step: the state is
  * the one before the step, and unlike the standard's stepFailed it allows what StepComplete allows
- * (the master may set other inputs and step again, or restore a state). Error: the model returned
- * fmi2Error (or fmi2Fatal); fmi2Terminated is then true until fmi2SetFMUstate or fmi2Reset, and the
- * calls the state before the Error allowed still reach the model, which refuses what it cannot do
- * (the drive FMU steps on after a refused NaN input; the bearing stops after a step refused twice). */
+ * (the master may set other inputs and retry the step from its start, or restore a state). Error: the
+ * model returned fmi2Error (or fmi2Fatal); fmi2Terminated is then true until fmi2SetFMUstate or
+ * fmi2Reset, and only what the standard's table allows in the state error is accepted (the getters,
+ * the status functions, the FMU state functions, fmi2Reset, fmi2FreeInstance). */
 enum {
     Instantiated = 1 << 0,
     InitializationMode = 1 << 1,
@@ -180,24 +186,17 @@ static const char *state_name(int s)
 #define MASK_EnterInitializationMode Instantiated
 #define MASK_ExitInitializationMode InitializationMode
 #define MASK_Terminate STEPPING
+#define MASK_Reset ALL_STATES
 #define MASK_Get (InitializationMode | STEPPING | Terminated | ErrorState)
 #define MASK_Set (Instantiated | InitializationMode | STEPPING)
-#define MASK_GetFMUstate (Instantiated | InitializationMode | STEPPING | Terminated)
+#define MASK_GetFMUstate ALL_STATES
 #define MASK_StateData ALL_STATES /* Set, Free, (De)Serialize: from Error too (FMI 2.0 section 2.1.3) */
-#define MASK_GetDirectionalDerivative (InitializationMode | STEPPING | Terminated)
+#define MASK_GetDirectionalDerivative (InitializationMode | STEPPING | Terminated | ErrorState)
 #define MASK_SetRealInputDerivatives (Instantiated | InitializationMode | STEPPING)
-#define MASK_GetRealOutputDerivatives (STEPPING | Terminated)
+#define MASK_GetRealOutputDerivatives (STEPPING | Terminated | ErrorState)
 #define MASK_DoStep STEPPING
 #define MASK_CancelStep 0
 #define MASK_Status (STEPPING | Terminated | ErrorState)
-
-/* A currentCommunicationPoint after the instance's time (a forward gap): 1, accepted with a Warning in the
- * log (the model steps on from its state; hosts and tests that compare a run with a refused step against
- * one that skips that step rely on it); 0, refused as FMI 2.0 requires (equal to the end of the last step).
- * A point before the instance's time is refused either way. */
-#ifndef STEP_GAPS_ALLOWED
-#define STEP_GAPS_ALLOWED 1
-#endif
 
 /* where the expected currentCommunicationPoint comes from (for the message) */
 enum { TIME_START, TIME_STEP, TIME_DISCARD, TIME_STATE };
@@ -218,10 +217,9 @@ typedef struct {
     fmi2Status logged;                 /* worst status the slave logged during the current call */
     int python_exception;              /* pythonfmu reported a Python exception during the current call */
     int state;                         /* Instantiated, ... */
-    int before_error;                  /* in the state Error: the state the Error came in */
+    int before_error;                  /* in the state Error: the state the Error came in (fmi2SetFMUstate's) */
     double start_time;                 /* fmi2SetupExperiment's startTime */
     double time;                       /* the currentCommunicationPoint the next fmi2DoStep must give */
-    double discard_end;                /* after a Discard: the refused step's end, which the next may also give */
     int time_origin;                   /* TIME_START, ... */
     ShimVariables variables;           /* resources/fmi_variables.tsv */
     ShimState *states;                 /* the FMU states handed to the host */
@@ -336,7 +334,7 @@ static void state_list(int mask, char *buf, size_t size)
 /* 0 where the instance's state allows the call, else fmi2Error logged */
 static int not_allowed(Instance *in, const char *function, int mask)
 {
-    if ((in->state | (in->state == ErrorState ? in->before_error : 0)) & mask)
+    if (in->state & mask)
         return 0;
     char allowed[256];
     state_list(mask, allowed, sizeof allowed);
@@ -585,7 +583,7 @@ EXPORT fmi2Status fmi2Terminate(fmi2Component c)
 
 EXPORT fmi2Status fmi2Reset(fmi2Component c)
 {
-    CHECK("fmi2Reset", ALL_STATES);
+    CHECK("fmi2Reset", MASK_Reset);
     fmi2Status status = FORWARD("fmi2Reset", fmi2Reset(IN->inner));
     if (status <= fmi2Warning) {
         IN->state = Instantiated;
@@ -659,13 +657,14 @@ EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
     ShimState *s = our_state(IN, "fmi2SetFMUstate", state);
     if (!s)
         return fmi2Error;
-    int was = IN->state;
+    int to = IN->state == ErrorState ? IN->before_error : IN->state;
     fmi2Status status = FORWARD("fmi2SetFMUstate", fmi2SetFMUstate(IN->inner, s->inner));
     if (status <= fmi2Warning) {
         IN->time = s->time;
         IN->time_origin = TIME_STATE;
-        if (was == ErrorState || was == StepFailed)  /* the master restarts from a stored state */
-            IN->state = StepComplete;
+        /* the master restarts from a stored state: out of StepFailed, and out of Error to the state the
+         * Error came in */
+        IN->state = to == StepFailed ? StepComplete : to;
     }
     return status;
 }
@@ -793,26 +792,15 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint
     char a[32], b[32];
     if (!(communicationStepSize > 0) || communicationStepSize - communicationStepSize != 0)
         return refuse(IN, "fmi2DoStep: communicationStepSize = %s must be > 0", shim_double(a, communicationStepSize));
-    int same = shim_same_time(IN->time, currentCommunicationPoint)
-               || (IN->time_origin == TIME_DISCARD && shim_same_time(IN->discard_end, currentCommunicationPoint));
-    if (!same && STEP_GAPS_ALLOWED && currentCommunicationPoint > IN->time) {
-        if (category_logged(IN, "logStatusWarning")) {
-            char text[256];
-            shim_format(text, sizeof text, "fmi2DoStep: currentCommunicationPoint = %s is after the instance's time %s: "
-                        "the interval between is skipped (the model steps on from its state at %s)",
-                        shim_double(a, currentCommunicationPoint), shim_double(b, IN->time), b);
-            host_log(IN, fmi2Warning, "logStatusWarning", text);
-        }
-    } else if (!same) {
+    if (!shim_same_time(IN->time, currentCommunicationPoint)) {
         static const char *origin[] = {
             [TIME_START] = "but the experiment starts at %s (fmi2SetupExperiment's startTime)",
             [TIME_STEP] = "but the last step ended at %s",
-            [TIME_DISCARD] = "but the refused step started at %s (retry it from there) and ended at %s (go on from there)",
+            [TIME_DISCARD] = "but the refused step started at %s (retry it from there, possibly with other inputs)",
             [TIME_STATE] = "but the state set by fmi2SetFMUstate is at %s",
         };
         char where[160];
-        char e[32];
-        shim_format(where, sizeof where, origin[IN->time_origin], shim_double(b, IN->time), shim_double(e, IN->discard_end));
+        shim_format(where, sizeof where, origin[IN->time_origin], shim_double(b, IN->time));
         return refuse(IN, "fmi2DoStep: currentCommunicationPoint = %s %s%s", shim_double(a, currentCommunicationPoint),
                       where, currentCommunicationPoint < IN->time && IN->time_origin == TIME_STEP
                                  ? " (restore a state with fmi2SetFMUstate to go back)" : "");
@@ -827,7 +815,6 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint
             IN->state = StepComplete;
     } else if (status == fmi2Discard) {
         IN->time = currentCommunicationPoint;
-        IN->discard_end = currentCommunicationPoint + communicationStepSize;
         IN->time_origin = TIME_DISCARD;
         if (IN->state != ErrorState)
             IN->state = StepFailed;

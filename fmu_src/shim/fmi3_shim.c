@@ -25,9 +25,9 @@
  *    is not passed to pythonfmu3 and changes nothing: the instance stays in its state.
  *
  * 4. Variables. resources/fmi_variables.tsv (written by the build, read with shim_rules.h) gives each
- *    value reference's type, causality and variability; the array sizes come from the FMU's
- *    modelDescription.xml (its Dimension elements), where the host unpacked it beside the resources
- *    folder (without it nValues is not checked). An unknown value reference, a value reference
+ *    value reference's type, causality, variability and number of values (the product of its
+ *    Dimension starts: nValues is checked against it, except for an array a structural parameter
+ *    sizes). An unknown value reference, a value reference
  *    of another type, nValues not matching the variables, a NULL array, and a set the standard
  *    forbids (an output, a calculated parameter, the independent variable, a constant, a fixed
  *    parameter after initialization, a structural parameter outside ConfigurationMode) are refused.
@@ -51,8 +51,9 @@
  * 8. FMU states. The host gets a ShimState (shim_rules.h) that holds pythonfmu3's state and the
  *    communication time it was taken at; a pointer that is not a live state of this instance is
  *    refused without being read. A serialized state carries shim_rules.h's header (magic, format
- *    version, the instantiation token's hash, the time, the payload length), checked by
- *    fmi3DeserializeFMUState, which names the check that failed.
+ *    version, the payload's CRC-32, the instantiation token's hash, the time, the payload length),
+ *    checked by fmi3DeserializeFMUState, which names the check that failed: a corrupted payload is
+ *    refused before it reaches pythonfmu3.
  */
 #include "shim_platform.h"  /* first: glibc_compat.h on Linux, windows.h on Windows */
 #include "python_runtime.h"
@@ -203,7 +204,6 @@ typedef struct {
     size_t n_categories;
     char **categories;
     ShimVariables variables;           /* resources/fmi_variables.tsv */
-    size_t *elements;                  /* per variable: number of values (product of its dimensions) */
     int structural, tunable_structural;
     double time;                       /* where the next step must start */
     fmi3Status logged;                 /* worst status pythonfmu3 logged during the current call */
@@ -331,99 +331,6 @@ static fmi3Status finish(Instance *in, fmi3Status status, int discard_allowed)
 }
 
 /* ---- variables ----------------------------------------------------------------------------- */
-static const char *const VARIABLE_TAGS[] = {"Float32", "Float64", "Int8", "UInt8", "Int16", "UInt16", "Int32",
-                                            "UInt32", "Int64", "UInt64", "Boolean", "String", "Binary",
-                                            "Clock", "Enumeration", NULL};
-
-static int is_variable_tag(const char *p, size_t n)
-{
-    for (int i = 0; VARIABLE_TAGS[i]; i++)
-        if (strlen(VARIABLE_TAGS[i]) == n && !strncmp(p, VARIABLE_TAGS[i], n))
-            return 1;
-    return 0;
-}
-
-/* The value of attribute name="..." inside the tag [tag, end), or NULL; copied into buf. */
-static const char *tag_attribute(const char *tag, const char *end, const char *name, char *buf, size_t size)
-{
-    size_t n = strlen(name);
-    for (const char *p = tag; p + n + 2 < end; p++) {
-        if ((p[-1] == ' ' || p[-1] == '\t' || p[-1] == '\n' || p[-1] == '\r') && !strncmp(p, name, n) &&
-            p[n] == '=' && p[n + 1] == '"') {
-            const char *v = p + n + 2, *q = v;
-            while (q < end && *q != '"')
-                q++;
-            size_t m = (size_t)(q - v) < size - 1 ? (size_t)(q - v) : size - 1;
-            memcpy(buf, v, m);
-            buf[m] = '\0';
-            return buf;
-        }
-    }
-    return NULL;
-}
-
-/* The number of values of each variable (its Dimension elements' start values multiplied; 0: not
- * known, not checked), and the instantiation token, from the FMU's modelDescription.xml beside its
- * resources folder. A host may unpack only the binaries and resources (fmpy's simulate_fmu does):
- * without modelDescription.xml no count is known and the token is not checked. 0, or -1 with a message. */
-static int read_model_description(Instance *in, const char *resource_path, char *token, size_t token_size,
-                                  char *err, size_t size)
-{
-    char path[4096];
-    in->elements = (size_t *)calloc(in->variables.n ? in->variables.n : 1, sizeof(size_t));
-    if (!in->elements) {
-        shim_format(err, size, "out of memory");
-        return -1;
-    }
-    token[0] = '\0';
-    FILE *f = NULL;
-    if (shim_resource_path(resource_path, "../modelDescription.xml", path, sizeof path) == 0)
-        f = fopen(path, "rb");
-    if (!f)
-        return 0;
-    for (size_t i = 0; i < in->variables.n; i++)
-        in->elements[i] = 1;
-    fseek(f, 0, SEEK_END);
-    long length = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = length > 0 ? (char *)malloc((size_t)length + 1) : NULL;
-    if (!text || fread(text, 1, (size_t)length, f) != (size_t)length) {
-        fclose(f);
-        free(text);
-        shim_format(err, size, "cannot read %s", path);
-        return -1;
-    }
-    fclose(f);
-    text[length] = '\0';
-    size_t current = (size_t)-1;  /* the variable whose Dimension elements follow */
-    for (char *p = strchr(text, '<'); p; p = strchr(p + 1, '<')) {
-        char *name = p + 1, *end = strchr(name, '>'), buf[64];
-        if (!end)
-            break;
-        size_t n = strcspn(name, " \t\r\n/>");
-        if (n == 19 && !strncmp(name, "fmiModelDescription", 19)) {
-            tag_attribute(name, end, "instantiationToken", token, token_size);
-        } else if (is_variable_tag(name, n)) {
-            current = (size_t)-1;
-            if (tag_attribute(name, end, "valueReference", buf, sizeof buf)) {
-                const ShimVariable *v = shim_variable_find(&in->variables, NULL, (unsigned int)strtoul(buf, NULL, 10));
-                if (v)
-                    current = (size_t)(v - in->variables.items);
-            }
-        } else if (n == 9 && !strncmp(name, "Dimension", 9) && current != (size_t)-1) {
-            if (tag_attribute(name, end, "start", buf, sizeof buf))
-                in->elements[current] *= (size_t)strtoull(buf, NULL, 10);
-            else
-                in->elements[current] = 0;  /* sized by a structural parameter: not checked */
-        } else if (n > 0 && name[0] == '/' && is_variable_tag(name + 1, strcspn(name + 1, " \t\r\n>"))) {
-            current = (size_t)-1;
-        }
-        p = end;
-    }
-    free(text);
-    return 0;
-}
-
 static const char *variable_name(const ShimVariable *v)
 {
     return v->name ? v->name : "?";
@@ -481,7 +388,7 @@ static int check_values(Instance *in, const char *fn, const char *type, const fm
             refuse(in, "%s: %s (value reference %u) %s", fn, variable_name(v), vrs[i], why);
             return 0;
         }
-        size_t count = in->elements[v - in->variables.items];
+        size_t count = v->n_values;  /* 0: sized by a structural parameter, not checked */
         if (count == 0)
             known = 0;
         total += count;
@@ -1106,7 +1013,6 @@ static void free_instance(Instance *in)
     if (!in)
         return;
     shim_variables_free(&in->variables);
-    free(in->elements);
     free_categories(in);
     free(in->name);
     free(in->token);
@@ -1120,7 +1026,7 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
     fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage,
     fmi3IntermediateUpdateCallback intermediateUpdate)
 {
-    char err[2048] = "", token[512];
+    char err[2048] = "";
     if (eventModeUsed) {
         report(instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation: eventModeUsed = true, but this FMU "
                                                 "has no event mode (hasEventMode is false)");
@@ -1140,18 +1046,9 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
         report(instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation: out of memory");
         return NULL;
     }
-    if (shim_variables_load(&in->variables, resourcePath, err, sizeof err) != 0 ||
-        read_model_description(in, resourcePath, token, sizeof token, err, sizeof err) != 0) {
+    if (shim_variables_load(&in->variables, resourcePath, err, sizeof err) != 0) {
         char text[2200];
         shim_format(text, sizeof text, "fmi3InstantiateCoSimulation: %s", err);
-        report(instanceEnvironment, logMessage, text);
-        free_instance(in);
-        return NULL;
-    }
-    if (token[0] && (!instantiationToken || strcmp(token, instantiationToken))) {
-        char text[1200];
-        shim_format(text, sizeof text, "fmi3InstantiateCoSimulation: instantiationToken %s is not this FMU's (%s)",
-                    instantiationToken ? instantiationToken : "NULL", token);
         report(instanceEnvironment, logMessage, text);
         free_instance(in);
         return NULL;

@@ -8,12 +8,15 @@
  *
  * Variables table: resources/fmi_variables.tsv, written by fmu_build/shim.py from the FMU's own
  * modelDescription.xml, one line per model variable:
- *     value_reference TAB type TAB causality TAB variability TAB initial TAB name
+ *     value_reference TAB type TAB causality TAB variability TAB initial TAB name TAB n_values
  * (type as the modelDescription names it: Real/Integer/Boolean/String in FMI 2.0, Float64/Int32/...
- * in FMI 3.0; initial may be empty; lines starting with '#' and empty lines are skipped).
+ * in FMI 3.0; initial may be empty; n_values: the number of values, the product of the variable's
+ * Dimension starts (FMI 3.0 arrays), 1 for a scalar, 0 where a structural parameter sizes the array;
+ * a table of 6 columns gives 0 there; lines starting with '#' and empty lines are skipped).
  *
  *   typedef struct { unsigned int vr; char type[16]; char causality[24]; char variability[16];
- *                    char initial[16]; char *name; } ShimVariable;
+ *                    char initial[16]; char *name; size_t n_values; } ShimVariable;
+ *       n_values: 0 where the number is not known (not checked).
  *   typedef struct { ShimVariable *items; size_t n; } ShimVariables;
  *
  *   int shim_variables_load(ShimVariables *t, const char *resource_location, char *err, size_t size);
@@ -41,12 +44,14 @@
  *       calculated parameters, independents and constants never.
  *
  * Serialized state header (SHIM_STATE_HEADER_SIZE = 40 bytes, little-endian whatever the machine):
- *     8 bytes magic "SLWFMUST", 4 bytes format version (SHIM_STATE_FORMAT), 4 bytes reserved (0),
- *     8 bytes FNV-1a 64-bit hash of the FMU's GUID / instantiation token, 8 bytes the communication
- *     time (IEEE double), 8 bytes the payload length; then the payload (pythonfmu's bytes).
+ *     8 bytes magic "SLWFMUST", 4 bytes format version (SHIM_STATE_FORMAT = 2), 4 bytes the payload's
+ *     CRC-32 (the checksum of zlib and PNG), 8 bytes FNV-1a 64-bit hash of the FMU's GUID /
+ *     instantiation token, 8 bytes the communication time (IEEE double), 8 bytes the payload length;
+ *     then the payload (pythonfmu's bytes).
  *
  *   size_t shim_state_header_size(void);
  *   void shim_state_header_write(unsigned char *bytes, const char *token, double time, size_t payload);
+ *       Call it once the payload is in place after the header: the checksum covers it.
  *   int shim_state_header_check(const unsigned char *bytes, size_t size, const char *token,
  *                               double *time, const unsigned char **payload, size_t *payload_size,
  *                               char *why, size_t why_size);
@@ -56,6 +61,8 @@
  *       SHIM_STATE_VERSION "another format version: V, this FMU reads version 1"
  *       SHIM_STATE_TOKEN   "another FMU's state: its GUID / instantiation token differs"
  *       SHIM_STATE_LENGTH  "wrong length: the header announces P bytes of state, N follow it"
+ *       SHIM_STATE_CHECKSUM "the content's checksum does not match: corrupted"
+ *   unsigned long shim_crc32(const unsigned char *bytes, size_t n);   the payload's checksum
  *
  * FMU state pointers handed to the host (each layer's own small struct, not the inner binary's):
  *   typedef struct ShimState { unsigned int magic; double time; void *inner; struct ShimState *next; } ShimState;
@@ -130,6 +137,7 @@ typedef struct {
     char variability[16];
     char initial[16];
     char *name;
+    size_t n_values;  /* the number of values (1: a scalar); 0: not known */
 } ShimVariable;
 
 typedef struct {
@@ -295,19 +303,21 @@ static SHIM_UNUSED int shim_variables_load(ShimVariables *t, const char *resourc
             line = next;
             continue;
         }
-        char *field[6];
+        char *field[7];
         int k = 0;
         field[k++] = line;
-        for (char *q = line; *q && k < 6; q++)
+        for (char *q = line; *q && k < 7; q++)
             if (*q == '\t') {
                 *q = '\0';
                 field[k++] = q + 1;
             }
-        char *end = NULL;
-        unsigned long vr = k == 6 ? strtoul(field[0], &end, 10) : 0;
-        if (k != 6 || end == field[0] || *end != '\0') {
+        char *end = NULL, *end_values = NULL;
+        unsigned long vr = k >= 6 ? strtoul(field[0], &end, 10) : 0;
+        unsigned long long n_values = k == 7 ? strtoull(field[6], &end_values, 10) : 0;
+        if (k < 6 || end == field[0] || *end != '\0' ||
+            (k == 7 && (end_values == field[6] || *end_values != '\0' || field[6][0] == '-'))) {
             shim_format(err, size, "%s, line %lu: not value_reference<TAB>type<TAB>causality<TAB>variability<TAB>"
-                        "initial<TAB>name", path, (unsigned long)number);
+                        "initial<TAB>name<TAB>n_values", path, (unsigned long)number);
             status = -1;
             break;
         }
@@ -324,6 +334,7 @@ static SHIM_UNUSED int shim_variables_load(ShimVariables *t, const char *resourc
             break;
         }
         strcpy(v->name, field[5]);
+        v->n_values = (size_t)n_values;
         t->n++;
         line = next;
     }
@@ -391,8 +402,9 @@ static SHIM_UNUSED int shim_may_set(const ShimVariable *v, int phase, const char
 /* ---- serialized state header ------------------------------------------------------------ */
 #define SHIM_STATE_HEADER_SIZE 40
 #define SHIM_STATE_MAGIC_TEXT "SLWFMUST"
-#define SHIM_STATE_FORMAT 1u
-enum { SHIM_STATE_OK = 0, SHIM_STATE_SHORT, SHIM_STATE_MAGIC, SHIM_STATE_VERSION, SHIM_STATE_TOKEN, SHIM_STATE_LENGTH };
+#define SHIM_STATE_FORMAT 2u
+enum { SHIM_STATE_OK = 0, SHIM_STATE_SHORT, SHIM_STATE_MAGIC, SHIM_STATE_VERSION, SHIM_STATE_TOKEN, SHIM_STATE_LENGTH,
+       SHIM_STATE_CHECKSUM };
 
 static SHIM_UNUSED size_t shim_state_header_size(void) { return SHIM_STATE_HEADER_SIZE; }
 
@@ -404,6 +416,18 @@ static unsigned long long shim_token_hash(const char *token)
         h *= 1099511628211ull;
     }
     return h;
+}
+
+/* CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320: zlib's crc32), bitwise: no table */
+static SHIM_UNUSED unsigned long shim_crc32(const unsigned char *bytes, size_t n)
+{
+    unsigned long crc = 0xffffffffUL;
+    for (size_t i = 0; i < n; i++) {
+        crc ^= bytes[i];
+        for (int k = 0; k < 8; k++)
+            crc = (crc >> 1) ^ (0xedb88320UL & (0UL - (crc & 1UL)));
+    }
+    return (crc ^ 0xffffffffUL) & 0xffffffffUL;
 }
 
 static void shim_put_u64(unsigned char *p, unsigned long long x)
@@ -424,7 +448,9 @@ static SHIM_UNUSED void shim_state_header_write(unsigned char *bytes, const char
 {
     unsigned long long bits;
     memcpy(bytes, SHIM_STATE_MAGIC_TEXT, 8);
-    shim_put_u64(bytes + 8, SHIM_STATE_FORMAT);  /* format version (4 bytes), then 4 reserved */
+    /* format version (4 bytes), then the payload's CRC-32 (4 bytes) */
+    shim_put_u64(bytes + 8, SHIM_STATE_FORMAT | ((unsigned long long)shim_crc32(bytes + SHIM_STATE_HEADER_SIZE, payload)
+                                                 << 32));
     shim_put_u64(bytes + 16, shim_token_hash(token));
     memcpy(&bits, &time, 8);
     shim_put_u64(bytes + 24, bits);
@@ -459,6 +485,10 @@ static SHIM_UNUSED int shim_state_header_check(const unsigned char *bytes, size_
         shim_format(why, why_size, "wrong length: the header announces %.0f bytes of state, %lu follow it",
                     (double)announced, (unsigned long)(size - SHIM_STATE_HEADER_SIZE));
         return SHIM_STATE_LENGTH;
+    }
+    if ((shim_get_u64(bytes + 8) >> 32) != shim_crc32(bytes + SHIM_STATE_HEADER_SIZE, size - SHIM_STATE_HEADER_SIZE)) {
+        shim_format(why, why_size, "the content's checksum does not match: corrupted");
+        return SHIM_STATE_CHECKSUM;
     }
     unsigned long long bits = shim_get_u64(bytes + 24);
     if (time)
