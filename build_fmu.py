@@ -86,8 +86,10 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         floor). Not with ``numba=True``.
     win64 : bool
         Also carry a standalone Windows binary (``binaries/win64``, FMI 3.0 ``binaries/x86_64-windows``:
-        :mod:`fmu_build.win64`; needs mingw-w64 and PyPI): default True. The win64 half runs numpy's loops,
-        unless ``win64_numba``.
+        :mod:`fmu_build.win64`; needs mingw-w64 and PyPI): default True. The win64 half runs the loops compiled
+        ahead of time where the Linux half carries them (:func:`fmu_build.win64.aot_module`: under wine, with
+        mingw-w64's gcc and g++; numpy's loops, with a warning, where they cannot be compiled here), numba's with
+        ``win64_numba``, else numpy's.
     win64_numba : bool
         The win64 half carries numba too, and the loops compiled for an x86-64-v3 and a generic x86-64
         Windows CPU (under wine, here: :func:`fmu_build.win64.compile_kernels`, about three minutes each once per
@@ -346,6 +348,17 @@ def runtime_of(fmu) -> dict:
     return dict(line.split("=", 1) for line in text.splitlines() if "=" in line and not line.startswith("#"))
 
 
+def windows_loops(fmu, described: dict) -> str:
+    """Which loops the win64 half of ``fmu`` runs, in words: numba's, compiled ahead of time, or numpy's."""
+    if "numba" in described.get("win64_packages", ""):
+        return "numba's loops"
+    with zipfile.ZipFile(fmu) as archive:
+        windows = [name for name in archive.namelist() if name.startswith(("binaries/win64/", "binaries/x86_64-windows/"))]
+    if any(name.endswith(".pyd") and "slewing_kernels" in name for name in windows):
+        return "the loops compiled ahead of time"
+    return "numpy's loops"
+
+
 def describe_fmu(fmu) -> str:
     """One paragraph for the user: what the target machine needs to run ``fmu``."""
     r = runtime_of(fmu)
@@ -353,7 +366,7 @@ def describe_fmu(fmu) -> str:
     if r.get("runtime") == "standalone":
         windows = (f" Windows: 64-bit Windows 10 or 11 (8.1 with its Universal C Runtime update), nothing else (it carries Python {r['win64_version']} "
                    f"with {r['win64_packages'].replace(' ', ', ')} and the Visual C++ runtime; "
-                   f"{'numba' if 'numba' in r['win64_packages'] else 'numpy'}'s loops; "
+                   f"{windows_loops(fmu, r)}; "
                    "tested under wine, not on Windows)." if r.get("win64_version") else " No standalone Windows binary.")
         return (f"standalone FMU: it carries Python {r['version']} with {r['packages'].replace(' ', ', ')}; "
                 f"the target needs {floor}, and no Python.{windows}")

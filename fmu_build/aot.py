@@ -19,8 +19,9 @@ meanwhile (two test workers, two builds) waits and takes it from the cache. ``ma
 them first (the Makefile's ``COMPILE_LOOPS``: :func:`prepare_cache`).
 
 numba's ``pycc`` is pending deprecation ("replacement technology is being developed"); it is in
-the pinned numba 0.68.1 and gives the same numbers as numba's JIT, bit for bit, on the benchmark
-cases (docs/performance.md, "The FMU variants"). Linux only: the win64 half of an FMU runs numpy's loops.
+the pinned numba 0.68.1, and its modules give numba's JIT numbers on the benchmark cases (the generic
+module to the last bit, the x86-64-v3 one to 1e-9: docs/fmu/hosts.md). The win64 half's module is made
+from the same kernels by :func:`fmu_build.win64.aot_module` (pycc under wine, linked with mingw-w64).
 
 Run: .venv/bin/python -m fmu_build.aot [-o FOLDER] [--target x86-64-v3|generic]    (prints the modules' paths)
 """
