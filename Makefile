@@ -9,14 +9,15 @@ STAMP  := $(VENV)/.installed
 
 # Debian packages, each target its own (installed with apt-get when run as root, else named):
 #   the demo builds an FMU: gcc, libc6-dev, binutils compile its Linux binary (fmu_src/shim; readelf checks
-#   its glibc floor), gcc-mingw-w64-x86-64 cross-compiles its standalone Windows binary (fmu_build/win64.py)
+#   its glibc floor), gcc-mingw-w64-x86-64 cross-compiles its standalone Windows binary (fmu_build/win64.py),
+#   wine wine64 and g++-mingw-w64-x86-64 compile its Windows loops ahead of time (numba's pycc under wine,
+#   linked with mingw-w64's gcc and g++)
 #   the tests also use: libtbb12 (the ecos C++ co-simulation host), debootstrap (bare Debian systems without
 #   Python, where the standalone FMUs run), libxml2-dev libminizip-dev libsundials-dev zlib1g-dev (fmusim, built
-#   from ../shared/vendor: an independent FMI host), wine wine64 (the win64 binary in Windows hosts),
-#   calculix-ccx (the CalculiX reference tests)
-DEMO_PACKAGES := gcc libc6-dev binutils gcc-mingw-w64-x86-64
+#   from ../shared/vendor: an independent FMI host), calculix-ccx (the CalculiX reference tests)
+DEMO_PACKAGES := gcc libc6-dev binutils gcc-mingw-w64-x86-64 g++-mingw-w64-x86-64 wine wine64
 TEST_PACKAGES := $(DEMO_PACKAGES) libtbb12 debootstrap libxml2-dev libminizip-dev libsundials-dev zlib1g-dev \
-                 wine wine64 calculix-ccx
+                 calculix-ccx
 define debian_packages
 	@missing=$$(for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || echo $$p; done); \
@@ -41,11 +42,13 @@ demo: $(STAMP)
 	$(PY) examples/demo.py
 
 # the test files run on TEST_WORKERS processes (pytest-xdist), a file's tests on one of them (its module
-# fixtures built once). numba's loops are compiled first, once, into its cache, which the tests then load:
-# for this CPU and, side by side, for the CPUs build_fmu.py adds to the FMU (an x86-64-v3 one and any
-# x86-64: slewing_model/numerics/targets.py)
+# fixtures built once). The loops are compiled first, once, into their caches, which the tests then load:
+# numba's for this CPU and, side by side, for the CPUs build_fmu.py adds to the FMU (an x86-64-v3 one and any
+# x86-64: slewing_model/numerics/targets.py); the FMU's modules compiled ahead of time (fmu_build/aot.py,
+# the tests take them from the user's cache) and the win64 half's (fmu_build/win64.py, under wine)
 TEST_WORKERS ?= 2
-COMPILE_LOOPS := import build_fmu, fmu_build.aot; build_fmu.compiled_kernel_files(); fmu_build.aot.prepare_cache()
+COMPILE_LOOPS := import build_fmu, fmu_build.aot, fmu_build.win64; build_fmu.compiled_kernel_files(); \
+                 fmu_build.aot.prepare_cache(); fmu_build.win64.prepare_aot()
 
 test: $(STAMP)
 	$(call debian_packages,$(TEST_PACKAGES))

@@ -1,8 +1,9 @@
 """The same FMU on Linux and on win64 under wine: size of each half, instantiation, doStep.
 
 Two builds of the pitch bearing FMU (150 balls, fine superelement, free rings, FMI 2.0), each carrying
-both binaries (build_fmu.py's default, fmu_build/win64.py): the default (Linux half with numba; the win64
-half has no numba and runs numpy's loops) and ``--no-numba`` (both halves run numpy's loops). Each FMU
+both binaries (fmu_build/win64.py): the default (both halves run the loops compiled ahead of time),
+``--numba`` (the Linux half with numba; the win64 half runs numpy's loops) and ``--no-numba`` (both halves
+run numpy's loops). Each FMU
 is unpacked once and run by our C host (``tests/c_host/host.c``, scenario ``bench``): the Linux build with
 ``PATH=/usr/bin:/bin``, the mingw build under wine 8 (``WINEDEBUG=-all``); a fresh process per run, the
 Linux and the wine runs alternating so that both see the same machine load. A run is the pitch case of
@@ -46,7 +47,8 @@ RUNS = 3
 BASELINE = None
 INPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "psi", "omega")
 OUTPUTS = ("z", "rx", "ry", "friction_torque", "max_ball_load")
-VARIANTS = {"default (numba on Linux)": {"numba": True}, "--no-numba": {"numba": False}}
+VARIANTS = {"default (loops compiled ahead of time)": {}, "--numba (numba on Linux)": {"numba": True},
+            "--no-numba": {"numba": False}}
 WARM = 20
 
 
@@ -159,8 +161,10 @@ def main(args) -> None:
             record(f"{name} {platform} [ms]", s)
             against = s["median"] / np.median(np.concatenate(times[reference, platform]) * 1e3)
             variant = variants[name] or {}
-            rows.append([name, "Linux" if platform == "linux" else "win64 under wine", "numba" if
-                         variant.get("win64_numba" if platform == "win64" else "numba") else "numpy",
+            numba = variant.get("win64_numba" if platform == "win64" else "numba")
+            loops = "numba" if numba else "numpy" if numba is False or platform == "win64" and "numba" in variant \
+                else "ahead of time"
+            rows.append([name, "Linux" if platform == "linux" else "win64 under wine", loops,
                          f"{np.median(starts[name, platform]):.2f} s", f"{s['median']:.2f} ms",
                          f"{s['p95']:.2f} ms", f"{s['p99']:.2f} ms", f"{against:.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",

@@ -213,7 +213,7 @@ class SlewingBearing(Fmi2Slave):
     # A step is refused (do_step returns False) with the reason logged as Discard: pythonfmu
     # then returns fmi2Discard, and the FMU's Linux binary (fmu_src/shim) reports
     # fmi2Terminated = false. The state stays the one before the step (FMI 2.0, 4.2.3:
-    # the master may restore a state and retry, or go on with other inputs). What leaves
+    # the master retries the step from its start, with other inputs or after restoring a state). What leaves
     # the instance unable to continue is logged as Error, and the binary returns fmi2Error.
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self.simulator is None and not self._build_simulator():

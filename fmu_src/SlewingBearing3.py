@@ -135,7 +135,7 @@ class SlewingBearing3(Fmi3Slave):
 
     # A step is refused as by the FMI 2.0 slave: do_step returns False (fmi3Discard) with the
     # reason logged as Discard, and the state stays the one before the step, so the host may
-    # restore a state and retry or go on with other inputs; the same step refused twice (same
+    # retry the step from its start, with other inputs or after restoring a state; the same step refused twice (same
     # time, inputs and tunable parameters) cannot succeed and is logged as Error.
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self.simulator is None and not self._build_simulator():

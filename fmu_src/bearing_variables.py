@@ -254,7 +254,7 @@ def step_or_refuse(slave, current_time, discard, error, warning=None):
 
     A bad input or a load the bearing cannot carry refuses the step: logged with the status
     ``discard``, the simulator as before the step (it restores itself), so the master may
-    retry or go on with other inputs (FMI 2.0, 4.2.3). The same step refused again (same
+    retry the step from its start with other inputs (FMI 2.0, 4.2.3). The same step refused again (same
     time, inputs and tunable parameters: a master that retries unchanged) cannot succeed and
     is logged with ``error``, as is an internal error; no exception leaves (it would reach
     the host). ``slave._refused`` keeps the last refused step. A valid result the user must
