@@ -307,6 +307,39 @@ def test_fmusim_runs_the_standalone_fmu_every_time_and_exits_cleanly(release, ve
     assert_fmusim_runs_as_fmpy(bare_system(release), fmusim, standalone[version], FMUSIM_RUNS, rel=SAME_FMU)
 
 
+@pytest.mark.parametrize("version", [2, 3])
+def test_fmusim_saves_the_final_state_and_a_run_from_it_goes_on_as_one_run_does(version, fmusim, standalone,
+                                                                                 tmp_path):
+    # fmusim's --final-fmu-state-file serializes the state and hands fmi2FreeFMUstate the state itself, not its
+    # address; --initial-fmu-state-file restores it right after instantiation and steps without initializing:
+    # the layer must accept both, and the second half must be the single run's second half
+    t = np.round(np.arange(21) * H, 10)
+    rows = ["time," + ",".join(INPUTS)] + [f"{tk:.2f}," + ",".join(repr(x) for x in host_inputs(k))
+                                           for k, tk in enumerate(t)]
+    (tmp_path / "input.csv").write_text("\n".join(rows) + "\n")
+    outputs = sum((["--output-variable", n] for n in OUTPUTS), [])
+
+    def fmusim_run(name, start, stop, *state):
+        run = subprocess.run([str(fmusim), "--interface-type", "cs", "--start-time", str(start), "--stop-time",
+                              str(stop), "--output-interval", str(H), "--input-file", str(tmp_path / "input.csv"),
+                              *outputs, *state, "--output-file", str(tmp_path / name), str(standalone[version])],
+                             capture_output=True, text=True, timeout=600)
+        assert run.returncode == 0, f"{name}: exit {run.returncode}\n{run.stdout[-2000:]}{run.stderr[-2000:]}"
+        return np.genfromtxt(tmp_path / name, delimiter=",", names=True)
+
+    whole = fmusim_run("whole.csv", 0, 0.2)
+    fmusim_run("first.csv", 0, 0.1, "--final-fmu-state-file", str(tmp_path / "state.bin"))
+    assert (tmp_path / "state.bin").read_bytes()[:8] == b"SLWFMUST"      # the layer's header on the state
+    second = fmusim_run("second.csv", 0.1, 0.2, "--initial-fmu-state-file", str(tmp_path / "state.bin"))
+    tail = whole[-len(second):]
+    assert np.allclose(tail["time"], second["time"], rtol=0, atol=1e-12)
+    assert second["time"][0] == pytest.approx(0.1) and len(second) == 11
+    for name in OUTPUTS:  # fmusim writes 16 significant digits
+        assert second[name] == pytest.approx(tail[name], rel=SAME_FMU, abs=1e-300), name
+    # the inputs change every step: a restore that lost the state (started over) would differ at once
+    assert not np.allclose(whole["z"][:11], whole["z"][10:], rtol=1e-6)
+
+
 def glibc_of(system: Path) -> str:
     """The glibc version of a bare system (X.Y), as its ldd prints it."""
     have = re.search(r"GNU C Library[^\n]*?release version (\d+\.\d+)|ldd \(.*\) (\d+\.\d+)",

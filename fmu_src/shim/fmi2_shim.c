@@ -622,6 +622,14 @@ static ShimState *our_state(Instance *in, const char *function, fmi2FMUstate sta
     return s;
 }
 
+/* The state machine state an FMU state taken now returns the instance to (fmi2SetFMUstate): a state
+ * taken in StepFailed is the one before the refused step, one taken in Error the one before the Error */
+static int taken_in(const Instance *in)
+{
+    int state = in->state == ErrorState ? in->before_error : in->state;
+    return state == StepFailed ? StepComplete : state;
+}
+
 EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
 {
     CHECK("fmi2GetFMUstate", MASK_GetFMUstate);
@@ -640,6 +648,7 @@ EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
             inner.fmi2FreeFMUstate(IN->inner, &previous);
         old->inner = got;
         old->time = IN->time;
+        old->phase = taken_in(IN);
         return status;
     }
     ShimState *s = shim_state_add(&IN->states, got, IN->time);
@@ -647,6 +656,7 @@ EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
         inner.fmi2FreeFMUstate(IN->inner, &got);
         return refuse(IN, "fmi2GetFMUstate: out of memory");
     }
+    s->phase = taken_in(IN);
     *state = s;
     return status;
 }
@@ -657,14 +667,14 @@ EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
     ShimState *s = our_state(IN, "fmi2SetFMUstate", state);
     if (!s)
         return fmi2Error;
-    int to = IN->state == ErrorState ? IN->before_error : IN->state;
     fmi2Status status = FORWARD("fmi2SetFMUstate", fmi2SetFMUstate(IN->inner, s->inner));
     if (status <= fmi2Warning) {
         IN->time = s->time;
         IN->time_origin = TIME_STATE;
-        /* the master restarts from a stored state: out of StepFailed, and out of Error to the state the
-         * Error came in */
-        IN->state = to == StepFailed ? StepComplete : to;
+        /* the instance returns to the state machine state the FMU state was taken in, as the Reference
+         * FMUs' do (fmusim restores a running state right after fmi2Instantiate): a deserialized state
+         * is a running instance's (StepComplete); out of StepFailed and out of Error */
+        IN->state = s->phase ? s->phase : StepComplete;
     }
     return status;
 }
@@ -674,6 +684,22 @@ EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
     if (!c || !state || !*state)
         return fmi2OK;
     CHECK("fmi2FreeFMUstate", MASK_StateData);
+    /* fmusim (v0.0.39, --final-fmu-state-file) passes the state itself instead of its address: one of our
+     * states is recognised by its pointer alone (never read), freed, and the host told so (a Warning) */
+    ShimState *given = shim_state_lookup(IN->states, (const void *)state);
+    if (given) {
+        if (category_logged(IN, "logStatusWarning"))
+            host_log(IN, fmi2Warning, "logStatusWarning", "fmi2FreeFMUstate: given an FMU state instead of its "
+                     "address (an fmi2FMUstate*): that state is freed");
+        fmi2FMUstate inner_state = given->inner;
+        fmi2Status status = fmi2OK;
+        if (inner_state) {
+            begin(IN, "fmi2FreeFMUstate");
+            status = finish(IN, inner.fmi2FreeFMUstate(IN->inner, &inner_state), 0, 0);
+        }
+        shim_state_remove(&IN->states, given);
+        return status;
+    }
     ShimState *s = our_state(IN, "fmi2FreeFMUstate", *state);
     if (!s)
         return fmi2Error;
@@ -754,6 +780,7 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[
             inner.fmi2FreeFMUstate(IN->inner, &previous);
         old->inner = got;
         old->time = time;
+        old->phase = 0;     /* a deserialized state: a running instance's */
         return status;
     }
     ShimState *s = shim_state_add(&IN->states, got, time);

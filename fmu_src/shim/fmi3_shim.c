@@ -871,6 +871,7 @@ FMI3_Export fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUS
         inner.fmi3FreeFMUState(IN->inner, &taken);
         return refuse(IN, "%s: out of memory", fn);
     }
+    s->phase = IN->mode == M_ERROR ? IN->mode_before_error : IN->mode;
     *FMUState = s;
     return status;
 }
@@ -883,11 +884,12 @@ FMI3_Export fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUSt
     ShimState *s = own_state(IN, fn, FMUState);
     if (!s)
         return fmi3Error;
-    int mode = IN->mode == M_ERROR ? IN->mode_before_error : IN->mode;
     begin(IN);
     fmi3Status status = finish(IN, inner.fmi3SetFMUState(IN->inner, s->inner), 0);
     if (status <= fmi3Warning) {
-        IN->mode = mode;  /* out of Error: back where the error happened, at the state's time */
+        /* back to the mode the state was taken in, at its time, as the Reference FMUs do (fmusim restores a
+         * running state right after instantiation): a deserialized state is a running instance's (StepMode) */
+        IN->mode = s->phase ? s->phase : M_STEP;
         IN->time = s->time;
     }
     return status;
@@ -899,8 +901,15 @@ FMI3_Export fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMU
         return fmi3Error;
     if (!FMUState || !*FMUState)
         return fmi3OK;
-    ShimState *s = own_state(IN, "fmi3FreeFMUState", *FMUState);
-    if (!s)
+    /* fmusim (v0.0.39, --final-fmu-state-file) passes the state itself instead of its address: one of our
+     * states is recognised by its pointer alone (never read) and freed, the host told so (a Warning) */
+    ShimState *s = shim_state_lookup(IN->states, (const void *)FMUState);
+    int given_state = s != NULL;
+    if (given_state) {
+        if (IN->host_log && category_logged(IN, "logStatusWarning"))
+            IN->host_log(IN->host_environment, fmi3Warning, "logStatusWarning", "fmi3FreeFMUState: given an FMU "
+                         "state instead of its address (an fmi3FMUState*): that state is freed");
+    } else if (!(s = own_state(IN, "fmi3FreeFMUState", *FMUState)))
         return fmi3Error;
     fmi3FMUState taken = s->inner;
     begin(IN);
@@ -908,7 +917,8 @@ FMI3_Export fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMU
     fmi3Status status = inner.fmi3FreeFMUState(IN->inner, &taken);  /* a Py_DECREF: safe in a broken instance */
     IN->logged = fmi3OK;
     shim_state_remove(&IN->states, s);
-    *FMUState = NULL;
+    if (!given_state)
+        *FMUState = NULL;
     return status == fmi3OK ? fmi3OK : fmi3Error;
 }
 

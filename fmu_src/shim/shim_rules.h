@@ -65,7 +65,7 @@
  *   unsigned long shim_crc32(const unsigned char *bytes, size_t n);   the payload's checksum
  *
  * FMU state pointers handed to the host (each layer's own small struct, not the inner binary's):
- *   typedef struct ShimState { unsigned int magic; double time; void *inner; struct ShimState *next; } ShimState;
+ *   typedef struct ShimState { unsigned int magic; double time; int phase; void *inner; struct ShimState *next; } ShimState;
  *   ShimState *shim_state_add(ShimState **list, void *inner, double time);    NULL: out of memory
  *   ShimState *shim_state_lookup(ShimState *list, const void *pointer);      NULL: not one of ours
  *       (compares pointers only: never reads memory a foreign pointer points to)
@@ -506,6 +506,8 @@ static SHIM_UNUSED int shim_state_header_check(const unsigned char *bytes, size_
 typedef struct ShimState {
     unsigned int magic;
     double time;            /* the communication time the state was taken at */
+    int phase;              /* the layer's state machine state it was taken in (0: a deserialized state,
+                             * taken by a running instance); fmiSetFMUstate returns the instance to it */
     void *inner;            /* the inner binary's state */
     struct ShimState *next;
 } ShimState;
