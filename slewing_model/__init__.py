@@ -15,7 +15,7 @@ from .bearing.manufacturing import ManufacturingErrors, RingErrorMap, synthetic_
 from .distribution.bime import BimeSolver, LoadCapacityError, LoadDistribution, Loads, NoEquilibriumError, solve
 from .friction.torque import FrictionTorque, catalogue_torque, friction_torque
 
-__version__ = "1.0.0"
+__version__ = "1.1.0"
 
 #: the run-time part of the package (numpy and the standard library): the modules an FMU carries
 #: (paths below slewing_model/, without .py; build_fmu.py keeps each subpackage's folder). Not in it:
