@@ -611,6 +611,11 @@ def aot_cache_key() -> str:
     return f"{kernel_source_hash():016x}-numba{numba_version}-win_amd64-{AOT_TARGET}-{digest}"
 
 
+#: set to 1, :func:`aot_module` takes the win64 module from its cache only, else raises (the build then warns
+#: and the win64 half runs numpy's loops): for the tests, which do not compile it (tests/conftest.py)
+AOT_CACHED_ONLY = "SLEWING_WIN64_AOT_CACHED_ONLY"
+
+
 def aot_module(cache_dir=None) -> Path:
     """The loops (every entry of the kernels' ``KERNELS``, as :mod:`fmu_build.aot` exports them on Linux)
     compiled ahead of time into an extension module of the win64 Python 3.11
@@ -633,6 +638,10 @@ def aot_module(cache_dir=None) -> Path:
     from slewing_model.numerics.compiled import AOT_MODULES
 
     cached = Path(cache_dir or aot_cache_dir()) / aot_cache_key() / (AOT_MODULES[AOT_TARGET] + AOT_SUFFIX)
+    if not cached.exists() and os.environ.get(AOT_CACHED_ONLY) == "1":
+        raise RuntimeError(f"the win64 loops are not compiled yet in {cached.parent} and {AOT_CACHED_ONLY}=1 "
+                           "takes them from the cache only (python -c 'import fmu_build.win64 as w; w.prepare_aot()' "
+                           "compiles them, about 2.5 minutes once)")
     if not cached.exists():
         cached.parent.mkdir(parents=True, exist_ok=True)
         with open(cached.with_suffix(".lock"), "w") as lock:

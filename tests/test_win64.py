@@ -237,6 +237,10 @@ def test_the_win64_half_runs_the_loops_compiled_ahead_of_time(table3_aot_fmu, ho
 
     module = f"binaries/win64/python/Lib/site-packages/slewing_kernels{fmu_build.win64.AOT_SUFFIX}"
     with zipfile.ZipFile(table3_aot_fmu) as z:
+        if module not in z.namelist() and os.environ.get(fmu_build.win64.AOT_CACHED_ONLY) == "1":
+            pytest.skip("SKIPPED: the win64 loops are not compiled yet (about 2.5 minutes under wine, once per "
+                        "version of the loops, kept in the aot cache): run tests/win64/run_all.sh, or set "
+                        "SLEWING_BUILD_WIN64_AOT=1")
         assert module in z.namelist()
         (tmp_path / "module.pyd").write_bytes(z.read(module))
     objdump = shutil.which("x86_64-w64-mingw32-objdump")
