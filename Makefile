@@ -43,12 +43,13 @@ demo: $(STAMP)
 
 # the test files run on TEST_WORKERS processes (pytest-xdist), a file's tests on one of them (its module
 # fixtures built once). The loops are compiled first, once, into their caches, which the tests then load:
-# numba's for this CPU and, side by side, for the CPUs build_fmu.py adds to the FMU (an x86-64-v3 one and any
-# x86-64: slewing_model/numerics/targets.py) and the FMU's modules compiled ahead of time (fmu_build/aot.py,
-# the tests take them from the user's cache). The win64 half's module (fmu_build/win64.py, under wine, 2.5
+# numba's for this CPU and the FMU's modules compiled ahead of time (fmu_build/aot.py, the tests take them
+# from the user's cache). The --numba FMU's tests, which compile numba's loops for two more CPUs, are opt-in
+# (SLEWING_TEST_NUMBA_FMU=1). The win64 half's module (fmu_build/win64.py, under wine, 2.5
 # minutes) is taken from that cache only: tests/win64/run_all.sh compiles it and runs the win64 tests in full
 TEST_WORKERS ?= 2
-COMPILE_LOOPS := import build_fmu, fmu_build.aot; build_fmu.compiled_kernel_files(); fmu_build.aot.prepare_cache()
+COMPILE_LOOPS := from slewing_model.friction import kernel; import fmu_build.aot; kernel.compile_all(); \
+                 fmu_build.aot.prepare_cache()
 
 test: $(STAMP)
 	$(call debian_packages,$(TEST_PACKAGES))

@@ -246,8 +246,9 @@ def test_another_python_named_by_the_variable_runs_the_fmu(c_host, host_fmu_dir,
     assert code == 1 and "fmi2Instantiate" in err  # the Python named by the FMU is gone
     code, values, _, _, err = run_host(c_host, (moved, guid, vrs), "basic", env={"SLEWING_FMU_PYTHONHOME": str(venv)})
     assert code == 0, err
-    for k in range(6):
-        assert_close(values["run"][k], reference[1.0][k])
+    for k in range(6):  # the host FMU runs the loops compiled ahead of time (x86-64-v3: fused multiply-adds), the
+        # reference numpy's: the two agree to about 1e-10, within the solver's tolerance
+        assert_close(values["run"][k], reference[1.0][k], rel=1e-9)
 
 
 def test_a_missing_python_gets_a_message_instead_of_a_crash(c_host, host_fmu_dir, tmp_path):
