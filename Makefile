@@ -31,10 +31,21 @@ define debian_packages
 	fi
 endef
 
+# ROSCO, NREL's reference wind turbine controller (slewing_turbine: the turbine loop), for its compiled library
+# libdiscon.so only: installed without its dependencies, which pull WISDEM and 1.4 GB that the loop never
+# imports; ROSCO needs Python 3.11 or newer (with 3.10 the turbine loop and its tests are left out, saying so)
+ROSCO := rosco==2.10.6
+define rosco
+	@if $(PY) -c 'import sys; sys.exit(sys.version_info < (3, 11))'; then \
+	  $(PY) -m pip install --quiet --no-deps $(ROSCO); \
+	else echo "note: $(ROSCO) needs Python 3.11 or newer: the turbine loop is left out"; fi
+endef
+
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[all]"
+	$(call rosco)
 	touch $(STAMP)
 
 demo: $(STAMP)

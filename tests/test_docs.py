@@ -21,7 +21,7 @@ SHARED = ROOT.parent / "shared"
 PAGES = sorted([ROOT / "README.md", ROOT / "CHANGELOG.md"]
                + [p for p in DOCS.rglob("*.md") if "_build" not in p.parts])
 #: top-level folders and files whose paths a page may name in backticks
-TOP = ("examples", "docs", "slewing_model", "slewing_drives", "tests", "benchmarks", "references", "fmu_src",
+TOP = ("examples", "docs", "slewing_model", "slewing_drives", "slewing_turbine", "tests", "benchmarks", "references", "fmu_src",
        "fmu_build", "build_fmu.py", "pyproject.toml", "Makefile", "LICENSE", "CHANGELOG.md", "README.md")
 #: outputs of commands, not files of the repository
 OUTPUTS = ("results/", "build/", "docs/_build")
@@ -138,7 +138,7 @@ def test_every_validation_page_has_its_figure_its_table_and_their_command(page):
 def test_the_repository_root_holds_what_the_design_names():
     tracked = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
     top = {line.split("/")[0] for line in tracked.splitlines()}
-    allowed = {"pyproject.toml", "fmu_src", "slewing_model", "slewing_drives", "build_fmu.py", "fmu_build", "tests",
+    allowed = {"pyproject.toml", "fmu_src", "slewing_model", "slewing_drives", "slewing_turbine", "build_fmu.py", "fmu_build", "tests",
                "examples", "benchmarks", "references", "docs", "README.md", "LICENSE", "CHANGELOG.md", "Makefile",
                ".gitignore", ".ci"}
     assert top <= allowed, sorted(top - allowed)
