@@ -22,8 +22,8 @@ checked by their SHA-256:
   them (``build_fmu.py --aot``, the default): ``slewing_kernels.cp311-win_amd64.pyd`` in the runtime's
   ``Lib/site-packages``, for any x86-64 CPU, needing numpy only. numba's pycc runs on a Windows CPython
   with numba and llvmlite's Windows wheels under wine up to the LLVM object file; mingw-w64 compiles
-  pycc's C part and links the module on Linux. Made once per version of the loops (about seven minutes
-  here), cached; where it cannot be made (no wine, no ``g++-mingw-w64-x86-64``), a warning and numpy's
+  pycc's C part and links the module on Linux. Made once per version of the loops (about 2.5 minutes
+  on a quiet 2-core machine, up to seven on a busy one), cached; where it cannot be made (no wine, no ``g++-mingw-w64-x86-64``), a warning and numpy's
   loops. With a Linux half of numpy's loops or numba's JIT, the win64 half runs numpy's loops.
 * **numba and llvmlite's Windows wheels**, only for ``build_fmu.py --win64-numba`` (:func:`compile_kernels`):
   the loops are then compiled once under wine, for an x86-64-v3 CPU and for any x86-64 CPU
@@ -621,7 +621,7 @@ def aot_module(cache_dir=None) -> Path:
     compiled ahead of time into an extension module of the win64 Python 3.11
     (``slewing_kernels.cp311-win_amd64.pyd``, for any x86-64 CPU): it needs numpy only. Made once per
     version of the loops, kept beside the Linux modules (``fmu_build.aot.aot_cache_dir``, ``<key>/``; about
-    seven minutes under wine on two busy CPUs, one process at a time):
+    2.5 minutes under wine on a quiet 2-core machine, up to seven when it is busy; one process at a time):
 
     1. numba's pycc on the build-time Windows Python (:func:`build_python`, numba and llvmlite's Windows
        wheels) under wine writes the loops' LLVM object file (:data:`_AOT_OBJECTS`);

@@ -2,7 +2,7 @@
 # The win64 tests in full (tests/test_win64.py): 5 runs per FMU and host, fmusim for mingw built first (about
 # 5 minutes the first time, kept in /var/cache/slewing-wine), and the loops of --win64-numba compiled under
 # wine (about 5 minutes the first time per version of the loops, kept in /var/cache/slewing-wine/build), and
-# the default build's loops compiled ahead of time for win64 (fmu_build/win64.py's aot_module: about 7 minutes
+# the default build's loops compiled ahead of time for win64 (fmu_build/win64.py's aot_module: about 2.5 minutes
 # the first time per version of the loops, kept beside the Linux modules in the aot cache). As root, after
 # `make .venv/.installed`; about 10 minutes on 2 cores with all built.
 #   bash tests/win64/run_all.sh [pytest options]
