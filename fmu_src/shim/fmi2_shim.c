@@ -48,7 +48,6 @@
 #include "shim_rules.h"
 
 #include <limits.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -210,9 +209,7 @@ typedef struct {
     fmi2CallbackFunctions mine;        /* given to pythonfmu: our logger, this instance as environment */
     char *name;
     char *guid;                        /* the token in a serialized state's header */
-    int logging_on;
-    size_t n_categories;
-    char **categories;
+    ShimLog log;                       /* to the host's logger: loggingOn, fmi2SetDebugLogging's categories */
     const char *function;              /* the fmi2 function being called */
     fmi2Status logged;                 /* worst status the slave logged during the current call */
     int python_exception;              /* pythonfmu reported a Python exception during the current call */
@@ -225,33 +222,11 @@ typedef struct {
     ShimState *states;                 /* the FMU states handed to the host */
 } Instance;
 
-static void free_categories(Instance *in)
-{
-    for (size_t i = 0; i < in->n_categories; i++)
-        free(in->categories[i]);
-    free(in->categories);
-    in->categories = NULL;
-    in->n_categories = 0;
-}
-
-static int category_logged(const Instance *in, fmi2String category)
-{
-    if (!in->logging_on)
-        return 0;
-    if (in->n_categories == 0)
-        return 1;
-    for (size_t i = 0; i < in->n_categories; i++)
-        if (category && !strcmp(category, in->categories[i]))
-            return 1;
-    return 0;
-}
-
-/* Pass a message to the host's logger: the message is plain text (pythonfmu formats nothing),
+/* The instance's log sink (shim_rules.h): the message is plain text (pythonfmu formats nothing),
  * and the host's logger takes a format string, so '%' is doubled. */
-static void host_log(const Instance *in, fmi2Status status, fmi2String category, const char *text)
+static void log_sink(void *layer, int status, const char *category, const char *text)
 {
-    if (!in->host.logger)
-        return;
+    const Instance *in = (const Instance *)layer;
     size_t n = strlen(text), extra = 0;
     for (size_t i = 0; i < n; i++)
         extra += text[i] == '%';
@@ -265,7 +240,7 @@ static void host_log(const Instance *in, fmi2Status status, fmi2String category,
             *q++ = '%';
     }
     *q = '\0';
-    in->host.logger(in->host.componentEnvironment, in->name, status, category, escaped);
+    in->host.logger(in->host.componentEnvironment, in->name, (fmi2Status)status, category, escaped);
     free(escaped);
 }
 
@@ -287,7 +262,7 @@ static void shim_logger(fmi2ComponentEnvironment environment, fmi2String instanc
                         message + strlen(PYTHON_EXCEPTION));
             if (status > in->logged)
                 in->logged = fmi2Error;
-            host_log(in, fmi2Error, "logStatusError", text);
+            shim_log_text(&in->log, fmi2Error, "logStatusError", text);
             free(text);
             return;
         }
@@ -295,27 +270,11 @@ static void shim_logger(fmi2ComponentEnvironment environment, fmi2String instanc
     }
     if (status > in->logged && status != fmi2Pending)
         in->logged = status;
-    if (status >= fmi2Error || category_logged(in, category))
-        host_log(in, status, category, message);
+    shim_log_text(&in->log, status, category, message);
 }
 
-/* A call refused by this layer: logged as an Error, not forwarded, nothing changed. */
-static fmi2Status refuse(Instance *in, const char *format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static fmi2Status refuse(Instance *in, const char *format, ...)
-{
-    char text[1024];
-    va_list ap;
-    va_start(ap, format);
-    vsnprintf(text, sizeof text, format, ap);
-    va_end(ap);
-    text[sizeof text - 1] = '\0';
-    host_log(in, fmi2Error, "logStatusError", text);
-    return fmi2Error;
-}
+/* A call refused by this layer: logged as an Error, not forwarded, nothing changed: fmi2Error. */
+#define refuse(in, ...) ((fmi2Status)shim_refuse(&(in)->log, __VA_ARGS__))
 
 static void state_list(int mask, char *buf, size_t size)
 {
@@ -387,6 +346,22 @@ static fmi2Status finish(Instance *in, fmi2Status status, int discard_allowed, i
     } while (0)
 #define FORWARD(function, call) (begin(IN, function), finish(IN, inner.call, 0, 1))
 
+/* The end of a life-cycle call: where it succeeded (status OK or Warning) the instance is in state next
+ * (0: the state it is in) and, where start is given, the experiment starts at *start: the
+ * currentCommunicationPoint the first fmi2DoStep must give. Returns status. */
+static fmi2Status moved(Instance *in, fmi2Status status, int next, const double *start)
+{
+    if (status <= fmi2Warning) {
+        if (next)
+            in->state = next;
+        if (start) {
+            in->start_time = in->time = *start;
+            in->time_origin = TIME_START;
+        }
+    }
+    return status;
+}
+
 /* Value references of the type (NULL-safe): 0, or fmi2Error logged naming the first unknown one */
 static int check_references(Instance *in, const char *function, const char *type, const fmi2ValueReference vr[],
                             size_t nvr, const void *value, int set)
@@ -429,7 +404,7 @@ static void instantiate_error(const fmi2CallbackFunctions *functions, fmi2String
 
 static void free_instance(Instance *in)
 {
-    free_categories(in);
+    shim_log_free(&in->log);
     shim_variables_free(&in->variables);
     while (in->states) {
         ShimState *s = in->states;
@@ -477,7 +452,9 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     in->mine = *functions;
     in->mine.logger = shim_logger;
     in->mine.componentEnvironment = in;
-    in->logging_on = loggingOn;
+    in->log.sink = in->host.logger ? log_sink : NULL;
+    in->log.layer = in;
+    in->log.on = loggingOn;
     begin(in, "fmi2Instantiate");
     /* pythonfmu always logs to us; we filter */
     in->inner = inner.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation, &in->mine, visible, 1);
@@ -513,22 +490,8 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, si
         return fmi2Error;
     if (nCategories > 0 && !categories)
         return refuse(IN, "fmi2SetDebugLogging: categories is NULL with nCategories = %lu", (unsigned long)nCategories);
-    char **copy = NULL;
-    if (nCategories > 0) {
-        if (!(copy = calloc(nCategories, sizeof(char *))))
-            return refuse(IN, "fmi2SetDebugLogging: out of memory");
-        for (size_t i = 0; i < nCategories; i++)
-            if (!(copy[i] = strdup(categories[i] ? categories[i] : ""))) {
-                for (size_t j = 0; j < i; j++)
-                    free(copy[j]);
-                free(copy);
-                return refuse(IN, "fmi2SetDebugLogging: out of memory");
-            }
-    }
-    free_categories(IN);
-    IN->logging_on = loggingOn;
-    IN->categories = copy;
-    IN->n_categories = copy ? nCategories : 0;
+    if (shim_log_set(&IN->log, loggingOn, nCategories, categories) != 0)
+        return refuse(IN, "fmi2SetDebugLogging: out of memory");
     return fmi2OK;
 }
 
@@ -542,56 +505,24 @@ EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefi
     if (stopTimeDefined && !(stopTime >= startTime))
         return refuse(IN, "fmi2SetupExperiment: stopTime = %s is before startTime = %s", shim_double(a, stopTime),
                       shim_double(b, startTime));
-    fmi2Status status = FORWARD("fmi2SetupExperiment", fmi2SetupExperiment(IN->inner, toleranceDefined, tolerance,
-                                                                           startTime, stopTimeDefined, stopTime));
-    if (status <= fmi2Warning) {
-        IN->start_time = IN->time = startTime;
-        IN->time_origin = TIME_START;
+    return moved(IN, FORWARD("fmi2SetupExperiment", fmi2SetupExperiment(IN->inner, toleranceDefined, tolerance,
+                                                                         startTime, stopTimeDefined, stopTime)),
+                 0, &startTime);
+}
+
+/* The life-cycle calls without arguments: checked, forwarded, and where pythonfmu's call succeeds the
+ * instance moves to `next`, with the experiment starting at *start where start is given */
+#define LIFE_CYCLE(Name, next, start)                                                  \
+    EXPORT fmi2Status fmi2##Name(fmi2Component c)                                      \
+    {                                                                                  \
+        CHECK("fmi2" #Name, MASK_##Name);                                              \
+        return moved(IN, FORWARD("fmi2" #Name, fmi2##Name(IN->inner)), next, start);  \
     }
-    return status;
-}
-
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c)
-{
-    CHECK("fmi2EnterInitializationMode", MASK_EnterInitializationMode);
-    fmi2Status status = FORWARD("fmi2EnterInitializationMode", fmi2EnterInitializationMode(IN->inner));
-    if (status <= fmi2Warning)
-        IN->state = InitializationMode;
-    return status;
-}
-
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c)
-{
-    CHECK("fmi2ExitInitializationMode", MASK_ExitInitializationMode);
-    fmi2Status status = FORWARD("fmi2ExitInitializationMode", fmi2ExitInitializationMode(IN->inner));
-    if (status <= fmi2Warning) {
-        IN->state = StepComplete;
-        IN->time = IN->start_time;
-        IN->time_origin = TIME_START;
-    }
-    return status;
-}
-
-EXPORT fmi2Status fmi2Terminate(fmi2Component c)
-{
-    CHECK("fmi2Terminate", MASK_Terminate);
-    fmi2Status status = FORWARD("fmi2Terminate", fmi2Terminate(IN->inner));
-    if (status <= fmi2Warning)
-        IN->state = Terminated;
-    return status;
-}
-
-EXPORT fmi2Status fmi2Reset(fmi2Component c)
-{
-    CHECK("fmi2Reset", MASK_Reset);
-    fmi2Status status = FORWARD("fmi2Reset", fmi2Reset(IN->inner));
-    if (status <= fmi2Warning) {
-        IN->state = Instantiated;
-        IN->start_time = IN->time = 0.0;
-        IN->time_origin = TIME_START;
-    }
-    return status;
-}
+static const double DEFAULT_START_TIME = 0.0;  /* fmi2Reset's: as before fmi2SetupExperiment */
+LIFE_CYCLE(EnterInitializationMode, InitializationMode, NULL)
+LIFE_CYCLE(ExitInitializationMode, StepComplete, &IN->start_time)
+LIFE_CYCLE(Terminate, Terminated, NULL)
+LIFE_CYCLE(Reset, Instantiated, &DEFAULT_START_TIME)
 
 #define GET_SET(Kind, type_name, value_type, set)                                                                  \
     EXPORT fmi2Status fmi2##Kind(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, value_type value[])  \
@@ -630,6 +561,27 @@ static int taken_in(const Instance *in)
     return state == StepFailed ? StepComplete : state;
 }
 
+/* Hands pythonfmu's state got (taken at time, in the state machine state phase) to the host: in old, one of
+ * the instance's states the host gave (updated: its previous pythonfmu state freed), else in a new one
+ * written to *state. Returns status, or fmi2Error logged where out of memory. */
+static fmi2Status hand_over(Instance *in, const char *function, fmi2Status status, fmi2FMUstate got, double time,
+                            int phase, ShimState *old, fmi2FMUstate *state)
+{
+    if (old) {
+        fmi2FMUstate previous = old->inner;
+        if (previous)
+            inner.fmi2FreeFMUstate(in->inner, &previous);
+        old->inner = got;
+    } else if (!(old = shim_state_add(&in->states, got, time))) {
+        inner.fmi2FreeFMUstate(in->inner, &got);
+        return refuse(in, "%s: out of memory", function);
+    }
+    old->time = time;
+    old->phase = phase;
+    *state = old;
+    return status;
+}
+
 EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
 {
     CHECK("fmi2GetFMUstate", MASK_GetFMUstate);
@@ -642,23 +594,7 @@ EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
     fmi2Status status = FORWARD("fmi2GetFMUstate", fmi2GetFMUstate(IN->inner, &got));
     if (status > fmi2Warning)
         return status;
-    if (old) {
-        fmi2FMUstate previous = old->inner;
-        if (previous)
-            inner.fmi2FreeFMUstate(IN->inner, &previous);
-        old->inner = got;
-        old->time = IN->time;
-        old->phase = taken_in(IN);
-        return status;
-    }
-    ShimState *s = shim_state_add(&IN->states, got, IN->time);
-    if (!s) {
-        inner.fmi2FreeFMUstate(IN->inner, &got);
-        return refuse(IN, "fmi2GetFMUstate: out of memory");
-    }
-    s->phase = taken_in(IN);
-    *state = s;
-    return status;
+    return hand_over(IN, "fmi2GetFMUstate", status, got, IN->time, taken_in(IN), old, state);
 }
 
 EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
@@ -686,22 +622,12 @@ EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
     CHECK("fmi2FreeFMUstate", MASK_StateData);
     /* fmusim (v0.0.39, --final-fmu-state-file) passes the state itself instead of its address: one of our
      * states is recognised by its pointer alone (never read), freed, and the host told so (a Warning) */
-    ShimState *given = shim_state_lookup(IN->states, (const void *)state);
-    if (given) {
-        if (category_logged(IN, "logStatusWarning"))
-            host_log(IN, fmi2Warning, "logStatusWarning", "fmi2FreeFMUstate: given an FMU state instead of its "
-                     "address (an fmi2FMUstate*): that state is freed");
-        fmi2FMUstate inner_state = given->inner;
-        fmi2Status status = fmi2OK;
-        if (inner_state) {
-            begin(IN, "fmi2FreeFMUstate");
-            status = finish(IN, inner.fmi2FreeFMUstate(IN->inner, &inner_state), 0, 0);
-        }
-        shim_state_remove(&IN->states, given);
-        return status;
-    }
-    ShimState *s = our_state(IN, "fmi2FreeFMUstate", *state);
-    if (!s)
+    ShimState *s = shim_state_lookup(IN->states, (const void *)state);
+    int given_state = s != NULL;
+    if (given_state)
+        shim_log_text(&IN->log, fmi2Warning, "logStatusWarning", "fmi2FreeFMUstate: given an FMU state instead of its "
+                      "address (an fmi2FMUstate*): that state is freed");
+    else if (!(s = our_state(IN, "fmi2FreeFMUstate", *state)))
         return fmi2Error;
     fmi2FMUstate inner_state = s->inner;
     fmi2Status status = fmi2OK;
@@ -710,7 +636,8 @@ EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
         status = finish(IN, inner.fmi2FreeFMUstate(IN->inner, &inner_state), 0, 0);
     }
     shim_state_remove(&IN->states, s);
-    *state = NULL;
+    if (!given_state)
+        *state = NULL;
     return status;
 }
 
@@ -774,22 +701,7 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[
     fmi2Status status = finish(IN, inner.fmi2DeSerializeFMUstate(IN->inner, (const fmi2Byte *)payload, n, &got), 0, 0);
     if (status > fmi2Warning)
         return status;
-    if (old) {
-        fmi2FMUstate previous = old->inner;
-        if (previous)
-            inner.fmi2FreeFMUstate(IN->inner, &previous);
-        old->inner = got;
-        old->time = time;
-        old->phase = 0;     /* a deserialized state: a running instance's */
-        return status;
-    }
-    ShimState *s = shim_state_add(&IN->states, got, time);
-    if (!s) {
-        inner.fmi2FreeFMUstate(IN->inner, &got);
-        return refuse(IN, "fmi2DeSerializeFMUstate: out of memory");
-    }
-    *state = s;
-    return status;
+    return hand_over(IN, "fmi2DeSerializeFMUstate", status, got, time, 0, old, state);  /* 0: a running instance's */
 }
 
 EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,

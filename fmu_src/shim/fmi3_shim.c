@@ -60,7 +60,6 @@
 #include "shim_rules.h"
 
 #include <limits.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -200,9 +199,7 @@ typedef struct {
     fmi3LogMessageCallback host_log;
     char *name;
     char *token;                       /* instantiationToken: in every serialized state's header */
-    int logging_on;
-    size_t n_categories;
-    char **categories;
+    ShimLog log;                       /* to the host's logMessage: loggingOn, fmi3SetDebugLogging's categories */
     ShimVariables variables;           /* resources/fmi_variables.tsv */
     int structural, tunable_structural;
     double time;                       /* where the next step must start */
@@ -210,25 +207,11 @@ typedef struct {
     ShimState *states;                 /* FMU states handed to the host, not yet freed */
 } Instance;
 
-static void free_categories(Instance *in)
+/* The instance's log sink (shim_rules.h) */
+static void log_sink(void *layer, int status, const char *category, const char *text)
 {
-    for (size_t i = 0; i < in->n_categories; i++)
-        free(in->categories[i]);
-    free(in->categories);
-    in->categories = NULL;
-    in->n_categories = 0;
-}
-
-static int category_logged(const Instance *in, fmi3String category)
-{
-    if (!in->logging_on)
-        return 0;
-    if (in->n_categories == 0)
-        return 1;
-    for (size_t i = 0; i < in->n_categories; i++)
-        if (category && !strcmp(category, in->categories[i]))
-            return 1;
-    return 0;
+    const Instance *in = (const Instance *)layer;
+    in->host_log(in->host_environment, (fmi3Status)status, category ? category : "", text);
 }
 
 /* pythonfmu3's messages come here (its logger's environment is our instance) */
@@ -246,32 +229,14 @@ static void shim_log(fmi3InstanceEnvironment environment, fmi3Status status, fmi
             message += strlen(prefix);
         char text[4096];
         shim_format(text, sizeof text, "%s: the model's Python code failed: %s", in->call ? in->call : "fmi3", message);
-        if (in->host_log)
-            in->host_log(in->host_environment, fmi3Error, "logStatusError", text);
+        shim_log_text(&in->log, fmi3Error, "logStatusError", text);
         return;
     }
-    if (in->host_log && (status >= fmi3Error || category_logged(in, category)))
-        in->host_log(in->host_environment, status, category ? category : "", message);
+    shim_log_text(&in->log, status, category, message);
 }
 
 /* A caller's mistake: one Error line in the host's log; returns fmi3Error, changes nothing. */
-static fmi3Status refuse(const Instance *in, const char *format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static fmi3Status refuse(const Instance *in, const char *format, ...)
-{
-    char text[1024];
-    va_list ap;
-    va_start(ap, format);
-    vsnprintf(text, sizeof text, format, ap);
-    va_end(ap);
-    text[sizeof text - 1] = '\0';
-    if (in && in->host_log)
-        in->host_log(in->host_environment, fmi3Error, "logStatusError", text);
-    return fmi3Error;
-}
+#define refuse(in, ...) ((fmi3Status)shim_refuse(&(in)->log, __VA_ARGS__))
 
 static void enter_error(Instance *in)
 {
@@ -694,16 +659,8 @@ FMI3_Export fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean lo
         return fmi3Error;
     if (nCategories > 0 && !categories)
         return refuse(IN, "fmi3SetDebugLogging: categories is NULL, nCategories = %lu", (unsigned long)nCategories);
-    free_categories(IN);
-    IN->logging_on = loggingOn;
-    if (nCategories > 0) {
-        IN->categories = (char **)calloc(nCategories, sizeof(char *));
-        if (!IN->categories)
-            return refuse(IN, "fmi3SetDebugLogging: out of memory");
-        for (size_t i = 0; i < nCategories; i++)
-            IN->categories[i] = strdup(categories[i] ? categories[i] : "");
-        IN->n_categories = nCategories;
-    }
+    if (shim_log_set(&IN->log, loggingOn, nCategories, categories) != 0)
+        return refuse(IN, "fmi3SetDebugLogging: out of memory");
     return fmi3OK;  /* pythonfmu3 logs everything to this layer, which filters */
 }
 
@@ -906,9 +863,8 @@ FMI3_Export fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMU
     ShimState *s = shim_state_lookup(IN->states, (const void *)FMUState);
     int given_state = s != NULL;
     if (given_state) {
-        if (IN->host_log && category_logged(IN, "logStatusWarning"))
-            IN->host_log(IN->host_environment, fmi3Warning, "logStatusWarning", "fmi3FreeFMUState: given an FMU "
-                         "state instead of its address (an fmi3FMUState*): that state is freed");
+        shim_log_text(&IN->log, fmi3Warning, "logStatusWarning", "fmi3FreeFMUState: given an FMU state instead of "
+                      "its address (an fmi3FMUState*): that state is freed");
     } else if (!(s = own_state(IN, "fmi3FreeFMUState", *FMUState)))
         return fmi3Error;
     fmi3FMUState taken = s->inner;
@@ -1023,7 +979,7 @@ static void free_instance(Instance *in)
     if (!in)
         return;
     shim_variables_free(&in->variables);
-    free_categories(in);
+    shim_log_free(&in->log);
     free(in->name);
     free(in->token);
     free(in);
@@ -1073,7 +1029,9 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
     in->token = strdup(instantiationToken ? instantiationToken : "");
     in->host_environment = instanceEnvironment;
     in->host_log = logMessage;
-    in->logging_on = loggingOn;
+    in->log.sink = logMessage ? log_sink : NULL;
+    in->log.layer = in;
+    in->log.on = loggingOn;
     in->mode = M_INSTANTIATED;
     if (!in->name || !in->token) {
         report(instanceEnvironment, logMessage, "fmi3InstantiateCoSimulation: out of memory");

@@ -1,6 +1,7 @@
 /* What the FMI 2.0 and FMI 3.0 layers (fmi2_shim.c, fmi3_shim.c) share to enforce the standard:
  * the FMU's table of variables, the header of a serialized FMU state, the tracking of state
- * pointers, the step-time tolerance and message formatting. Header only (every function is
+ * pointers, the step-time tolerance, message formatting and the host's log (which messages pass,
+ * a refused call's Error line). Header only (every function is
  * static), plain C types only (no FMI types), Linux (gcc) and Windows (mingw-w64) alike: include
  * it after shim_platform.h.
  *
@@ -79,6 +80,26 @@
  *       "1e-05"): enough to tell apart two times shim_same_time tells apart.
  *   void shim_format(char *buf, size_t size, const char *format, ...);
  *       snprintf that always terminates (truncates). Use %u/%lu/%s/%g, not %zu (old msvcrt).
+ *
+ * The host's log (what both layers pass on, and how; each layer calls its host's logger in a sink):
+ *   typedef void (*ShimLogSink)(void *layer, int status, const char *category, const char *text);
+ *       The layer's call of its host's logger (FMI 2.0's and 3.0's differ): status is the layer's
+ *       fmi2Status / fmi3Status (OK 0, Warning 1, Discard 2, Error 3, Fatal 4 in both), text plain text.
+ *   typedef struct { ShimLogSink sink; void *layer; int on; size_t n_categories; char **categories; } ShimLog;
+ *       sink NULL: the host gave no logger; layer: the sink's first argument; on: loggingOn;
+ *       categories: fmiXSetDebugLogging's (none: every category).
+ *   int shim_log_wanted(const ShimLog *log, int status, const char *category);
+ *       1 where a message goes to the host: an Error or worse always, another one where logging is on
+ *       and its category is one of the categories (or none were given).
+ *   int shim_log_set(ShimLog *log, int on, size_t n, const char *const categories[]);
+ *       fmiXSetDebugLogging's loggingOn and categories (copied; a NULL category is ""). 0, or -1 out
+ *       of memory, the log unchanged.
+ *   void shim_log_free(ShimLog *log);                                     frees the categories
+ *   void shim_log_text(const ShimLog *log, int status, const char *category, const char *text);
+ *       Passes text to the sink where shim_log_wanted.
+ *   int shim_refuse(const ShimLog *log, const char *format, ...);
+ *       A call refused by the layer: the formatted message (at most 1023 characters) as one Error
+ *       line of category "logStatusError". Returns SHIM_LOG_ERROR (fmi2Error, fmi3Error).
  */
 #ifndef SLEWING_SHIM_RULES_H
 #define SLEWING_SHIM_RULES_H
@@ -127,6 +148,89 @@ static SHIM_UNUSED int shim_same_time(double expected, double got)
     if (gap < 0)
         gap = -gap;
     return gap <= 1e-9 * scale + 1e-12;  /* false for NaN */
+}
+
+/* ---- the host's log ------------------------------------------------------------------------ */
+#define SHIM_LOG_ERROR 3  /* fmi2Error, fmi3Error */
+
+typedef void (*ShimLogSink)(void *layer, int status, const char *category, const char *text);
+
+typedef struct {
+    ShimLogSink sink;      /* NULL: the host gave no logger */
+    void *layer;           /* the sink's first argument: the layer's instance */
+    int on;                /* loggingOn */
+    size_t n_categories;   /* 0: every category */
+    char **categories;
+} ShimLog;
+
+static SHIM_UNUSED int shim_log_wanted(const ShimLog *log, int status, const char *category)
+{
+    if (status >= SHIM_LOG_ERROR)
+        return 1;
+    if (!log->on)
+        return 0;
+    if (log->n_categories == 0)
+        return 1;
+    for (size_t i = 0; i < log->n_categories; i++)
+        if (category && !strcmp(category, log->categories[i]))
+            return 1;
+    return 0;
+}
+
+static void shim_log_free(ShimLog *log)
+{
+    for (size_t i = 0; i < log->n_categories; i++)
+        free(log->categories[i]);
+    free(log->categories);
+    log->categories = NULL;
+    log->n_categories = 0;
+}
+
+static SHIM_UNUSED int shim_log_set(ShimLog *log, int on, size_t n, const char *const categories[])
+{
+    char **copy = NULL;
+    if (n > 0) {
+        if (!(copy = (char **)calloc(n, sizeof(char *))))
+            return -1;
+        for (size_t i = 0; i < n; i++) {
+            const char *category = categories[i] ? categories[i] : "";
+            if (!(copy[i] = (char *)malloc(strlen(category) + 1))) {
+                for (size_t j = 0; j < i; j++)
+                    free(copy[j]);
+                free(copy);
+                return -1;
+            }
+            strcpy(copy[i], category);
+        }
+    }
+    shim_log_free(log);
+    log->on = on;
+    log->categories = copy;
+    log->n_categories = copy ? n : 0;
+    return 0;
+}
+
+static SHIM_UNUSED void shim_log_text(const ShimLog *log, int status, const char *category, const char *text)
+{
+    if (log->sink && shim_log_wanted(log, status, category))
+        log->sink(log->layer, status, category, text);
+}
+
+static int shim_refuse(const ShimLog *log, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3), unused))
+#endif
+    ;
+static int shim_refuse(const ShimLog *log, const char *format, ...)
+{
+    char text[1024];
+    va_list ap;
+    va_start(ap, format);
+    vsnprintf(text, sizeof text, format, ap);
+    va_end(ap);
+    text[sizeof text - 1] = '\0';
+    shim_log_text(log, SHIM_LOG_ERROR, "logStatusError", text);
+    return SHIM_LOG_ERROR;
 }
 
 /* ---- variables table -------------------------------------------------------------------- */
