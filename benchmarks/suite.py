@@ -42,7 +42,7 @@ BENCHMARKS = {
     "rigid": "rigid", "superelement": "superelement", "flexible": "flexible", "operator": "ring_operator",
     "friction": "friction", "fmu": "fmu", "batch": "batch", "realtime": "realtime", "flagged": "flagged",
     "fmu_variants": "fmu_variants", "win64": "win64", "fmi3": "fmi3", "life": "life", "connected": "connected",
-    "step_parts": "step_parts", "slowest": "slowest", "machine_noise": "machine_noise",
+    "step_parts": "step_parts", "slowest": "slowest", "machine_noise": "machine_noise", "turbine": "turbine",
 }
 #: the main set: what ``make bench`` runs (the figures of docs/performance.md; several minutes)
 MAIN = ("rigid", "superelement", "flexible", "operator", "friction", "fmu", "batch", "realtime", "flagged")

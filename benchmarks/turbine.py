@@ -1,0 +1,145 @@
+"""The closed turbine loop against a real-time clock: ROSCO, the rotor, each blade's BEM and three pitch
+drives on flexible pitch bearings, at 10 ms steps.
+
+The NREL 5MW in IEC class B turbulence (Kaimal, 13 m/s mean at the hub, seeded) for ``--duration`` s
+(default 30) through :func:`slewing_turbine.loop.run_turbine` with ``drives="electric"``,
+``bearings="flexible"`` (``examples/bearings/pitch_bearing.toml``, ``--mesh`` superelement, friction on),
+``aero="bem"``, its bearings solving every step to their tolerance (``step_work`` "complete"), and the
+same with bounded steps (``step_work`` "bounded": a step's work capped, as a real-time host runs the FMU).
+Two baselines measured in the same run, alternating with them (``--runs`` rounds, each of the four once):
+
+* ``ideal drives``: the same loop with ideal pitch drives and no bearing (ROSCO, rotor, BEM, blade loads):
+  what the loop costs without its pitch axes;
+* ``bearings alone``: the three bearing simulators stepped through the loads, angles and speeds the full
+  loop gave them in that round (fresh simulators, the same inputs): what the pitch bearings cost on their
+  own.
+
+Each row: seconds of wall time per simulated second (its inverse is the real-time factor; the goal is at
+least 1.5, i.e. at most 0.67 s per s; the step times summed, the set-up outside), the process's CPU
+seconds per simulated second over the whole run (what a shared machine's other load does not inflate as
+much as the wall time: the two differ when the process waited for a core), the median and tail of the
+step times over the rounds' steps (a step of the loop: all of it; of the bearings alone: the three
+bearings' steps), and the full loop's median against each baseline's. Simulators are built (and their
+loops compiled or loaded from cache) before a round's clock starts; each round's first 0.5 s of simulated
+time is left out of the step statistics (the first steps solve from a cold start), and a 1 s run before
+the rounds warms the caches.
+
+Run: .venv/bin/python -m benchmarks turbine [--runs 3] [--duration 30] [--mesh fine|coarse]
+"""
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from .suite import note, print_table, record, spread
+
+#: rounds of the four variants (``--runs``)
+RUNS = 3
+DT = 0.01
+MEAN_WIND = 13.0
+SEED = 63
+#: simulated time left out of the step statistics at the start of each run, s
+SETTLE = 0.5
+#: the real-time goal: simulated seconds per wall second
+GOAL = 1.5
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--duration", type=float, default=30.0, help="simulated seconds per run (default 30)")
+    parser.add_argument("--mesh", choices=("fine", "coarse"), default="fine",
+                        help="superelement mesh of the flexible bearings (default fine, the FMU's)")
+
+
+def _bearings_alone(config, result):
+    """Step three fresh flexible bearings through ``result``'s bearing inputs; the step times (s) of the
+    three together, per loop step."""
+    from slewing_model import Loads
+    from slewing_turbine.loop import make_bearings
+
+    sims = make_bearings(config, "flexible", friction=True)
+    n = result.time.size
+    seconds = np.zeros(n)
+    for i in range(1, n):
+        start = time.perf_counter()
+        for k, sim in enumerate(sims):
+            sim.step(Loads(*map(float, result.root_loads[i, k, :5])), psi=-float(result.pitch[i - 1, k]),
+                     omega=-float(result.pitch_rate[i - 1, k]))
+        seconds[i] = time.perf_counter() - start
+    return seconds
+
+
+def main(args) -> None:
+    from slewing_turbine.loop import TurbineConfig, make_bearings, run_turbine
+    from slewing_turbine.wind import kaimal
+
+    config = TurbineConfig(mesh=args.mesh)
+    wind = kaimal(MEAN_WIND, args.duration + 1.0, DT, seed=SEED)
+    note(f"NREL 5MW, Kaimal class B {MEAN_WIND:g} m/s (seed {SEED}), {args.duration:g} s at {DT * 1e3:g} ms, "
+         f"pitch bearing with flexible rings ({args.mesh} superelement), friction on; {args.runs} rounds")
+    note(f"machine load at the start (1, 5, 15 min): {', '.join(f'{x:.2f}' for x in os.getloadavg())} "
+         f"on {os.cpu_count()} cores")
+    started = time.perf_counter()
+    make_bearings(config, "flexible", friction=True, count=1)        # builds or loads the superelement
+    note(f"superelement and first simulator: {time.perf_counter() - started:.1f} s")
+    run_turbine(config, wind, t_end=1.0, dt=DT, drives="electric", bearings="flexible", aero="bem")   # warm-up
+
+    skip = int(round(SETTLE / DT)) + 1
+    steps = {"loop": [], "loop, bounded steps": [], "ideal drives": [], "bearings alone": []}
+    wall = {k: [] for k in steps}
+    cpu = {k: [] for k in steps}
+
+    def timed(name, func):
+        start = time.process_time()
+        out = func()
+        cpu[name].append((time.process_time() - start) / args.duration)
+        return out
+
+    for _ in range(args.runs):
+        sims = make_bearings(config, "flexible", friction=True)
+        full = timed("loop", lambda: run_turbine(config, wind, t_end=args.duration, dt=DT, drives="electric",
+                                                 bearings="flexible", aero="bem", bearing_simulators=sims))
+        bounded_config = replace(config, step_work="bounded")
+        sims = make_bearings(bounded_config, "flexible", friction=True)
+        bounded = timed("loop, bounded steps", lambda: run_turbine(
+            bounded_config, wind, t_end=args.duration, dt=DT, drives="electric", bearings="flexible", aero="bem",
+            bearing_simulators=sims))
+        ideal = timed("ideal drives", lambda: run_turbine(config, wind, t_end=args.duration, dt=DT, drives="ideal",
+                                                          aero="bem"))
+        alone = timed("bearings alone", lambda: _bearings_alone(config, full))
+        for name, seconds in (("loop", full.step_seconds), ("loop, bounded steps", bounded.step_seconds),
+                              ("ideal drives", ideal.step_seconds), ("bearings alone", alone)):
+            steps[name].append(seconds[skip:])
+            wall[name].append(float(seconds[1:].sum()) / args.duration)
+    rows, medians = [], {}
+    for name in steps:
+        s = spread(np.concatenate(steps[name]))
+        medians[name] = s["median"]
+        per_second = float(np.median(wall[name]))
+        rows.append([name, f"{per_second:.3f}", f"{1.0 / per_second:.2f}x", f"{max(wall[name]):.3f}",
+                     f"{float(np.median(cpu[name])):.3f}", f"{s['median'] * 1e3:.2f} ms", f"{s['p95'] * 1e3:.2f} ms",
+                     f"{s['p99'] * 1e3:.2f} ms", f"{s['max'] * 1e3:.1f} ms"])
+        record(name, {"seconds_per_simulated_second": wall[name], "cpu_seconds_per_simulated_second": cpu[name],
+                      "steps": s})
+    print_table(f"the turbine loop, {args.duration:g} s at {DT * 1e3:g} ms, {args.runs} rounds (goal: at least "
+                f"{GOAL:g}x real time)",
+                ["variant", "s per simulated s (median)", "real-time factor", "s per s (worst round)",
+                 "CPU s per simulated s", "median step", "p95", "p99", "slowest"], rows)
+    loop_median = medians["loop"]
+    print_table("the full loop's median step against the baselines'",
+                ["baseline", "baseline median", "loop / baseline", "loop - baseline"],
+                [[name, f"{medians[name] * 1e3:.2f} ms", f"{loop_median / medians[name]:.2f}",
+                  f"{(loop_median - medians[name]) * 1e3:.2f} ms"] for name in ("ideal drives", "bearings alone")])
+    factors = {}
+    for name in ("loop", "loop, bounded steps"):
+        factors[name] = factor = 1.0 / float(np.median(wall[name]))
+        note(f"real-time factor, {name}: {factor:.2f}x ({'meets' if factor >= GOAL else 'misses'} the {GOAL:g}x goal)")
+    note(f"machine load at the end (1, 5, 15 min): {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    factor = factors["loop"]
+    record("real_time_factor", factors)
+    record("goal", GOAL)
+    if not math.isfinite(factor):      # pragma: no cover
+        raise SystemExit("no steps timed")
