@@ -344,13 +344,6 @@ class RotorGeometry:
                                   blade_count=self.blade_count, precone=self.precone,
                                   shaft_tilt=self.shaft_tilt, air_density=self.air_density)
 
-    def read_blade_mass(self):
-        """The ElastoDyn blade of this rotor (:meth:`slewing_turbine.blade_loads.BladeMass.read_elastodyn`)."""
-        from .blade_loads import BladeMass
-
-        return BladeMass.read_elastodyn(self.elastodyn_blade_file, length=self.tip_radius - self.hub_radius,
-                                        hub_radius=self.hub_radius)
-
 
 def node_heights(blade: Blade, azimuth: float, hub_height: float, *, cone: float | None = None,
                  tilt: float | None = None) -> np.ndarray:

@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .bem import BladeAero
+from .bem import BladeAero, RotorGeometry
 
 __all__ = ["BladeMass", "RootLoads", "root_loads", "bearing_inputs", "bearing_load_series", "GRAVITY"]
 
@@ -158,6 +158,12 @@ class BladeMass:
         if self.edge_mode is None:
             return np.zeros_like(x)
         return self.edge_mode @ (x[None, :] ** np.arange(2, 7)[:, None])
+
+    @classmethod
+    def of_rotor(cls, rotor: RotorGeometry) -> "BladeMass":
+        """The ElastoDyn blade a rotor file names (:class:`slewing_turbine.bem.RotorGeometry`)."""
+        return cls.read_elastodyn(rotor.elastodyn_blade_file, length=rotor.tip_radius - rotor.hub_radius,
+                                  hub_radius=rotor.hub_radius)
 
     @classmethod
     def read_elastodyn(cls, blade_file, *, length: float, hub_radius: float) -> "BladeMass":

@@ -280,7 +280,7 @@ class _BemAero:
         self.bem, self.blade_loads, self.wind = bem, blade_loads, wind
         self.geometry = bem.RotorGeometry.read_toml(config.path(config.rotor))
         self.blade = self.geometry.read_blade()
-        self.mass = self.geometry.read_blade_mass()
+        self.mass = blade_loads.BladeMass.of_rotor(self.geometry)
         self.hub_height = self.geometry.hub_height if config.hub_height is None else float(config.hub_height)
         self.shear_exponent = config.shear_exponent
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from slewing_turbine.bem import RotorGeometry, bem_loads, node_heights
-from slewing_turbine.blade_loads import GRAVITY, RootLoads, bearing_inputs, bearing_load_series, root_loads
+from slewing_turbine.blade_loads import GRAVITY, BladeMass, RootLoads, bearing_inputs, bearing_load_series, root_loads
 
 CASE = Path(__file__).resolve().parents[1] / "examples" / "turbines" / "nrel5mw"
 RECORD = Path(__file__).resolve().parents[2] / "shared" / "data" / "openfast" / \
@@ -25,7 +25,7 @@ def rotor():
 
 @pytest.fixture(scope="module")
 def mass(rotor):
-    return rotor.read_blade_mass()
+    return BladeMass.of_rotor(rotor)
 
 
 @pytest.fixture(scope="module")
