@@ -112,13 +112,29 @@ def _cache_dir(tmp_path_factory):
 
 
 def _build_table3(tmp_path_factory, name, **options):
+    """The FMU ``name`` of table3_errors.toml, built once a session: under pytest-xdist the workers share
+    it (the first to ask builds it, in its own folder, then moves it into the session's ``shared_fmus``
+    folder; another asking meanwhile waits for it), instead of each worker building its own (half a
+    minute of CPU each)."""
+    import fcntl
     import sys
 
     sys.path.insert(0, str(ROOT))
     from build_fmu import build_fmu
 
-    path = tmp_path_factory.mktemp("fmu") / name
-    return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free", **options)
+    def build():
+        path = tmp_path_factory.mktemp("fmu") / name
+        return build_fmu(BEARINGS / "table3_errors.toml", path, mesh="coarse", bc="free", **options)
+
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return build()
+    shared = tmp_path_factory.getbasetemp().parent / "shared_fmus"     # the session's, beside the workers'
+    shared.mkdir(exist_ok=True)
+    with open(shared / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (shared / name).exists():               # a failed build leaves nothing: the next worker tries
+            os.replace(build(), shared / name)
+    return shared / name
 
 
 @pytest.fixture(scope="session")
