@@ -103,7 +103,12 @@ def _cache_dir(tmp_path_factory):
     from fmu_build.aot import CACHE_VARIABLE, aot_cache_dir
 
     os.environ.setdefault(CACHE_VARIABLE, str(aot_cache_dir()))
-    os.environ.setdefault("SLEWING_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
+    # one cache for the session's workers (pytest-xdist), so that a superelement one built the other loads
+    # (a save writes a file of its own process, then renames it: two workers saving one path do not collide)
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent / "cache" if os.environ.get("PYTEST_XDIST_WORKER") else base / "cache"
+    shared.mkdir(exist_ok=True)
+    os.environ.setdefault("SLEWING_CACHE_DIR", str(shared))
     # the win64 half's loops (about 2.5 minutes under wine, once per version of the loops) are taken from that
     # cache only: where they are not there the FMUs' win64 halves run numpy's loops and the test of the win64
     # module is skipped, saying how to compile them (SLEWING_BUILD_WIN64_AOT=1 compiles them in the tests)

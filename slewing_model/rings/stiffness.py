@@ -202,7 +202,7 @@ class Superelement:
         meta["ring_stiffness"] = {r.ring: {"ball_count": r.ball_count, "removed_modes": list(r.removed_modes),
                                   "boundary_condition": r.boundary_condition}
                          for r in (self.outer, self.inner)}
-        tmp = path + ".tmp.npz"
+        tmp = f"{path}.{os.getpid()}.tmp.npz"   # a file of this process: two saving the same path do not collide
         np.savez(tmp, outer_first_row=self.outer.first_row, inner_first_row=self.inner.first_row,
                  metadata=np.array(json.dumps(meta, sort_keys=True, default=_json_default)))
         os.replace(tmp, path)
