@@ -3,6 +3,7 @@
 ``slewing solve BEARING.toml [--fx N] [--fy N] [--fz N] [--mx Nm] [--my Nm] [--model rigid|flexible] [--json]``
 ``slewing superelement BEARING.toml [--mesh coarse|fine] [--bc free|clamped|frictionless] -o FILE``
 ``slewing loads FILE.outb --bearing pitch|yaw [--blade K] [--mounting M] [--start s] [--end s] -o LOADS.csv``
+``slewing turbine TURBINE.toml -o DIR`` (the turbine loop: slewing_turbine, imported when it runs)
 """
 from __future__ import annotations
 
@@ -263,6 +264,41 @@ def _add_batch(sub) -> None:
     p.set_defaults(func=command.run)
 
 
+def _add_turbine(sub) -> None:
+    """``slewing turbine FILE.toml -o DIR``: a closed-loop turbine case or a turbine study (slewing_turbine,
+    imported when the command runs: the bearing library does not depend on it)."""
+    p = _add_parser(sub, "turbine", help="the wind turbine's closed loop (ROSCO, rotor, pitch drives on their "
+                                         "bearings): a turbine file's case, or a turbine study's cases on Dask")
+    p.add_argument("file", help="turbine file (TOML: examples/turbines/nrel5mw.toml) or turbine study file "
+                                "(with a [study] table: examples/studies/turbine_nrel5mw.toml)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="output directory: summary.csv, summary.json, timeseries.csv, turbine.png (a study: "
+                        "summary.csv, cases/<key>/, figures/; finished cases are skipped)")
+    p.add_argument("--t-end", type=_finite_float, default=None, metavar="S",
+                   help="a turbine file's run length instead of its simulation.t_end_s, s")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="a study: worker processes of the embedded Dask LocalCluster (not given: one per core)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a study: submit to this Dask cluster")
+    p.add_argument("--retry-failed", action="store_true", help="a study: run again the cases that failed")
+    p.add_argument("--overwrite", action="store_true",
+                   help="a study: clear another study's results found in the output directory")
+    p.add_argument("--no-figures", action="store_true", help="write no PNG")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_run_turbine)
+
+
+def _run_turbine(args) -> int:
+    import importlib.util
+
+    if sys.version_info < (3, 11) or importlib.util.find_spec("rosco") is None:
+        print("slewing turbine: error: the turbine loop needs ROSCO's controller library (Python >= 3.11): "
+              "pip install --no-deps rosco==2.10.6", file=sys.stderr)
+        return 2
+    from slewing_turbine.cli import run
+
+    return run(args)
+
+
 def _add_life(sub) -> None:
     """``slewing life LOADS.csv BEARING.toml`` (slewing_model.life.command)."""
     from .life import command
@@ -285,6 +321,7 @@ def main(argv=None) -> int:
     _add_batch(sub)
     _add_loads(sub)
     _add_life(sub)
+    _add_turbine(sub)
     args = parser.parse_args(argv)
     try:
         code = int(args.func(args) or 0)
