@@ -133,35 +133,21 @@ def run(args) -> int:
 
 
 def _run_study(args) -> int:
-    from slewing_model.study.engine import StudyInterrupted
+    from slewing_model.study.command import report_run
 
     from .study import load_turbine_study, markdown_table, run_turbine_study
 
     study = load_turbine_study(args.file)
     if args.t_end is not None:
         raise ValueError("--t-end: for a turbine file only (a study sets simulation.t_end_s in its [overrides])")
-    try:
-        report = run_turbine_study(study, args.output, workers=args.workers, scheduler=args.scheduler,
-                                   progress=not args.quiet, retry_failed=args.retry_failed,
-                                   figures=not args.no_figures, overwrite=args.overwrite)
-    except StudyInterrupted as stop:
-        r = stop.report
-        finished = sum(1 for row in r.rows if not row["status"].startswith("not finished"))
-        print(f"\nslewing turbine: interrupted; {finished} of {r.cases} cases finished, summary: {r.summary} "
-              f"(the same command resumes)", file=sys.stderr)
-        return 130
-    ok = report.cases - len(report.failed)
-    print(f"{report.cases} cases: {ok} ok, {len(report.failed)} failed; {len(report.ran)} run now "
-          f"({report.wall_time:.1f} s{', ' + report.cluster if report.cluster else ''}), "
-          f"{len(report.skipped)} already finished. Summary: {report.summary}")
-    if not args.quiet:
-        print(markdown_table(report.summary))
-    for note in report.notes:
-        print(f"note: {note}", file=sys.stderr)
-    names = {row["case"]: row["name"] for row in report.rows}
-    for key, status in report.failed.items():
-        print(f"  {args.file}: case {key} ({names.get(key, '?')}): {status}", file=sys.stderr)
-    return 0 if not report.failed else 1
+
+    def table(report):
+        if not args.quiet:
+            print(markdown_table(report.summary))
+
+    return report_run("slewing turbine", args.file, lambda: run_turbine_study(
+        study, args.output, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+        retry_failed=args.retry_failed, figures=not args.no_figures, overwrite=args.overwrite), table)
 
 
 def summary_json(path) -> dict:

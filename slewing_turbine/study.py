@@ -49,7 +49,6 @@ import json
 import math
 import os
 import re
-import shutil
 import tempfile
 import time
 from dataclasses import dataclass
@@ -212,16 +211,10 @@ def load_turbine_study(path) -> TurbineStudy:
     TurbineStudyError, TurbineDefinitionError
         Naming the file, the key (and the case), the value and the rule.
     """
-    import tomllib
+    from slewing_model.study.definition import read_toml
 
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise TurbineStudyError(f"{path}: cannot read the study file: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise TurbineStudyError(f"{path}: not a valid TOML file: {exc}") from None
+    data = read_toml(path, TurbineStudyError, "study file")
     return turbine_study_from_dict(data, os.path.dirname(os.path.abspath(path)), path)
 
 
@@ -356,14 +349,10 @@ def controller_messages(path) -> list:
 
 # ---- the output directory ----------------------------------------------------------------------------
 
-def _case_dir(out_dir: str, key: str) -> str:
-    return os.path.join(out_dir, "cases", key)
-
-
 def _write_case(out_dir: str, sc: TurbineStudyCase, result: dict) -> dict:
-    from slewing_model.study.engine import write_json
+    from slewing_model.study.engine import case_dir, write_json
 
-    folder = _case_dir(out_dir, sc.key)
+    folder = case_dir(out_dir, sc.key)
     os.makedirs(folder, exist_ok=True)
     write_json(os.path.join(folder, "case.json"), {"key": sc.key, "index": sc.index, "name": sc.name,
                                                    "values": sc.values, "case": sc.case.describe()})
@@ -375,15 +364,6 @@ def _write_case(out_dir: str, sc: TurbineStudyCase, result: dict) -> dict:
               "controller_messages": result.get("messages", [])}
     write_json(os.path.join(folder, "result.json"), record)
     return record
-
-
-def _read_result(out_dir: str, key: str) -> dict | None:
-    try:
-        with open(os.path.join(_case_dir(out_dir, key), "result.json")) as fh:
-            data = json.load(fh)
-    except (OSError, ValueError):
-        return None
-    return data if data.get("key") == key else None
 
 
 def _cell(value) -> str:
@@ -419,15 +399,6 @@ def _rows(study: TurbineStudy, records: dict, lost: dict) -> tuple[list, list]:
     return columns, rows
 
 
-def _write_summary(path: str, columns: list, rows: list) -> None:
-    tmp = path + ".tmp"
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=columns)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, path)
-
-
 def run_turbine_study(study, out_dir, *, workers: int | None = None, scheduler: str | None = None, client=None,
                       progress: bool = True, retry_failed: bool = False, figures: bool = True,
                       overwrite: bool = False):
@@ -448,88 +419,30 @@ def run_turbine_study(study, out_dir, *, workers: int | None = None, scheduler: 
     slewing_model.study.ForeignOutputError
         ``out_dir`` holds another study's results and ``overwrite`` is not set.
     """
-    from slewing_model.study.case import one_line
-    from slewing_model.study.engine import (ForeignOutputError, StudyInterrupted, StudyReport, _client,
-                                            _quiet_sync_cancel, write_json)
+    from slewing_model.study.engine import (StudyInterrupted, StudyReport, finished_cases, open_output_dir,
+                                            run_on_dask, write_summary)
 
     if not isinstance(study, TurbineStudy):
         study = load_turbine_study(study)
     out_dir = os.fspath(out_dir)
-    try:
-        with open(os.path.join(out_dir, STUDY_RECORD)) as fh:
-            other = json.load(fh).get("name")
-    except (OSError, ValueError, AttributeError):
-        other = None
-    if other is None and os.path.isdir(os.path.join(out_dir, "cases")) and os.listdir(os.path.join(out_dir, "cases")):
-        if not set(os.listdir(os.path.join(out_dir, "cases"))) & {c.key for c in study.cases}:
-            other = "an unnamed study"
-    if other is not None and other != study.name:
-        if not overwrite:
-            raise ForeignOutputError(f"output directory {out_dir} holds the results of {other!r}, not of study "
-                                     f"{study.name!r}: give another directory, or --overwrite to clear them")
-        for name in ("cases", "figures"):
-            shutil.rmtree(os.path.join(out_dir, name), ignore_errors=True)
-        for name in ("summary.csv", STUDY_RECORD):
-            if os.path.exists(os.path.join(out_dir, name)):
-                os.remove(os.path.join(out_dir, name))
-    os.makedirs(os.path.join(out_dir, "cases"), exist_ok=True)
-    write_json(os.path.join(out_dir, STUDY_RECORD), {"name": study.name, "path": study.path, "kind": "turbine"})
+    open_output_dir(out_dir, {"name": study.name, "path": study.path, "kind": "turbine"},
+                    [c.key for c in study.cases], overwrite)
     report = StudyReport(len(study.cases), summary=os.path.join(out_dir, "summary.csv"))
-    records, lost, pending = {}, {}, []
-    for sc in study.cases:
-        record = _read_result(out_dir, sc.key)
-        if record is not None and (record["status"] == "ok" or not retry_failed):
-            records[sc.key] = record
-            report.skipped.append(sc.key)
-        else:
-            pending.append(sc)
+    records, pending = finished_cases(out_dir, study.cases, report, retry_failed)
+    lost = {}
 
     def finish():
         columns, report.rows = _rows(study, records, lost)
         report.failed = {r["case"]: r["status"] for r in report.rows if r["status"] != "ok"}
-        _write_summary(report.summary, columns, report.rows)
+        write_summary(report.summary, report.rows, columns)
+
+    def done(sc, result, client):
+        records[sc.key] = _write_case(out_dir, sc, result)
 
     try:
-        if pending:
-            from distributed import as_completed
-
-            owned, bar = [], None
-            with _quiet_sync_cancel():
-                try:
-                    if client is None:
-                        client, report.cluster = _client(workers, scheduler, owned)
-                    else:
-                        report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
-                    if progress:
-                        from slewing_model.progress import progress_bar
-
-                        bar = progress_bar(len(study.cases), study.name, "case",
-                                           initial=len(study.cases) - len(pending))
-                    start = time.perf_counter()
-                    by_key = {}
-                    futures = []
-                    for sc in pending:
-                        future = client.submit(run_case, sc.case, key=f"slewing-turbine-case-{sc.key}", pure=False)
-                        by_key[future.key] = sc
-                        futures.append(future)
-                    for future in as_completed(futures):
-                        sc = by_key[future.key]
-                        try:
-                            result = future.result()
-                        except Exception as exc:  # noqa: BLE001 - lost to the cluster: not marked finished
-                            lost[sc.key] = f"not finished: {one_line(exc)}"
-                        else:
-                            records[sc.key] = _write_case(out_dir, sc, result)
-                        report.ran.append(sc.key)
-                        future.release()
-                        if bar is not None:
-                            bar.update(1)
-                    report.wall_time = time.perf_counter() - start
-                finally:
-                    if bar is not None:
-                        bar.close()
-                    for thing in reversed(owned):
-                        thing.close()
+        run_on_dask(run_case, [(sc, sc.case, f"slewing-turbine-case-{sc.key}") for sc in pending], report, lost,
+                    done, workers=workers, scheduler=scheduler, client=client, progress=progress,
+                    total=len(study.cases), title=study.name)
     except KeyboardInterrupt:
         for sc in pending:
             if sc.key not in records and sc.key not in lost:

@@ -105,17 +105,9 @@ def _fail(key: str, value: Any, rule: str):
 def _known(table: Mapping, where: str, known) -> None:
     """Refuse a key of ``table`` that is not in ``known`` (``where``: the table's dotted name, ``""`` for the
     file's top level), naming the table, the key, its value and the known keys."""
-    for key in table:
-        if key in known:
-            continue
-        if not where:
-            _fail(key, table[key], f"unknown table [{key}] (known tables: "
-                  f"{', '.join(f'[{t}]' for t in sorted(known))}; names are case-sensitive)")
-        if isinstance(table[key], Mapping):
-            _fail(f"{where}.{key}", None, f"unknown table [{where}.{key}] "
-                  f"(known: {', '.join(sorted(known))}; names are case-sensitive)")
-        _fail(f"{where}.{key}", table[key],
-              f"unknown key in table [{where}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
+    from slewing_model.study.definition import refuse_unknown
+
+    refuse_unknown(table, f"{where}." if where else "", known, TurbineDefinitionError)
 
 
 def _table(data: Mapping, name: str) -> Mapping:
@@ -356,16 +348,10 @@ def load_turbine(path, *, overrides: Mapping | None = None) -> TurbineCase:
     TurbineDefinitionError
         Naming the file, the key, the value and the rule (also for a missing or malformed file).
     """
-    import tomllib
+    from slewing_model.study.definition import read_toml
 
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise TurbineDefinitionError(f"{path}: cannot read the turbine file: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise TurbineDefinitionError(f"{path}: not a valid TOML file: {exc}") from None
+    data = read_toml(path, TurbineDefinitionError, "turbine file")
     try:
         return turbine_from_dict(apply_overrides(data, overrides or {}), os.path.dirname(os.path.abspath(path)),
                                  path)

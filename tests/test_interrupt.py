@@ -271,7 +271,7 @@ def test_the_embedded_clusters_workers_drop_only_a_heartbeat_that_meets_its_clos
     above). The embedded cluster's workers drop that record, and only that one."""
     import logging
 
-    from slewing_model.study.engine import HEARTBEAT_AT_CLOSE, _client, _not_heartbeat_at_close
+    from slewing_model.study.engine import HEARTBEAT_AT_CLOSE, _not_heartbeat_at_close, dask_client
 
     def record(message):
         return logging.LogRecord("distributed.worker", logging.ERROR, __file__, 1, message, None, None)
@@ -280,7 +280,7 @@ def test_the_embedded_clusters_workers_drop_only_a_heartbeat_that_meets_its_clos
     assert _not_heartbeat_at_close(record("Compute Failed"))
     owned = []
     try:
-        client, _ = _client(1, None, owned)
+        client, _ = dask_client(1, None, owned)
         installed = client.run(lambda: _not_heartbeat_at_close in logging.getLogger("distributed.worker").filters)
         assert list(installed.values()) == [True]
     finally:
@@ -292,7 +292,7 @@ def test_a_ctrl_c_inside_distributeds_sync_before_its_future_exists_logs_nothing
     """A Ctrl-C that lands in ``distributed.utils.sync`` before the coroutine it runs has made its future
     makes the cancel callback read that future unassigned: tornado logs a NameError with a traceback
     (seen once in the Ctrl-C test above). Reproduced here: the wait for the coroutine interrupted at once.
-    Within a run (``_quiet_sync_cancel``) that record is dropped, and no other; outside it, it is logged."""
+    Within a run (``quiet_sync_cancel``) that record is dropped, and no other; outside it, it is logged."""
     import asyncio
     import logging
     import threading
@@ -300,7 +300,7 @@ def test_a_ctrl_c_inside_distributeds_sync_before_its_future_exists_logs_nothing
     from distributed.utils import sync
     from tornado.ioloop import IOLoop
 
-    from slewing_model.study.engine import _quiet_sync_cancel
+    from slewing_model.study.engine import quiet_sync_cancel
 
     ready, holder = threading.Event(), {}
 
@@ -340,7 +340,7 @@ def test_a_ctrl_c_inside_distributeds_sync_before_its_future_exists_logs_nothing
         held.release()
         sync(loop, work)                            # the loop has run the queued callbacks
     try:
-        with _quiet_sync_cancel():
+        with quiet_sync_cancel():
             ctrl_c_in_sync()
             logger.error("another error")           # the filter drops that one record only
         quiet = [r.getMessage() for r in logged]

@@ -21,25 +21,41 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    from .engine import StudyInterrupted, run_study
+    from .engine import run_study
+
+    return report_run("slewing batch", args.study, lambda: run_study(
+        args.study, args.output, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+        retry_failed=args.retry_failed, figures=not args.no_figures, overwrite=args.overwrite))
+
+
+def report_run(command: str, study_path, run, after_summary=None) -> int:
+    """Run a study (``run()``: a :class:`~slewing_model.study.StudyReport`) and report it on the terminal; the
+    command's exit status.
+
+    A Ctrl-C (:class:`~slewing_model.study.StudyInterrupted`): one line on stderr, ``"<command>: interrupted;
+    ..."``, and 130 (the status of a command ended by SIGINT). Otherwise the count line on stdout, then
+    ``after_summary(report)`` (if given), the notes and each failure with its case and ``study_path`` on
+    stderr; 0 when no case failed, 1 otherwise.
+    """
+    from .engine import StudyInterrupted
 
     try:
-        report = run_study(args.study, args.output, workers=args.workers, scheduler=args.scheduler,
-                           progress=not args.quiet, retry_failed=args.retry_failed, figures=not args.no_figures,
-                           overwrite=args.overwrite)
+        report = run()
     except StudyInterrupted as stop:   # Ctrl-C: one line, the status of a command ended by SIGINT
         r = stop.report
         finished = sum(1 for row in r.rows if not row["status"].startswith("not finished"))
-        print(f"\nslewing batch: interrupted; {finished} of {r.cases} cases finished, summary: {r.summary} "
+        print(f"\n{command}: interrupted; {finished} of {r.cases} cases finished, summary: {r.summary} "
               f"(the same command resumes)", file=sys.stderr)
         return 130
     ok = report.cases - len(report.failed)
     print(f"{report.cases} cases: {ok} ok, {len(report.failed)} failed; {len(report.ran)} run now "
           f"({report.wall_time:.1f} s{', ' + report.cluster if report.cluster else ''}), "
           f"{len(report.skipped)} already finished. Summary: {report.summary}")
+    if after_summary is not None:
+        after_summary(report)
     for note in report.notes:
         print(f"note: {note}", file=sys.stderr)
     names = {row["case"]: row["name"] for row in report.rows}
     for key, status in report.failed.items():   # each failure with its case and the study file
-        print(f"  {args.study}: case {key} ({names.get(key, '?')}): {status}", file=sys.stderr)
+        print(f"  {study_path}: case {key} ({names.get(key, '?')}): {status}", file=sys.stderr)
     return 0 if not report.failed else 1

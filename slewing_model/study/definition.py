@@ -260,6 +260,18 @@ def load_study(path: str | os.PathLike) -> Study:
     StudyDefinitionError
         Naming the key, the value and the rule broken (also for a missing or malformed file).
     """
+    path = os.fspath(path)
+    data = read_toml(path, StudyDefinitionError, "study file")
+    try:
+        return study_from_dict(data, os.path.dirname(os.path.abspath(path)), path)
+    except StudyDefinitionError as exc:  # name the file
+        raise StudyDefinitionError(f"{path}: {exc}") from None
+
+
+def read_toml(path: str | os.PathLike, error: type[Exception] = StudyDefinitionError,
+              what: str = "study file") -> dict:
+    """Read a TOML file; a file that cannot be read or is not TOML raises ``error`` naming it:
+    ``"PATH: cannot read the <what>: <reason>"`` or ``"PATH: not a valid TOML file: <reason>"``."""
     try:
         import tomllib
     except ModuleNotFoundError:  # pragma: no cover - Python 3.10
@@ -268,15 +280,11 @@ def load_study(path: str | os.PathLike) -> Study:
     path = os.fspath(path)
     try:
         with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+            return tomllib.load(fh)
     except OSError as exc:
-        raise StudyDefinitionError(f"{path}: cannot read the study file: {exc.strerror}") from None
+        raise error(f"{path}: cannot read the {what}: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
-        raise StudyDefinitionError(f"{path}: not a valid TOML file: {exc}") from None
-    try:
-        return study_from_dict(data, os.path.dirname(os.path.abspath(path)), path)
-    except StudyDefinitionError as exc:  # name the file
-        raise StudyDefinitionError(f"{path}: {exc}") from None
+        raise error(f"{path}: not a valid TOML file: {exc}") from None
 
 
 def study_from_dict(data: Mapping[str, Any], study_dir: str, path: str = "<dict>") -> Study:
@@ -302,9 +310,9 @@ def study_from_dict(data: Mapping[str, Any], study_dir: str, path: str = "<dict>
     StudyDefinitionError
         Naming the key, the value and the rule broken.
     """
-    _known(data, "", {"study", "loads", "bearings", "simulation"})
+    refuse_unknown(data, "", {"study", "loads", "bearings", "simulation"})
     head = _table(data, "study", required=False)
-    _known(head, "study.", {"name", "description", "base_dir"})
+    refuse_unknown(head, "study.", {"name", "description", "base_dir"})
     name = _string(head, "study.name", default=os.path.splitext(os.path.basename(path))[0])
     base_dir = os.path.normpath(os.path.join(study_dir, _string(head, "study.base_dir", default=".")))
 
@@ -324,20 +332,24 @@ def study_from_dict(data: Mapping[str, Any], study_dir: str, path: str = "<dict>
     return Study(name, path, base_dir, loads, variants, simulation, _string(head, "study.description", default=""))
 
 
-def _known(table: Mapping, where: str, known: set) -> None:
+def refuse_unknown(table: Mapping, where: str, known, error: type[Exception] = StudyDefinitionError) -> None:
     """Refuse a key of ``table`` not in ``known`` (``where``: the table's dotted name and a dot, ``""``
-    for the file's top level), naming the table, the key, its value and the known keys."""
+    for the file's top level), raising ``error`` that names the table, the key, its value and the known
+    keys (:func:`~slewing_model.bearing.conventions.definition_message`)."""
+    def fail(key, value, rule):
+        raise error(definition_message(key, value, rule))
+
     for key in table:
         if key in known:
             continue
         if not where:
-            _fail(key, table[key], f"unknown table [{key}] (known tables: "
-                  f"{', '.join(f'[{t}]' for t in sorted(known))}; names are case-sensitive)")
+            fail(key, table[key], f"unknown table [{key}] (known tables: "
+                 f"{', '.join(f'[{t}]' for t in sorted(known))}; names are case-sensitive)")
         if isinstance(table[key], Mapping):     # a misspelt [where.key] sub-table
-            _fail(where + key, None, f"unknown table [{where}{key}] "
-                  f"(known: {', '.join(sorted(known))}; names are case-sensitive)")
-        _fail(where + key, table[key],
-              f"unknown key in table [{where[:-1]}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
+            fail(where + key, None, f"unknown table [{where}{key}] "
+                 f"(known: {', '.join(sorted(known))}; names are case-sensitive)")
+        fail(where + key, table[key],
+             f"unknown key in table [{where[:-1]}] (known: {', '.join(sorted(known))}; names are case-sensitive)")
 
 
 def _table(data: Mapping, key: str, required: bool) -> Mapping:
@@ -410,7 +422,7 @@ def _load_entries(entry: Any, w: str, base_dir: str) -> list[dict]:
     common = {"name", "load_frame", "t_start_s", "t_end_s", "every", "omega_rad_s"}
     extra = {"openfast": {"openfast", "bearing", "blades", "mounting"}, "csv": {"csv"},
              "constant": {"constant", "duration_s", "steps"}}[kind]
-    _known(entry, w, common | extra)
+    refuse_unknown(entry, w, common | extra)
     load: dict = {"kind": kind}
     if kind == "constant":
         values = entry["constant"]
@@ -460,7 +472,8 @@ def _load_entries(entry: Any, w: str, base_dir: str) -> list[dict]:
 
 def _variants(table: Mapping, base_dir: str) -> list[dict]:
     w = "bearings."
-    _known(table, w, {"files", "ring_model", "preload_um", "friction_coefficient", "error_seeds", "synthetic_errors"})
+    refuse_unknown(table, w, {"files", "ring_model", "preload_um", "friction_coefficient", "error_seeds",
+                              "synthetic_errors"})
     files = []
     for f in _list(table, w + "files"):
         if not isinstance(f, str) or not f:
@@ -481,7 +494,7 @@ def _variants(table: Mapping, base_dir: str) -> list[dict]:
     if "error_seeds" in table:
         raw = table["error_seeds"]
         if isinstance(raw, Mapping):
-            _known(raw, w + "error_seeds.", {"first", "count"})
+            refuse_unknown(raw, w + "error_seeds.", {"first", "count"})
             first = _integer(raw, w + "error_seeds.first", default=0, minimum=0)
             count = _integer(raw, w + "error_seeds.count", minimum=1)
             seeds = list(range(first, first + count))
@@ -497,7 +510,7 @@ def _variants(table: Mapping, base_dir: str) -> list[dict]:
         synthetic = dict(table["synthetic_errors"]) if isinstance(table["synthetic_errors"], Mapping) else None
         if synthetic is None:
             _fail(w + "synthetic_errors", table["synthetic_errors"], "must be a table")
-        _known(synthetic, w + "synthetic_errors.", set(SYNTHETIC_KEYS))
+        refuse_unknown(synthetic, w + "synthetic_errors.", set(SYNTHETIC_KEYS))
         if seeds == [None]:
             _fail(w + "synthetic_errors", synthetic, "needs bearings.error_seeds (the seeds of the error sets)")
 
@@ -517,7 +530,7 @@ def _variants(table: Mapping, base_dir: str) -> list[dict]:
 
 def _simulation(table: Mapping) -> dict:
     w = "simulation."
-    _known(table, w, set(SIMULATION_DEFAULTS))
+    refuse_unknown(table, w, set(SIMULATION_DEFAULTS))
     s = dict(SIMULATION_DEFAULTS)
     s["mesh"] = _string(table, w + "mesh", default="coarse", choices=("coarse", "fine", "finer"))
     s["bc"] = _string(table, w + "bc", default="free", choices=("free", "clamped", "frictionless"))

@@ -129,28 +129,28 @@ class ForeignOutputError(ValueError):
     """The output directory holds another study's results (``overwrite`` clears them); a :class:`ValueError`."""
 
 
-def _foreign_study(out_dir: str, study: Study, cases: list) -> str | None:
-    """The name of the other study whose results ``out_dir`` holds, or None (empty, or this study's).
+def foreign_study(out_dir: str, name: str, keys) -> str | None:
+    """The name of the other study whose results ``out_dir`` holds, or None (empty, or study ``name``'s).
 
     ``study.json`` names the study that wrote the folder; a folder written before that record
-    existed is another study's when none of its cases is one of this study's."""
+    existed is another study's when none of its cases is one of ``keys`` (this study's case keys)."""
     try:
         with open(os.path.join(out_dir, STUDY_RECORD)) as fh:
-            name = json.load(fh).get("name")
+            other = json.load(fh).get("name")
     except (OSError, ValueError, AttributeError):
-        name = None
-    if name is not None:
-        return None if name == study.name else name
+        other = None
+    if other is not None:
+        return None if other == name else other
     try:
         found = set(os.listdir(os.path.join(out_dir, "cases")))
     except OSError:
         found = set()
-    if found and not found & {c.key for c in cases}:
+    if found and not found & set(keys):
         return "an unnamed study"
     return None
 
 
-def _clear_results(out_dir: str) -> None:
+def clear_results(out_dir: str) -> None:
     """Remove what a study run writes (nothing else of the folder)."""
     import shutil
 
@@ -161,6 +161,42 @@ def _clear_results(out_dir: str) -> None:
             os.remove(os.path.join(out_dir, name))
         except FileNotFoundError:
             pass
+
+
+def open_output_dir(out_dir: str, record: dict, keys, overwrite: bool = False) -> None:
+    """Make ``out_dir`` the folder of the study ``record["name"]`` (case keys ``keys``): refuse it when it
+    holds another study's results (:func:`foreign_study`), or clear them with ``overwrite``; then create
+    ``cases/`` and write ``record`` as ``study.json``.
+
+    Raises
+    ------
+    ForeignOutputError
+        ``out_dir`` holds another study's results and ``overwrite`` is not set.
+    """
+    other = foreign_study(out_dir, record["name"], keys)
+    if other is not None:
+        if not overwrite:
+            raise ForeignOutputError(
+                f"output directory {out_dir} holds the results of {other!r}, not of study {record['name']!r}: "
+                f"give another directory, or --overwrite to clear them")
+        clear_results(out_dir)
+    os.makedirs(os.path.join(out_dir, "cases"), exist_ok=True)
+    write_json(os.path.join(out_dir, STUDY_RECORD), record)
+
+
+def finished_cases(out_dir: str, cases, report: "StudyReport", retry_failed: bool = False) -> tuple[dict, list]:
+    """The records of the ``cases`` (each with a ``key``) finished in ``out_dir`` (key -> ``result.json``;
+    their keys appended to ``report.skipped``) and the list of the others, to run (a failed case is
+    finished unless ``retry_failed``)."""
+    records, pending = {}, []
+    for case in cases:
+        record = read_result(out_dir, case.key)
+        if record is not None and (record["status"] == "ok" or not retry_failed):
+            records[case.key] = record
+            report.skipped.append(case.key)
+        else:
+            pending.append(case)
+    return records, pending
 
 
 def case_dir(out_dir: str, key: str) -> str:
@@ -276,10 +312,11 @@ def summary_row(case: Case, record: dict | None, status: str | None = None) -> d
     return {k: str(v) for k, v in row.items()}             # as summary.csv reads back
 
 
-def write_summary(path: str, rows: list[dict]) -> None:
+def write_summary(path: str, rows: list[dict], columns=SUMMARY_COLUMNS) -> None:
+    """Write ``summary.csv``: ``columns`` (default :data:`SUMMARY_COLUMNS`) and ``rows``, atomically."""
     tmp = path + ".tmp"
     with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=SUMMARY_COLUMNS)
+        w = csv.DictWriter(fh, fieldnames=columns)
         w.writeheader()
         w.writerows(rows)
     os.replace(tmp, path)
@@ -342,8 +379,8 @@ class _Prepared:
 
 # ---- the run ------------------------------------------------------------------------------------
 
-def _client(workers: int | None, scheduler: str | None, owned: list):
-    """A Dask client and what it runs on; what the caller closes afterwards is appended to
+def dask_client(workers: int | None, scheduler: str | None, owned: list):
+    """A Dask client and what it runs on (a description); what the caller closes afterwards is appended to
     ``owned`` as it is made (the cluster before its client), so that a Ctrl-C pressed while the
     cluster starts, delivered as this returns, leaves nothing open."""
     from distributed import Client, LocalCluster
@@ -416,7 +453,7 @@ def _not_sync_cancel_error(record: logging.LogRecord) -> bool:
 
 
 @contextlib.contextmanager
-def _quiet_sync_cancel():
+def quiet_sync_cancel():
     """:func:`_not_sync_cancel_error` on tornado's ``tornado.application`` logger (where the event loop logs
     a callback's exception) for the length of the block: the run's Dask client, in this process."""
     logger = logging.getLogger("tornado.application")
@@ -515,26 +552,10 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, w
     out_dir = os.fspath(out_dir)
     check_files(study)
     cases = study.cases()
-    other = _foreign_study(out_dir, study, cases)
-    if other is not None:
-        if not overwrite:
-            raise ForeignOutputError(
-                f"output directory {out_dir} holds the results of {other!r}, not of study {study.name!r}: "
-                f"give another directory, or --overwrite to clear them")
-        _clear_results(out_dir)
-    os.makedirs(os.path.join(out_dir, "cases"), exist_ok=True)
-    _write_json(os.path.join(out_dir, STUDY_RECORD), {"name": study.name, "path": study.path})
+    open_output_dir(out_dir, {"name": study.name, "path": study.path}, [c.key for c in cases], overwrite)
     report = StudyReport(len(cases), summary=os.path.join(out_dir, "summary.csv"))
-    records: dict[str, dict] = {}
+    records, pending = finished_cases(out_dir, cases, report, retry_failed)
     lost: dict[str, str] = {}
-    pending = []
-    for case in cases:
-        record = read_result(out_dir, case.key)
-        if record is not None and (record["status"] == "ok" or not retry_failed):
-            records[case.key] = record
-            report.skipped.append(case.key)
-        else:
-            pending.append(case)
 
     try:
         _run_pending(out_dir, pending, study, records, lost, report, workers, scheduler, client, progress,
@@ -608,45 +629,68 @@ def _run_pending(out_dir, pending, study, records, lost, report, workers, schedu
             records[case.key] = write_case(out_dir, case, CaseResult(case.key, one_line(exc), 0.0, "client"))
             report.ran.append(case.key)
 
-    if tasks:
-        from distributed import as_completed
+    def done(case, result, client):
+        records[case.key] = write_case(out_dir, case, result)
+        if on_result is not None:
+            on_result(case, records[case.key], client)
 
-        owned = []    # what this run started, closed last made first (the client, then its cluster)
-        bar = None
-        with _quiet_sync_cancel():        # a Ctrl-C's known log line of distributed, not shown
-            try:
-                if client is None:
-                    client, report.cluster = _client(workers, scheduler, owned)
+    run_on_dask(run_case, [(case, task, f"slewing-case-{case.key}") for case, task in tasks], report, lost, done,
+                workers=workers, scheduler=scheduler, client=client, progress=progress, total=total,
+                title=study.name)
+
+
+def run_on_dask(function, tasks: list, report: StudyReport, lost: dict, on_result, *, workers: int | None = None,
+                scheduler: str | None = None, client=None, progress: bool = True, total: int | None = None,
+                title: str = "") -> None:
+    """Run ``function(argument)`` on Dask for each ``(case, argument, task_key)`` of ``tasks``, handing each
+    result as it arrives to ``on_result(case, result, client)`` (which writes it).
+
+    The client is ``client``, or one of :func:`dask_client` (``workers``, ``scheduler``), closed at the end;
+    ``report.cluster`` says which, ``report.ran`` gets each case's ``key`` and ``report.wall_time`` the time
+    from the first submission to the last result. A case lost to the cluster itself goes to ``lost``
+    (key -> ``"not finished: <error>"``). ``progress``: a bar titled ``title`` over ``total`` cases (default
+    ``len(tasks)``), those not in ``tasks`` counted as done. A Ctrl-C (KeyboardInterrupt) passes through,
+    after the client and cluster this made are closed.
+    """
+    if not tasks:
+        return
+    from distributed import as_completed
+
+    total = len(tasks) if total is None else total
+    owned = []    # what this run started, closed last made first (the client, then its cluster)
+    bar = None
+    with quiet_sync_cancel():        # a Ctrl-C's known log line of distributed, not shown
+        try:
+            if client is None:
+                client, report.cluster = dask_client(workers, scheduler, owned)
+            else:
+                report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
+            if progress:
+                from ..progress import progress_bar     # a bar on a terminal, plain lines in a file
+
+                bar = progress_bar(total, title, "case", initial=total - len(tasks))
+            by_key = {}
+            start = time.perf_counter()
+            futures = []
+            for case, argument, task_key in tasks:
+                future = client.submit(function, argument, key=task_key, pure=False)
+                by_key[future.key] = case
+                futures.append(future)
+            for future in as_completed(futures):
+                case = by_key[future.key]
+                try:
+                    result = future.result()
+                except Exception as exc:  # noqa: BLE001 - lost to the cluster: not marked finished
+                    lost[case.key] = f"not finished: {one_line(exc)}"
                 else:
-                    report.cluster = f"given client ({len(client.scheduler_info().get('workers', {}))} workers)"
-                if progress:
-                    from ..progress import progress_bar     # a bar on a terminal, plain lines in a file
-
-                    bar = progress_bar(total, study.name, "case", initial=total - len(tasks))
-                by_key = {}
-                start = time.perf_counter()
-                futures = []
-                for case, task in tasks:
-                    future = client.submit(run_case, task, key=f"slewing-case-{case.key}", pure=False)
-                    by_key[future.key] = case
-                    futures.append(future)
-                for future in as_completed(futures):
-                    case = by_key[future.key]
-                    try:
-                        result = future.result()
-                    except Exception as exc:  # noqa: BLE001 - lost to the cluster: not marked finished
-                        lost[case.key] = f"not finished: {one_line(exc)}"
-                    else:
-                        records[case.key] = write_case(out_dir, case, result)
-                        if on_result is not None:
-                            on_result(case, records[case.key], client)
-                    report.ran.append(case.key)
-                    future.release()
-                    if bar is not None:
-                        bar.update(1)
-                report.wall_time = time.perf_counter() - start
-            finally:
+                    on_result(case, result, client)
+                report.ran.append(case.key)
+                future.release()
                 if bar is not None:
-                    bar.close()
-                for thing in reversed(owned):
-                    thing.close()
+                    bar.update(1)
+            report.wall_time = time.perf_counter() - start
+        finally:
+            if bar is not None:
+                bar.close()
+            for thing in reversed(owned):
+                thing.close()
