@@ -99,12 +99,10 @@ def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np
     (DFT) basis, dropping the null space (a free ring's rigid-body modes)."""
     n, m, _ = first_row.shape
     blocks = np.fft.fft(first_row, axis=0)  # block j = sum_k C_k exp(-2 pi i j k / B)
-    top = max(np.abs(np.linalg.eigvalsh(0.5 * (b + b.conj().T))).max() for b in blocks)
-    inv = np.empty_like(blocks)
-    for j, b in enumerate(blocks):
-        w, v = np.linalg.eigh(0.5 * (b + b.conj().T))
-        keep = np.abs(w) > rcond * top
-        inv[j] = (v[:, keep] / w[keep]) @ v[:, keep].conj().T
+    w, v = np.linalg.eigh(0.5 * (blocks + blocks.conj().transpose(0, 2, 1)))   # all blocks at once
+    keep = np.abs(w) > rcond * np.abs(w).max()
+    inverse_w = np.divide(1.0, w, out=np.zeros_like(w), where=keep)          # the null space dropped
+    inv = (v * inverse_w[:, None, :]) @ v.conj().transpose(0, 2, 1)
     row = np.fft.ifft(inv, axis=0).real  # first block row of the pseudo-inverse
     k = (np.arange(n)[None, :] - np.arange(n)[:, None]) % n
     return row[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
