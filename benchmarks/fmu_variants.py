@@ -26,7 +26,10 @@ superelement is cached in both (built before the timing). Instantiation: loading
 ``fmi2Instantiate``, the parameters and initialisation, in the C host. Memory: the C host's resident set
 (VmRSS) after the initialisation less before loading the FMU's binary.
 
-Run: .venv/bin/python -m benchmarks fmu_variants [--steps 1000] [--runs 3]
+``--pair``: the default and the ``--numba`` FMU only, with their builds cached (no cold build), the
+``--numba`` FMU the baseline: the two alternating, as the instantiation and step goals compare them.
+
+Run: .venv/bin/python -m benchmarks fmu_variants [--steps 1000] [--runs 3] [--pair]
 """
 from __future__ import annotations
 
@@ -112,8 +115,13 @@ def run_host(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dic
     return bench_output(out.stdout)
 
 
+PAIR = ("standalone + aot (default)", "standalone + numba")
+
+
 def add_arguments(parser) -> None:
     parser.add_argument("--steps", type=int, default=1000)
+    parser.add_argument("--pair", action="store_true",
+                        help="the default and the --numba FMU only, builds cached, the --numba FMU the baseline")
 
 
 def main(args) -> None:
@@ -122,6 +130,8 @@ def main(args) -> None:
     from slewing_model import load_bearing
     from slewing_model.rings.superelement import build_superelement
 
+    variants = {name: VARIANTS[name] for name in PAIR} if args.pair else VARIANTS
+    reference = "standalone + numba" if args.pair else REFERENCE
     case = CASES["pitch"](args.steps)
     build_superelement(load_bearing(case.bearing), mesh="fine", bc="free")     # cached: not in the build times
     with tempfile.TemporaryDirectory(prefix="bench_runtime_") as tmp:
@@ -130,9 +140,9 @@ def main(args) -> None:
         inputs = tmp / "inputs.txt"
         np.savetxt(inputs, np.column_stack([case.loads, case.psi, case.omega]), fmt="%.17g")
         built, rows_build = {}, []
-        for name, variant in VARIANTS.items():
+        for name, variant in variants.items():
             fmu = tmp / f"{name.replace(' + ', '_').replace(', ', '_')}.fmu"
-            cold = build(variant, fmu, cold=name not in DROPPED)
+            cold = build(variant, fmu, cold=name not in DROPPED and not args.pair)
             warm = build(variant, fmu, cold=False)
             folder = tmp / fmu.stem
             with zipfile.ZipFile(fmu) as z:
@@ -146,14 +156,15 @@ def main(args) -> None:
             refs["guid"] = md.guid
             built[name] = (folder, refs)
             rows_build.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB", f"{raw / 1e6:.0f} MB",
-                               f"{cold:.1f} s" if variant["runtime"] == "standalone" and name not in DROPPED else "—",
+                               f"{cold:.1f} s" if variant["runtime"] == "standalone" and name not in DROPPED
+                               and not args.pair else "—",
                                f"{warm:.1f} s"])
-        times = {name: [] for name in VARIANTS}
-        starts = {name: [] for name in VARIANTS}
-        memory = {name: [] for name in VARIANTS}
+        times = {name: [] for name in variants}
+        starts = {name: [] for name in variants}
+        memory = {name: [] for name in variants}
         finals = {}
         for r in range(args.runs):
-            for name in VARIANTS:
+            for name in variants:
                 folder, refs = built[name]
                 instantiation, steps, final, resident = run_host(host, folder, refs, inputs, case.parameters)
                 starts[name].append(instantiation)
@@ -164,9 +175,9 @@ def main(args) -> None:
           f"C host, PATH=/usr/bin:/bin")
     print_table("FMU variants: size and build", ["FMU", "zipped", "unpacked", "build, runtime staged",
                                                    "build, runtime cached"], rows_build)
-    base = np.median(np.concatenate(times[REFERENCE]))
+    base = np.median(np.concatenate(times[reference]))
     rows = []
-    for name in VARIANTS:
+    for name in variants:
         s = spread(np.concatenate(times[name]) * 1e3)
         record(f"{name} [ms]", s)
         record(f"{name} instantiation [s]", float(np.median(starts[name])))
@@ -176,13 +187,15 @@ def main(args) -> None:
                      f"{s['median'] / (base * 1e3):.2f}"])
     print_table("doStep in the C host (set inputs, doStep, get outputs)",
                 ["FMU", "instantiation", "memory after instantiation", "median", "95th pct", "99th pct",
-                 f"median / {REFERENCE}"], rows)
+                 f"median / {reference}"], rows)
     numba_median = np.median(np.concatenate(times["standalone + numba"]))
     for name in ("standalone + aot (default)", "standalone"):
+        if name not in times:
+            continue
         note(f"median step of {name} / standalone + numba: "
              f"{np.median(np.concatenate(times[name])) / numba_median:.3f}")
-    reference = np.array(finals[REFERENCE])
+    final_reference = np.array(finals[reference])
     for name, final in finals.items():
-        deviation = np.max(np.abs(np.array(final) - reference) / np.maximum(np.abs(reference), 1e-300))
-        note(f"final outputs of {name}: largest relative difference to {REFERENCE}: {deviation:.1e}")
+        deviation = np.max(np.abs(np.array(final) - final_reference) / np.maximum(np.abs(final_reference), 1e-300))
+        note(f"final outputs of {name}: largest relative difference to {reference}: {deviation:.1e}")
 
