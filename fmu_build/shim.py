@@ -37,6 +37,11 @@ PYTHON_RUNTIME_FILE = "python_runtime.txt"
 PYTHON_HOME_VARIABLE = "SLEWING_FMU_PYTHONHOME"
 #: the FMU's table of model variables (read by the layer: fmu_src/shim/shim_rules.h)
 VARIABLES_FILE = "fmi_variables.tsv"
+#: pythonfmu's and pythonfmu3's packages in the FMU import their FMU builder (argparse, zipfile, xml, ...:
+#: 30-40 ms of every instantiation) for ``from pythonfmu import FmuBuilder``, which a running FMU never uses:
+#: the line is left out of their ``__init__.py`` in the FMU
+BUILDER_IMPORT = b"from .builder import FmuBuilder\n"
+RUN_TIME_INITS = ("resources/pythonfmu/__init__.py", "resources/pythonfmu3/__init__.py")
 #: FMI 2.0's type elements of a ScalarVariable
 FMI2_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
 #: the default causality and variability of a variable that states none (FMI 2.0 and 3.0)
@@ -231,6 +236,8 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                         dst.write(inner, f"{folder}/{INNER_BINARY}")
                     elif win64 and info.filename in windows:
                         continue                          # pythonfmu's DLL: written below, behind our layer
+                    elif info.filename in RUN_TIME_INITS:
+                        dst.writestr(info, src.read(info.filename).replace(BUILDER_IMPORT, b""))
                     elif not info.filename.endswith((PYTHON_RUNTIME_FILE, VARIABLES_FILE)):
                         dst.writestr(info, src.read(info.filename))
                 dst.write(shim, binary)

@@ -1,6 +1,7 @@
 """The bearing FMU, driven by fmpy (and by the ecos C++ host): model description,
 outputs against the library, rollback, instances, bad input."""
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -53,6 +54,16 @@ def test_runtime_is_numpy_only(table3_fmu, tmp_path):
         sources = [z.read(n).decode() for n in z.namelist()
                    if n.startswith("resources/") and n.endswith(".py") and "pythonfmu" not in n]
     assert not any("import scipy" in s or "from scipy" in s or "skfem" in s for s in sources)
+
+
+def test_the_fmus_pythonfmu_does_not_import_its_builder(table3_fmu, table3_fmu3):
+    """pythonfmu's FMU builder (argparse, zipfile, xml: 30-40 ms of each instantiation) is not imported by the
+    FMU's copy of pythonfmu, FMI 2.0 and 3.0; its slave classes are (the FMU runs: the tests above)."""
+    for fmu, package in ((table3_fmu, "pythonfmu"), (table3_fmu3, "pythonfmu3")):
+        with zipfile.ZipFile(fmu) as z:
+            init = z.read(f"resources/{package}/__init__.py").decode()
+        assert "from .builder import" not in init, init
+        assert re.search(r"^from \.fmi[23]slave import", init, flags=re.M), init
 
 
 LOADS = {"Fx": 8e3, "Fy": -3e3, "Fz": 3e4, "Mx": 1.5e3, "My": -2.5e3, "psi": 0.4, "omega": 0.05}
