@@ -1,8 +1,8 @@
 """The NREL 5MW in turbulent wind with ROSCO and three electric pitch drives on their pitch bearings.
 
 60 s of IEC class B turbulence (Kaimal, 13 m/s mean at the hub), once with the bearings' friction and once
-without; prints the summary table (pitch tracking, motor torque and duty, rotor speed, friction) and saves
-the time series as a figure.
+without; prints the summary table (pitch tracking, motor torque and duty, rotor speed, friction, x/2b;
+the first 20 s, the start-up, left out: TurbineConfig.settle) and saves the time series as a figure.
 
     nice -n 10 .venv/bin/python examples/turbine_loop.py [--t-end 60] [--rigid] [--results results]
 

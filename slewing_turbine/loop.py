@@ -49,6 +49,12 @@ PITCH_DRIVE = ROOT / "examples" / "drives" / "pitch_drive.toml"
 PITCH_BEARING = ROOT / "examples" / "bearings" / "pitch_bearing.toml"
 #: rated rotor speed of the NREL 5MW turbine, rad/s (12.1 rpm)
 RATED_ROTOR_SPEED = 12.1 * math.pi / 30.0
+#: the settle time the figures leave out by default, s (a run shorter than twice this: its first half): from
+#: ROSCO's ``Sim`` start (10 rpm, 0 deg) the NREL 5MW's start-up transient (overspeed, the blades pitching
+#: at the drives' rate limit) dies down within 10 to 20 s of simulated time
+SETTLE_DEFAULT = 20.0
+#: the pitch an emergency stop demands, rad (ROSCO's ``PC_MaxPit`` of the NREL 5MW: feather, 90 deg)
+FEATHER = math.pi / 2.0
 DRIVES = ("ideal", "electric")
 BEARINGS = (None, "flexible", "rigid")
 AERO = ("cp_table", "bem")
@@ -101,6 +107,9 @@ class TurbineConfig:
         A motor's continuous torque as a share of its peak (``torque_limit``), for the duty figure of
         :func:`summary`. Default 0.4 (ASSUMPTION: servo pitch motors carry 2-3 times their continuous torque
         for seconds; the drive file gives the peak only).
+    settle : float or None
+        s of simulated time :func:`summary` leaves out at the start (the start-up transient); None:
+        :data:`SETTLE_DEFAULT` (20 s), or half the run when it is shorter than 40 s.
     """
 
     turbine_dir: Path = NREL5MW
@@ -124,6 +133,7 @@ class TurbineConfig:
     azimuth_init: float = 0.0
     generator_torque_init: float = 1.0
     continuous_torque_share: float = 0.4
+    settle: float | None = None
 
     def path(self, name: str) -> Path:
         """A file of the turbine (``turbine_dir / name``)."""
@@ -152,7 +162,11 @@ class TurbineResult:
     sliding, held over the step), ``load_moment`` (the drive's load torque), ``root_loads`` (the blade-root
     loads ``Fx, Fy, Fz, Mx, My, Mz`` in the blade frame ``b`` at the step's start), ``bearing_loads`` (their
     first five: what each bearing got), ``root_moop`` (the out-of-plane root moments the controller got),
-    ``step_seconds`` (wall time of the step).
+    ``step_seconds`` (wall time of the step), ``motor_energy`` (each drive's delivered motor energy so far,
+    cumulative, J). With bearings: ``contact_b`` (n, 3, 4), the widest contact patch's semi-axis ``b`` of
+    each contact 1..4 of each blade's bearing at the step (m; 0: unloaded), and ``contact_angle`` at it
+    (rad); ``bearing_geometry`` ``(pitch_diameter, ball_diameter)`` (m). ``settle``: the s left out of the
+    figures (:func:`summary`); ``emergency_stop``: the time of the emergency stop (None: none).
     """
 
     time: np.ndarray
@@ -179,6 +193,12 @@ class TurbineResult:
     drivetrain: object = None
     continuous_torque_share: float = 0.4
     life: list | None = None
+    motor_energy: np.ndarray | None = None
+    contact_b: np.ndarray | None = None
+    contact_angle: np.ndarray | None = None
+    bearing_geometry: tuple | None = None
+    settle: float = 0.0
+    emergency_stop: float | None = None
 
     @property
     def bearing_loads(self) -> np.ndarray:
@@ -212,6 +232,7 @@ class PitchAxis:
         self.drive.state.angle = pitch
         self.bearing = bearing
         self.friction = 0.0
+        self.result = None          # the bearing's last StepResult
 
     def hold(self, load_moment: float) -> None:
         """Start at rest holding ``load_moment`` (N m), as a drive that has held its angle."""
@@ -231,6 +252,7 @@ class PitchAxis:
         if self.bearing is not None:
             r = self.bearing.step(loads, psi=-s.angle, omega=-s.speed)
             self.friction = r.friction_torque_magnitude
+            self.result = r
         return self.drive.step(demand, dt, load_torque=load_moment, friction_torque=self.friction)
 
 
@@ -310,7 +332,8 @@ def out_of_plane(root_loads: np.ndarray, pitch: np.ndarray) -> np.ndarray:
 
 def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = None, dt: float = 0.01,
                 drives: str = "ideal", bearings: str | None = None, friction: bool = True,
-                aero: str = "bem", bearing_simulators: list | None = None, progress: bool = False) -> TurbineResult:
+                aero: str = "bem", bearing_simulators: list | None = None, progress: bool = False,
+                emergency_stop: float | None = None) -> TurbineResult:
     """Run the closed loop over ``wind`` (module docstring: the order of a step).
 
     Parameters
@@ -340,6 +363,12 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
         match ``bearings`` and ``friction``, and carry on from their last state.
     progress : bool
         A progress bar on stderr.
+    emergency_stop : float or None, s
+        From the first controller call at or after this time the pitch demand of every blade is feather
+        (:data:`FEATHER`, 90 deg) and the generator torque is zero (the grid lost with the stop: the worst
+        case for the rotor's speed); the drives pitch at their rate and torque limits against the
+        bearings' friction and the blades' pitching moments. ROSCO is still called (its outputs are
+        overridden). None: no stop.
 
     Returns
     -------
@@ -363,6 +392,8 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
         raise ValueError("bearings need aero = 'bem' (the Cp table gives no blade-root loads)")
     if not (dt > 0 and math.isfinite(dt)):
         raise ValueError(f"dt = {dt!r}: must be a finite number > 0")
+    if emergency_stop is not None and not math.isfinite(emergency_stop):
+        raise ValueError(f"emergency_stop = {emergency_stop!r}: must be a finite time, s")
 
     drivetrain = config.the_drivetrain()
     t0 = float(wind.time[0])
@@ -371,6 +402,7 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
     if n < 2:
         raise ValueError(f"t_end = {t_end!r}: the run needs at least one step of dt = {dt!r} after {t0!r}")
     time = t0 + np.arange(n) * dt
+    settle = resolve_settle(config.settle, float(time[-1] - time[0]))
     wind_time, wind_speed = np.asarray(wind.time, float), np.asarray(wind.speed, float)
     if wind_time.size >= n and np.array_equal(wind_time[:n], time):
         ws = wind_speed[:n].copy()
@@ -393,6 +425,10 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
     demand, pitch, rate, motor, fric, mz, moop = (np.full((n, 3), np.nan) for _ in range(7))
     roots = np.full((n, 3, 6), np.nan)
     step_seconds = np.zeros(n)
+    motor_energy = np.zeros((n, 3)) if drives == "electric" else None
+    stepped = sims[0] is not None
+    contact_b = np.zeros((n, 3, 4)) if stepped else None
+    contact_angle = np.zeros((n, 3, 4)) if stepped else None
     rot[0], azimuth[0], gen_torque[0] = config.rotor_speed_init, config.azimuth_init, config.generator_torque_init
     demand[0] = pitch[0] = config.pitch_init
     rate[0] = 0.0
@@ -437,6 +473,9 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
                     s = axis.step(float(demand[i - 1, k]), dt, loads, load_moment)
                     pitch[i, k], rate[i, k], motor[i, k] = s.angle, s.speed, s.mean_motor_torque
                     fric[i, k], mz[i, k] = axis.friction, load_moment
+                    motor_energy[i, k] = axis.drive.state.motor_energy
+                    if stepped:
+                        contact_b[i, k], contact_angle[i, k] = widest_contacts(axis.result.distribution)
             # 4. controller: the new speed, the measured pitch
             m = Measurements(time=time[i], rotor_speed=rot[i], generator_speed=rot[i] * drivetrain.gear_ratio,
                              generator_torque=gen_torque[i - 1], blade_pitch=pitch[i].copy(), wind_speed=ws[i],
@@ -445,6 +484,9 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
             c = controller.step(m, last=i == n - 1)
             gen_torque[i] = c.generator_torque
             demand[i] = c.pitch
+            if emergency_stop is not None and time[i] >= emergency_stop - 1e-9 * dt:
+                gen_torque[i] = 0.0
+                demand[i] = FEATHER
             step_seconds[i] = _time.perf_counter() - start
 
     energies = rotor_energies(time, rot, aero_torque, gen_torque, drivetrain)
@@ -453,9 +495,34 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
     life = None
     if sims[0] is not None and sims[0].life is not None:
         life = [s.life for s in sims]
+    geometry = None
+    if stepped:
+        b = sims[0].bearing
+        geometry = (float(b.pitch_diameter), float(b.ball_diameter))
     return TurbineResult(time, ws, rot, azimuth, gen_torque, aero_torque, demand, pitch, rate, motor, fric, mz,
                          roots, moop, step_seconds, energies, drives, bearings, aero, friction, params, drivetrain,
-                         config.continuous_torque_share, life)
+                         config.continuous_torque_share, life, motor_energy, contact_b, contact_angle, geometry,
+                         settle, emergency_stop)
+
+
+def resolve_settle(settle: float | None, duration: float) -> float:
+    """The settle time of a run of ``duration`` s: ``settle`` (it must leave a window: ``0 <= settle <
+    duration``), or None: :data:`SETTLE_DEFAULT`, at most half the run."""
+    if settle is None:
+        return min(SETTLE_DEFAULT, 0.5 * duration)
+    settle = float(settle)
+    if not (math.isfinite(settle) and 0.0 <= settle < duration):
+        raise ValueError(f"settle = {settle!r} s: must be >= 0 and shorter than the run ({duration:g} s)")
+    return settle
+
+
+def widest_contacts(distribution) -> tuple:
+    """The widest patch's semi-axis ``b`` (m) of each contact 1..4 over the balls, and its contact angle
+    (rad), as :class:`slewing_model.life.LifeAccumulator` takes them for ``x/2b``."""
+    b = np.asarray(distribution.semi_axis_b, dtype=float)
+    j = np.argmax(b, axis=0)
+    cols = np.arange(b.shape[1])
+    return b[j, cols], np.asarray(distribution.contact_angle, dtype=float)[j, cols]
 
 
 # ---- energies ----------------------------------------------------------------------------------------
@@ -511,8 +578,94 @@ def drive_energies(axes, pitch, rate, motor_torque, friction, load_moment, param
 
 # ---- the figures -------------------------------------------------------------------------------------
 
-def summary(result: TurbineResult) -> dict:
-    """The figures of a run (the keys name their units).
+def settle_index(result: TurbineResult, settle: float | None = None) -> int:
+    """The first sample of the figures' window: the first at or after ``time[0] + settle`` (None: the run's
+    ``result.settle``)."""
+    r = result
+    settle = r.settle if settle is None else float(settle)
+    duration = float(r.time[-1] - r.time[0])
+    if not (math.isfinite(settle) and 0.0 <= settle < duration):
+        raise ValueError(f"settle = {settle!r} s: must be >= 0 and shorter than the run ({duration:g} s)")
+    return int(np.searchsorted(r.time, r.time[0] + settle - 1e-9 * r.dt))
+
+
+def window_energies(result: TurbineResult, i0: int) -> dict:
+    """:func:`rotor_energies` and the drives' energies (:func:`drive_energies`' keys) over the samples
+    ``i0 ...`` (the steps ending after ``time[i0]``); the motors' delivered energy from the cumulative
+    ``motor_energy``."""
+    r = result
+    out = rotor_energies(r.time[i0:], r.rotor_speed[i0:], r.aero_torque[i0:], r.generator_torque[i0:],
+                         r.drivetrain)
+    if r.drives == "electric":
+        p = r.drive_params
+        dpitch = np.diff(r.pitch[i0:], axis=0)
+        steps = slice(i0 + 1, None)
+        ring_work = np.nansum(p.torque_gain * r.motor_torque[steps] * dpitch, axis=0)
+        fric = np.nansum(r.friction_torque[steps] * np.abs(dpitch), axis=0)
+        load = np.nansum(r.load_moment[steps] * dpitch, axis=0)
+        kinetic = 0.5 * p.inertia * (r.pitch_rate[-1] ** 2 - r.pitch_rate[i0] ** 2)
+        motor = (r.motor_energy[-1] - r.motor_energy[i0] if r.motor_energy is not None
+                 else np.asarray(r.energies["motor"]))
+        out.update(motor=motor, ring_work=ring_work, friction=fric, load_moment=load,
+                   drive_kinetic_change=kinetic, drive_residual=ring_work - fric - load - kinetic)
+    return out
+
+
+def wear_cycles(result: TurbineResult, blade: int, i0: int = 0) -> tuple:
+    """The rainflow cycles of a blade's pitch over the samples ``i0 ...`` and each cycle's ``x/2b`` (the
+    smallest over the loaded contacts), as :func:`slewing_model.life.analyse_run` takes them: the ring's
+    swing (:func:`~slewing_model.life.oscillation.rainflow_cycles`, cycles not above the reversal
+    tolerance left out), the rolling travel ``x`` of each contact
+    (:func:`~slewing_model.life.wear.rolling_travel`) at its widest patch ``2b`` over the cycle.
+
+    Returns
+    -------
+    swing (rad), count (1 or 0.5), ratio (x/2b; inf: no contact loaded), counted (bool: not a micro-cycle,
+    :data:`slewing_model.life.duty.MICRO_CYCLE_STEPS` of the series' angle resolution)
+    """
+    from slewing_model.life.duty import DEFAULT_REVERSAL_TOLERANCE, MICRO_CYCLE_STEPS, angle_resolution
+    from slewing_model.life.oscillation import rainflow_cycles
+    from slewing_model.life.wear import rolling_travel
+
+    r = result
+    if r.contact_b is None:
+        raise ValueError("x/2b needs the bearings' contact patches: a run with bearings")
+    psi = -r.pitch[i0:, blade]                       # the ring angle (the blade turns by minus its pitch)
+    cyc = rainflow_cycles(psi, min_swing=DEFAULT_REVERSAL_TOLERANCE)
+    b, angle = r.contact_b[i0:, blade], r.contact_angle[i0:, blade]
+    dm, dw = r.bearing_geometry
+    ratio = np.full(cyc.swing.size, np.inf)
+    cols = np.arange(4)
+    for j, (s, e) in enumerate(zip(cyc.start, cyc.end)):
+        bb = b[s:e + 1]
+        k = np.argmax(bb, axis=0)
+        bmax, a = bb[k, cols], angle[s:e + 1][k, cols]
+        loaded = bmax > 0
+        if np.any(loaded):
+            ratio[j] = float(np.min(rolling_travel(cyc.swing[j], dm, dw, a[loaded]) / (2.0 * bmax[loaded])))
+    micro = max(DEFAULT_REVERSAL_TOLERANCE, MICRO_CYCLE_STEPS * angle_resolution(psi))
+    return cyc.swing, cyc.count, ratio, cyc.swing >= micro
+
+
+def wear_shares(result: TurbineResult, blade: int, i0: int = 0) -> dict:
+    """A blade's pitch oscillations by their ``x/2b`` (:func:`wear_cycles`), shares of the counted cycles
+    (by count, micro-cycles left out; NaN without cycles): ``x/2b < 1`` (part of the patch never uncovered:
+    false brinelling, standstill marks) and ``x/2b >= 1`` (the ball rolls off its patch: wear from grease
+    starvation is the risk); and the number of counted cycles."""
+    swing, count, ratio, counted = wear_cycles(result, blade, i0)
+    total = float(count[counted].sum())
+    below = float(count[counted & (ratio < 1.0)].sum() / total) if total else math.nan
+    return {"cycles": total, "below": below, "above": 1.0 - below if total else math.nan}
+
+
+def summary(result: TurbineResult, settle: float | None = None) -> dict:
+    """The figures of a run (the keys name their units), over the window after the settle time.
+
+    ``settle`` (s, None: the run's ``result.settle``, :attr:`TurbineConfig.settle`) of simulated time is
+    left out of every figure: the start-up transient from ``Sim``'s start. The window's energies are those
+    of its steps (the motors' delivered energy from the cumulative ``motor_energy``). Whole-run figures:
+    the bearing map damage and life (the accumulators run from the start) and the wall time per simulated
+    second.
 
     * pitch tracking error: demand of the last call minus the blades' angle at the next sample, per blade
       (``demand[i-1] - pitch[i]``: what the drive did not reach in the step it had), RMS and largest over
@@ -521,19 +674,25 @@ def summary(result: TurbineResult) -> dict:
     * the motors' energy (all blades) and their **duty**: the share of the time a motor's torque exceeds its
       continuous torque (``continuous_torque_share`` of its peak, see :class:`TurbineConfig`), largest over
       the blades; the RMS torque over the peak torque; and the **actuator duty cycle** (ADC, as in pitch
-      control studies): the pitch travel over the travel at the rate limit for the whole run;
+      control studies): the pitch travel over the travel at the rate limit for the window;
     * rotor speed: standard deviation, and the overspeed: the largest speed above rated (12.1 rpm), %;
     * the bearing friction torque: mean and peak (largest over the blades);
+    * with bearings: the share of the pitch oscillations with ``x/2b < 1`` (:func:`wear_shares`), largest
+      over the blades;
+    * with an emergency stop inside the window: the time from the stop until every blade is within 1 deg
+      of feather (NaN: not reached), and the rotor's speed at the stop and at the end;
     * the rotor's energy balance residual over the aero energy.
     """
     r = result
-    d = slice(1, None)                       # the steps (index 0 is the start)
-    out = {}
-    error = r.pitch_demand[:-1] - r.pitch[1:]
+    i0 = settle_index(r, settle)
+    d = slice(i0 + 1, None)                  # the window's steps (ending after time[i0])
+    out = {"settle time [s]": float(r.time[i0] - r.time[0])}
+    error = r.pitch_demand[i0:-1] - r.pitch[i0 + 1:]
     out["pitch tracking error RMS [deg]"] = float(np.degrees(np.sqrt(np.mean(error**2))))
     out["pitch tracking error max [deg]"] = float(np.degrees(np.max(np.abs(error))))
-    duration = float(r.time[-1] - r.time[0])
-    travel = np.sum(np.abs(np.diff(r.pitch, axis=0)), axis=0)
+    duration = float(r.time[-1] - r.time[i0])
+    energies = window_energies(r, i0)
+    travel = np.sum(np.abs(np.diff(r.pitch[i0:], axis=0)), axis=0)
     out["pitch travel [deg]"] = float(np.degrees(np.max(travel)))
     if r.drives == "electric":
         p = r.drive_params
@@ -545,31 +704,58 @@ def summary(result: TurbineResult) -> dict:
             100.0 * np.max(np.mean(torque > r.continuous_torque_share * p.torque_limit, axis=0)))
         out["time at torque limit [%]"] = float(
             100.0 * np.max(np.mean(torque >= (1.0 - 1e-6) * p.torque_limit, axis=0)))
-        out["drive energy [kJ]"] = float(np.sum(r.energies["motor"]) / 1e3)
-        out["load moment work [kJ]"] = float(np.sum(r.energies["load_moment"]) / 1e3)
+        out["drive energy [kJ]"] = float(np.sum(energies["motor"]) / 1e3)
+        out["load moment work [kJ]"] = float(np.sum(energies["load_moment"]) / 1e3)
         out["actuator duty cycle [%]"] = float(100.0 * np.max(travel) / (p.rate_limit * duration))
         out["friction torque mean [kN m]"] = float(np.mean(r.friction_torque[d]) / 1e3)
         out["friction torque peak [kN m]"] = float(np.max(r.friction_torque[d]) / 1e3)
-        out["friction energy [kJ]"] = float(np.sum(r.energies["friction"]) / 1e3)
-    rpm = r.rotor_speed * 30.0 / math.pi
+        out["friction energy [kJ]"] = float(np.sum(energies["friction"]) / 1e3)
+    if r.contact_b is not None:
+        shares = [wear_shares(r, k, i0)["below"] for k in range(3)]
+        finite = [x for x in shares if math.isfinite(x)]
+        out["x/2b below 1, worst blade [%]"] = 100.0 * max(finite) if finite else math.nan
+    rpm = r.rotor_speed[i0:] * 30.0 / math.pi
     out["rotor speed mean [rpm]"] = float(np.mean(rpm))
     out["rotor speed std [rpm]"] = float(np.std(rpm))
-    out["overspeed [%]"] = float(max(0.0, 100.0 * (r.rotor_speed.max() / RATED_ROTOR_SPEED - 1.0)))
-    out["electrical energy [kWh]"] = r.energies["electrical"] / 3.6e6
-    out["rotor energy residual / aero energy"] = r.energies["rotor_residual"] / r.energies["aero"]
+    out["overspeed [%]"] = float(max(0.0, 100.0 * (r.rotor_speed[i0:].max() / RATED_ROTOR_SPEED - 1.0)))
+    out["electrical energy [kWh]"] = energies["electrical"] / 3.6e6
+    out["rotor energy residual / aero energy"] = (energies["rotor_residual"] / energies["aero"]
+                                                  if energies["aero"] != 0 else math.nan)
+    if r.emergency_stop is not None and r.emergency_stop >= r.time[i0] and r.emergency_stop <= r.time[-1]:
+        out.update({f"{k} [{u}]": v for (k, u), v in zip(
+            (("time to feather", "s"), ("rotor speed at stop", "rpm"), ("rotor speed at end", "rpm")),
+            emergency_stop_figures(r))})
     if r.life is not None:
         damage = [a.worst_damage for a in r.life]
+        whole = float(r.time[-1] - r.time[0])
         out["bearing map damage, worst blade"] = float(max(damage))
-        out["bearing map life, worst blade [h]"] = (duration / max(damage) / 3600.0 if max(damage) > 0
+        out["bearing map life, worst blade [h]"] = (whole / max(damage) / 3600.0 if max(damage) > 0
                                                     else math.inf)
-    seconds = r.step_seconds[d]
-    out["seconds per simulated second"] = float(seconds.sum() / duration)
+    seconds = r.step_seconds[1:]
+    out["seconds per simulated second"] = float(seconds.sum() / float(r.time[-1] - r.time[0]))
     return out
 
 
-def summary_table(results: dict) -> str:
+def emergency_stop_figures(result: TurbineResult, within: float = math.radians(1.0)) -> tuple:
+    """After the emergency stop: the time (s) until every blade is within ``within`` (rad) of feather and
+    stays there (NaN: not reached by the end), and the rotor speed (rpm) at the stop and at the end."""
+    r = result
+    i_stop = int(np.searchsorted(r.time, r.emergency_stop - 1e-9 * r.dt))
+    near = np.all(r.pitch >= FEATHER - within, axis=1)
+    later = near[i_stop:]
+    if not later[-1]:
+        t_feather = math.nan
+    else:
+        last_off = np.flatnonzero(~later)
+        first = int(last_off[-1]) + 1 if last_off.size else 0
+        t_feather = float(r.time[i_stop + first] - r.time[i_stop])
+    rpm = r.rotor_speed * 30.0 / math.pi
+    return t_feather, float(rpm[i_stop]), float(rpm[-1])
+
+
+def summary_table(results: dict, settle: float | None = None) -> str:
     """Markdown table of :func:`summary` for named results (``{"friction on": r1, "friction off": r2}``)."""
-    sums = {name: summary(r) for name, r in results.items()}
+    sums = {name: summary(r, settle) for name, r in results.items()}
     keys = list(dict.fromkeys(k for s in sums.values() for k in s))
     lines = ["| quantity | " + " | ".join(sums) + " |", "|---|" + "---|" * len(sums)]
     for k in keys:

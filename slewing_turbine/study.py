@@ -61,7 +61,7 @@ from slewing_model.bearing.conventions import definition_message
 from .turbine_file import TABLES, TurbineCase, TurbineDefinitionError, load_turbine
 
 #: bump when a case's numbers change for the same inputs (reruns then recompute)
-CASE_FORMAT = 1
+CASE_FORMAT = 2
 STUDY_RECORD = "study.json"
 #: a case's time series (SI; per blade k = 1, 2, 3)
 TIMESERIES_COLUMNS = (("time_s", "wind_m_s", "rotor_speed_rad_s", "generator_torque_Nm", "aero_torque_Nm")
@@ -87,28 +87,38 @@ def column_name(key: str) -> str:
     return f"{name}_{unit}" if unit else name
 
 
-def summary_row(result) -> dict:
-    """The figures of a run as a row (column name -> number): :func:`slewing_turbine.loop.summary`, then per
-    blade (``_1``, ``_2``, ``_3``) the pitch tracking error RMS, the motor torque peak and RMS, the drive
-    energy, the friction torque mean and peak and, with life, the bearing's largest raceway damage; and the
-    wind's mean and standard deviation."""
-    from .loop import summary
+def summary_row(result, settle: float | None = None) -> dict:
+    """The figures of a run as a row (column name -> number), over the window after the settle time
+    (``settle``, None: the run's; :func:`slewing_turbine.loop.summary`): the summary, then per blade
+    (``_1``, ``_2``, ``_3``) the pitch tracking error RMS, the motor torque peak and RMS, the drive energy,
+    the friction torque mean and peak; with bearings, the pitch oscillations by ``x/2b``
+    (:func:`slewing_turbine.loop.wear_shares`: the counted rainflow cycles and the shares with ``x/2b < 1``
+    and ``>= 1``, %); with life, the bearing's largest raceway damage (whole run); and the wind's mean and
+    standard deviation over the window."""
+    from .loop import settle_index, summary, wear_shares, window_energies
 
-    row = {column_name(k): float(v) for k, v in summary(result).items()}
     r = result
-    row["wind_mean_m_s"] = float(np.mean(r.wind))
-    row["wind_std_m_s"] = float(np.std(r.wind))
-    error = r.pitch_demand[:-1] - r.pitch[1:]
+    i0 = settle_index(r, settle)
+    row = {column_name(k): float(v) for k, v in summary(r, settle).items()}
+    row["wind_mean_m_s"] = float(np.mean(r.wind[i0:]))
+    row["wind_std_m_s"] = float(np.std(r.wind[i0:]))
+    error = r.pitch_demand[i0:-1] - r.pitch[i0 + 1:]
+    motor = window_energies(r, i0).get("motor")
     for k in range(3):
         b = k + 1
         row[f"pitch_tracking_error_rms_deg_{b}"] = float(np.degrees(np.sqrt(np.mean(error[:, k] ** 2))))
         if r.drives == "electric":
-            torque = np.abs(r.motor_torque[1:, k])
+            torque = np.abs(r.motor_torque[i0 + 1:, k])
             row[f"motor_torque_peak_Nm_{b}"] = float(torque.max())
             row[f"motor_torque_rms_Nm_{b}"] = float(np.sqrt(np.mean(torque ** 2)))
-            row[f"drive_energy_kJ_{b}"] = float(r.energies["motor"][k] / 1e3)
-            row[f"friction_torque_mean_kNm_{b}"] = float(np.mean(r.friction_torque[1:, k]) / 1e3)
-            row[f"friction_torque_peak_kNm_{b}"] = float(np.max(r.friction_torque[1:, k]) / 1e3)
+            row[f"drive_energy_kJ_{b}"] = float(motor[k] / 1e3)
+            row[f"friction_torque_mean_kNm_{b}"] = float(np.mean(r.friction_torque[i0 + 1:, k]) / 1e3)
+            row[f"friction_torque_peak_kNm_{b}"] = float(np.max(r.friction_torque[i0 + 1:, k]) / 1e3)
+        if r.contact_b is not None:
+            w = wear_shares(r, k, i0)
+            row[f"oscillations_{b}"] = w["cycles"]
+            row[f"x2b_below_1_pct_{b}"] = 100.0 * w["below"]
+            row[f"x2b_above_1_pct_{b}"] = 100.0 * w["above"]
         if r.life is not None:
             row[f"bearing_damage_{b}"] = float(r.life[k].worst_damage)
     return row
@@ -465,7 +475,7 @@ def run_turbine_study(study, out_dir, *, workers: int | None = None, scheduler: 
 # ---- the study's figure ------------------------------------------------------------------------------
 
 #: the first column of :func:`summary_row` (the summary's columns: case, status, name, the axes, the figures)
-FIRST_FIGURE = "pitch_tracking_error_rms_deg"
+FIRST_FIGURE = "settle_time_s"
 #: the figures :func:`study_figure` shows (column, label)
 FIGURE_COLUMNS = (("pitch_tracking_error_rms_deg", "pitch tracking error RMS [deg]"),
                   ("motor_torque_rms_Nm", "motor torque RMS [N m]"),
@@ -474,7 +484,8 @@ FIGURE_COLUMNS = (("pitch_tracking_error_rms_deg", "pitch tracking error RMS [de
                   ("time_above_continuous_torque_pct", "time above continuous torque [%]"),
                   ("friction_torque_mean_kNm", "friction torque mean [kN m]"),
                   ("rotor_speed_std_rpm", "rotor speed std [rpm]"),
-                  ("overspeed_pct", "overspeed [%]"))
+                  ("overspeed_pct", "overspeed [%]"),
+                  ("x_2b_below_1_worst_blade_pct", "oscillations x/2b < 1, worst blade [%]"))
 
 
 def read_summary(path) -> list[dict]:
@@ -543,7 +554,7 @@ def study_figure(summary_csv, png) -> str | None:
 
 def _axes(header: list) -> list:
     """The axes' columns of a summary: between ``name`` and the first figure (:func:`summary_row`)."""
-    first = FIRST_FIGURE if FIRST_FIGURE in header else "elapsed_s"
+    first = next((c for c in (FIRST_FIGURE, "pitch_tracking_error_rms_deg") if c in header), "elapsed_s")
     return header[header.index("name") + 1:header.index(first)]
 
 

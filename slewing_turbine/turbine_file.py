@@ -19,6 +19,7 @@ the file's folder)::
     [controller]
     ipc = false                         # individual pitch control (1P): IPC_ControlMode 1 with ipc_ki
     ipc_ki = [1e-8, 0.0]                # IPC_KI (1P, 2P) when ipc = true; optional ipc_kp likewise
+    emergency_stop_s = 30.0             # optional: from this time on, feather (90 deg) and no generator torque
     [controller.overrides]              # any other parameter of DISCON.IN, by its name
     PC_MaxRat = 0.1396
 
@@ -49,6 +50,7 @@ the file's folder)::
     dt_s = 0.01                         # the loop's and the controller's step
     rotor_speed_init_rpm = 10.0         # optional: the start (ROSCO's Sim: 10 rpm, 0 deg)
     pitch_init_deg = 0.0
+    settle_s = 20.0                     # optional: s left out of the figures (default 20 s, at most half the run)
 
 Every table refuses a key it does not know, and every value is checked when the file is read: the message
 names the file, the key, the value and the rule (:class:`TurbineDefinitionError`, a :class:`ValueError`).
@@ -72,12 +74,12 @@ from slewing_model.bearing.conventions import definition_message
 TABLES = {
     "case": ("name", "description"),
     "turbine": ("directory", "discon", "cp_table", "rotor", "aero", "hub_height_m", "shear_exponent"),
-    "controller": ("ipc", "ipc_ki", "ipc_kp", "overrides"),
+    "controller": ("ipc", "ipc_ki", "ipc_kp", "emergency_stop_s", "overrides"),
     "pitch": ("drives", "drive", "bearing", "ring_model", "mesh", "friction", "friction_coefficient",
               "seal_torque_Nm", "life", "step_work", "drive_substeps", "continuous_torque_share"),
     "wind": ("kind", "speed_m_s", "seed", "turbulence_class", "wind_class", "speed_after_m_s", "step_time_s",
              "gust_start_s", "file"),
-    "simulation": ("t_end_s", "dt_s", "rotor_speed_init_rpm", "pitch_init_deg"),
+    "simulation": ("t_end_s", "dt_s", "rotor_speed_init_rpm", "pitch_init_deg", "settle_s"),
 }
 #: the wind keys each kind takes (``kind`` itself aside)
 WIND_KEYS = {
@@ -213,6 +215,10 @@ class TurbineCase:
         ``kind`` and its values (SI; ``file`` absolute).
     t_end, dt : float, s
     rotor_speed_init, pitch_init : float or None, rad/s, rad (None: the loop's default)
+    settle : float or None, s
+        Left out of the figures (None: the loop's default, :data:`slewing_turbine.loop.SETTLE_DEFAULT`).
+    emergency_stop : float or None, s
+        The emergency stop's time (None: none).
     """
 
     name: str
@@ -244,6 +250,8 @@ class TurbineCase:
     dt: float
     rotor_speed_init: float | None = None
     pitch_init: float | None = None
+    settle: float | None = None
+    emergency_stop: float | None = None
     data: dict = field(default_factory=dict, repr=False)
 
     # ---- what the loop takes ----
@@ -266,7 +274,7 @@ class TurbineCase:
                   drive=Path(self.drive), drive_substeps=self.drive_substeps, bearing=Path(self.bearings[0]),
                   mesh=self.mesh, friction_coefficient=self.friction_coefficient, seal_torque=self.seal_torque,
                   life=self.life, hub_height=self.hub_height, shear_exponent=self.shear_exponent,
-                  continuous_torque_share=self.continuous_torque_share)
+                  continuous_torque_share=self.continuous_torque_share, settle=self.settle)
         if self.rotor_speed_init is not None:
             kw["rotor_speed_init"] = self.rotor_speed_init
         if self.pitch_init is not None:
@@ -317,7 +325,8 @@ class TurbineCase:
             sims = [loop.make_bearings(dataclasses.replace(config, bearing=Path(f)), bearings, self.friction, 1)[0]
                     for f in self.bearings]
         return loop.run_turbine(config, wind, t_end=self.t_end, dt=self.dt, drives=self.drives, bearings=bearings,
-                                friction=self.friction, aero=self.aero, bearing_simulators=sims, progress=progress)
+                                friction=self.friction, aero=self.aero, bearing_simulators=sims, progress=progress,
+                                emergency_stop=self.emergency_stop)
 
     def describe(self) -> dict:
         """The case as plain data (JSON): every setting, paths absolute."""
@@ -425,6 +434,8 @@ def turbine_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
         overrides["IPC_KI"] = _gains(controller, "controller.ipc_ki", list(IPC_KI_DEFAULT))
         if "ipc_kp" in controller:
             overrides["IPC_KP"] = _gains(controller, "controller.ipc_kp", None)
+    emergency_stop = (_number(controller, "controller.emergency_stop_s", minimum=0.0)
+                      if "emergency_stop_s" in controller else None)
     raw = controller.get("overrides", {})
     if not isinstance(raw, Mapping):
         _fail("controller.overrides", raw, "must be a table of DISCON.IN parameters")
@@ -524,6 +535,12 @@ def turbine_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
                                                           f"{t_end:g}")
     rotor_speed_init = (_number(simulation, "simulation.rotor_speed_init_rpm", minimum=0.0) * math.pi / 30.0
                         if "rotor_speed_init_rpm" in simulation else None)
+    settle = (_number(simulation, "simulation.settle_s", minimum=0.0) if "settle_s" in simulation else None)
+    if settle is not None and settle >= t_end:
+        _fail("simulation.settle_s", settle, f"must be shorter than simulation.t_end_s = {t_end:g} (the figures' "
+                                             f"window is what follows it)")
+    if emergency_stop is not None and emergency_stop >= t_end:
+        _fail("controller.emergency_stop_s", emergency_stop, f"must lie before simulation.t_end_s = {t_end:g}")
     pitch_init = (math.radians(_number(simulation, "simulation.pitch_init_deg", minimum=-10.0, maximum=90.0))
                   if "pitch_init_deg" in simulation else None)
 
@@ -533,7 +550,8 @@ def turbine_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
                        drives=drives, drive=drive_paths[0], bearings=bearing_paths, ring_model=ring_model, mesh=mesh,
                        friction=friction, friction_coefficient=mu, seal_torque=seal, life=life, step_work=step_work,
                        drive_substeps=substeps, continuous_torque_share=share, wind=spec, t_end=t_end, dt=dt,
-                       rotor_speed_init=rotor_speed_init, pitch_init=pitch_init, data=copy.deepcopy(dict(data)))
+                       rotor_speed_init=rotor_speed_init, pitch_init=pitch_init, settle=settle,
+                       emergency_stop=emergency_stop, data=copy.deepcopy(dict(data)))
 
 
 def _repo_examples() -> str:

@@ -234,8 +234,17 @@ def test_summary_reports_the_figures(frictionless_run):
         assert math.isfinite(s[key]), key
     assert s["friction torque peak [kN m]"] == 0.0
     assert s["motor torque peak [N m]"] <= frictionless_run.drive_params.torque_limit * (1 + 1e-12)
+    # the default settle time: half of this 6 s run (20 s in a run of 40 s or more)
+    assert frictionless_run.settle == 3.0 and s["settle time [s]"] == pytest.approx(3.0)
     rpm = frictionless_run.rotor_speed * 30 / math.pi
-    assert s["overspeed [%]"] == pytest.approx(max(0.0, 100 * (rpm.max() / 12.1 - 1)))
+    window = frictionless_run.time >= 3.0 - 1e-9
+    assert s["overspeed [%]"] == pytest.approx(max(0.0, 100 * (rpm[window].max() / 12.1 - 1)))
+    whole = loop.summary(frictionless_run, settle=0.0)
+    assert whole["overspeed [%]"] == pytest.approx(max(0.0, 100 * (rpm.max() / 12.1 - 1)))
+    # the whole run's drive energy is the drives' own count; the window's is its part of it
+    assert whole["drive energy [kJ]"] == pytest.approx(np.sum(frictionless_run.energies["motor"]) / 1e3, rel=1e-12)
+    assert 0.0 <= s["drive energy [kJ]"] <= whole["drive energy [kJ]"]
+    assert abs(s["rotor energy residual / aero energy"]) < 1e-9            # the window's balance closes too
 
 
 def test_bad_options_are_refused(wind30):

@@ -43,6 +43,7 @@ speed_m_s = 13.0
 [simulation]
 t_end_s = {T_END}
 rotor_speed_init_rpm = 12.1
+settle_s = 1.0
 """
 
 
@@ -68,6 +69,7 @@ def test_example_turbine_file_reads():
     assert case.wind == {"kind": "kaimal", "speed_m_s": 13.0, "seed": 1, "turbulence_class": "B"}
     assert case.bearings == [str(ROOT / "examples" / "bearings" / "pitch_bearing_nrel5mw.toml")] * 3
     assert case.discon_overrides == {}
+    assert case.settle == 20.0 and case.config().settle == 20.0 and case.emergency_stop is None
     ipc = load_turbine(EXAMPLE, overrides={"controller.ipc": True})
     assert ipc.discon_overrides == {"IPC_ControlMode": 1, "IPC_KI": [1e-8, 0.0]}
     wind = case.wind_series()
@@ -88,6 +90,10 @@ def test_example_turbine_file_reads():
      ["controller.overrides.PC_MaxRate", "no parameter 'PC_MaxRate'", "did you mean 'PC_MaxRat'"]),
     (("[pitch]", "[controller]\nipc_ki = [1e-8, 0.0]\n[pitch]"), ["controller.ipc_ki", "only with controller.ipc"]),
     (("[turbine]", '[turbine]\naero = "cp_table"'), ["pitch.ring_model", "turbine.aero = 'bem'"]),
+    (("settle_s = 1.0", f"settle_s = {T_END}"), ["simulation.settle_s", "shorter than simulation.t_end_s"]),
+    (("settle_s = 1.0", "settle_s = -1.0"), ["simulation.settle_s", "must be >= 0"]),
+    (("[pitch]", "[controller]\nemergency_stop_s = 9.0\n[pitch]"),
+     ["controller.emergency_stop_s", "before simulation.t_end_s"]),
 ])
 def test_turbine_file_refuses_bad_keys_and_values(tmp_path, change, words):
     old, new = change
@@ -111,7 +117,7 @@ def test_example_study_has_24_distinct_cases():
     assert len(study.cases) == 24 == len({c.key for c in study.cases})
     assert {(c.case.wind["speed_m_s"], c.case.wind["seed"], c.case.ipc, c.case.friction) for c in study.cases} == {
         (v, s, i, f) for v in (8.0, 13.0, 18.0) for s in (1, 2) for i in (False, True) for f in (False, True)}
-    assert all(c.case.t_end == 60.0 for c in study.cases)
+    assert all(c.case.t_end == 60.0 and c.case.settle == 20.0 for c in study.cases)
     again = load_turbine_study(EXAMPLE_STUDY)
     assert [c.key for c in again.cases] == [c.key for c in study.cases]   # keys do not depend on the run
 
@@ -173,7 +179,13 @@ def test_study_writes_its_folder_and_friction_costs_drive_energy(study_run):
     assert float(on["friction_torque_mean_kNm"]) > 1.0                  # kN m, each blade's bearing turning
     assert float(on["friction_energy_kJ"]) > 0.0 == float(off["friction_energy_kJ"])
     assert float(on["drive_energy_kJ"]) > float(off["drive_energy_kJ"])   # the drives pay for the friction
-    assert float(on["pitch_travel_deg"]) > 5.0                             # pitching towards feather
+    assert float(on["pitch_travel_deg"]) > 2.0                             # pitching towards feather
+    assert float(on["settle_time_s"]) == float(off["settle_time_s"]) == 1.0
+    # the pitch oscillations by x/2b, per blade: only where a bearing was stepped (friction on)
+    for b in (1, 2, 3):
+        assert off[f"x2b_below_1_pct_{b}"] == "" and float(on[f"oscillations_{b}"]) >= 0.5
+        shares = float(on[f"x2b_below_1_pct_{b}"]) + float(on[f"x2b_above_1_pct_{b}"])
+        assert shares == pytest.approx(100.0)
     assert report.figures and Path(report.figures[0]).is_file()
     assert json.loads((folder / "out" / "study.json").read_text())["name"] == "two"
 
