@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the NREL 5MW turbine's files (copies of ROSCO 2.10.6's case, Apache-2.0: their README)
 NREL5MW = ROOT / "examples" / "turbines" / "nrel5mw"
 #: the pitch drive and pitch bearing of the examples
-PITCH_DRIVE = ROOT / "examples" / "drives" / "pitch_drive.toml"
+PITCH_DRIVE = ROOT / "examples" / "drives" / "pitch_drive_nrel5mw.toml"
 PITCH_BEARING = ROOT / "examples" / "bearings" / "pitch_bearing.toml"
 #: rated rotor speed of the NREL 5MW turbine, rad/s (12.1 rpm)
 RATED_ROTOR_SPEED = 12.1 * math.pi / 30.0
@@ -79,7 +79,7 @@ class TurbineConfig:
     drivetrain : Drivetrain or None
         The rotor's 1-DOF drivetrain; None: :meth:`Drivetrain.from_nrel5mw`.
     drive : DriveParameters or path
-        Each blade's pitch drive (default ``examples/drives/pitch_drive.toml``).
+        Each blade's pitch drive (default ``examples/drives/pitch_drive_nrel5mw.toml``: two motors).
     drive_substeps : int
         Inner steps of a drive per loop step (:class:`~slewing_drives.ElectricDrive`).
     bearing : path

@@ -25,7 +25,7 @@ the file's folder)::
 
     [pitch]
     drives = "electric"                 # "electric" (a drive per blade) or "ideal" (at the demand: no drive)
-    drive = "../drives/pitch_drive.toml"                  # one file for the three blades (the loop runs one)
+    drive = "../drives/pitch_drive_nrel5mw.toml"         # one file for the three blades (the loop runs one)
     bearing = "../bearings/pitch_bearing_nrel5mw.toml"    # one file, or a list of three (one per blade)
     ring_model = "rigid"                # "rigid", "flexible" or "none" (no bearing: no friction)
     mesh = "coarse"                     # flexible rings' superelement mesh ("coarse", "fine")
@@ -460,7 +460,7 @@ def turbine_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
 
     # ---- [pitch] ----
     drives = _string(pitch, "pitch.drives", default="electric", choices=("electric", "ideal"))
-    drive_files = pitch.get("drive", os.path.join(_repo_examples(), "drives", "pitch_drive.toml"))
+    drive_files = pitch.get("drive", os.path.join(_repo_examples(), "drives", "pitch_drive_nrel5mw.toml"))
     drive_list = drive_files if isinstance(drive_files, list) else [drive_files]
     if len(drive_list) not in (1, 3):
         _fail("pitch.drive", drive_files, "must be one file (the three blades) or a list of three")

@@ -24,6 +24,7 @@ ROOT_LOAD = Loads(Fx=-1.0e5, Fy=1.5e5, Fz=6.0e5, Mx=0.8e6, My=7.9e6)
 
 @pytest.fixture(scope="module")
 def pitch_drive():
+    """One motor's drive (162 kN m at the ring), which a pitching moment of 140 kN m nearly saturates."""
     return DriveParameters.from_toml(ROOT / "examples" / "drives" / "pitch_drive.toml")
 
 
@@ -127,11 +128,11 @@ def frictionless_run(wind30, rigid_bearings):
                             friction=False, aero="bem", bearing_simulators=bearings)
 
 
-def test_without_friction_the_drive_torque_is_inertia_and_load_moment(frictionless_run, pitch_drive):
+def test_without_friction_the_drive_torque_is_inertia_and_load_moment(frictionless_run):
     """Friction off: at every step, motors' torque at the ring minus the blade's pitching moment equals the
     drive's inertia times its acceleration (the drive's mechanics are exact for the torque held over each
     inner step; the steps where the speed changes sign stop the ring within an inner step and are left out)."""
-    r, p = frictionless_run, pitch_drive
+    r, p = frictionless_run, frictionless_run.drive_params
     assert np.all(r.friction_torque[1:] == 0.0)
     assert np.abs(r.load_moment[1:]).max() > 1e3               # the BEM's pitching moments reached the drives
     acceleration = np.diff(r.pitch_rate, axis=0) / DT
