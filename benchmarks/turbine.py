@@ -1,8 +1,9 @@
 """The closed turbine loop against a real-time clock: ROSCO, the rotor, each blade's BEM and three pitch
 drives on flexible pitch bearings, at 10 ms steps.
 
-The NREL 5MW in IEC class B turbulence (Kaimal, 13 m/s mean at the hub, seeded) for ``--duration`` s
-(default 30) through :func:`slewing_turbine.loop.run_turbine` with ``drives="electric"``,
+The NREL 5MW in IEC class B turbulence (Kaimal, 13 m/s mean at the hub, seeded: the first ``--duration`` s,
+default 30, of a 10-minute realisation, as :func:`slewing_turbine.wind.kaimal` gives a short run) through
+:func:`slewing_turbine.loop.run_turbine` with ``drives="electric"``,
 ``bearings="flexible"`` (``examples/bearings/pitch_bearing.toml``, ``--mesh`` superelement, friction on),
 ``aero="bem"``, its bearings solving every step to their tolerance (``step_work`` "complete"), and the
 same with bounded steps (``step_work`` "bounded": a step's work capped, as a real-time host runs the FMU).
@@ -78,7 +79,8 @@ def main(args) -> None:
 
     config = TurbineConfig(mesh=args.mesh)
     wind = kaimal(MEAN_WIND, args.duration + 1.0, DT, seed=SEED)
-    note(f"NREL 5MW, Kaimal class B {MEAN_WIND:g} m/s (seed {SEED}), {args.duration:g} s at {DT * 1e3:g} ms, "
+    note(f"NREL 5MW, Kaimal class B {MEAN_WIND:g} m/s (seed {SEED}, the first {args.duration:g} s of a 600 s "
+         f"realisation), {args.duration:g} s at {DT * 1e3:g} ms, "
          f"pitch bearing with flexible rings ({args.mesh} superelement), friction on; {args.runs} rounds")
     note(f"machine load at the start (1, 5, 15 min): {', '.join(f'{x:.2f}' for x in os.getloadavg())} "
          f"on {os.cpu_count()} cores")

@@ -378,7 +378,12 @@ def step_change(before, after, at, duration, dt, *, direction=0.0) -> WindSeries
     return WindSeries(time, np.where(time >= at - 1e-9 * dt, after, before), direction)
 
 
-def kaimal(mean_speed, duration, dt, *, seed, turbulence_class="B", hub_height=90.0, rescale=True) -> WindSeries:
+#: the shortest period of a :func:`kaimal` realisation, s: IEC's 10 minutes, over which sigma1 is defined
+KAIMAL_PERIOD = 600.0
+
+
+def kaimal(mean_speed, duration, dt, *, seed, turbulence_class="B", hub_height=90.0, rescale=True,
+           period=KAIMAL_PERIOD) -> WindSeries:
     """Seeded turbulent hub-height wind of the IEC Normal Turbulence Model.
 
     The longitudinal wind at the hub point (no spatial field: the whole rotor sees it)
@@ -388,15 +393,21 @@ def kaimal(mean_speed, duration, dt, *, seed, turbulence_class="B", hub_height=9
     bin ``k`` (``1 <= k < n/2``) has the amplitude ``(n/2) sqrt(2 S_1(f_k) / T)`` (the
     variance ``S_1(f_k) / T`` of the band ``[(k-1/2)/T, (k+1/2)/T]``) and a phase drawn
     uniformly from ``[0, 2 pi)`` by ``numpy.random.default_rng(seed)``; the mean and
-    the Nyquist bin are 0. The series is periodic with period ``T``: its last sample,
-    at ``t = T``, repeats the first, and its statistics are those of the first ``n``.
+    the Nyquist bin are 0. The realisation is periodic with period ``T``: its sample at
+    ``t = T`` repeats the first, and its statistics are those of the first ``n``.
+
+    ``T`` is at least ``period`` (default 600 s, IEC's 10 minutes, over which sigma1 is
+    defined): a shorter run gets the first ``duration`` s of a 10-minute realisation. A
+    realisation as short as the run, scaled to sigma1, would put the whole variance into
+    the frequencies above ``1/T`` and so carry about twice the spectrum's turbulence at
+    the loads' frequencies for a 10 s run (1.6 times for 30 s).
 
     Parameters
     ----------
     mean_speed : float, m/s
         V_hub, the 10-minute mean at the hub, > 0.
     duration : float, s
-        At least the span of the series (``T = n dt >= duration``).
+        The span of the series (``m dt >= duration``, ``m = ceil(duration / dt)``).
     dt : float, s
         Sample step; the spectrum is resolved up to the Nyquist frequency ``1 / (2 dt)``.
     seed : int or numpy.random.SeedSequence
@@ -409,11 +420,14 @@ def kaimal(mean_speed, duration, dt, *, seed, turbulence_class="B", hub_height=9
         Scale the fluctuation to the standard deviation sigma1 exactly (default). Without,
         the series carries the spectrum's variance between ``1/(2T)`` and the Nyquist
         frequency only (about 92 % of sigma1^2 for 600 s at 13 m/s, 90 m).
+    period : float or None, s
+        The shortest period ``T`` of the realisation (default :data:`KAIMAL_PERIOD`, 600 s);
+        None: ``T`` is the run's span (the series then is periodic).
 
     Returns
     -------
     WindSeries
-        ``n + 1`` samples at ``0, dt, ..., T``; direction 0.
+        ``m + 1`` samples at ``0, dt, ..., m dt``; direction 0.
 
     Raises
     ------
@@ -421,7 +435,8 @@ def kaimal(mean_speed, duration, dt, *, seed, turbulence_class="B", hub_height=9
         If a speed, time or height is not a finite positive number, or a class is unknown.
     """
     mean_speed = _positive("mean_speed", mean_speed, "m/s")
-    time, n = _grid(duration, dt)
+    time, m = _grid(duration, dt)
+    n = m if period is None else max(m, int(math.ceil(_positive("period", period, "s") / float(dt) - 1e-9)))
     if n < 4:
         raise ValueError(f"duration / dt = {n}: need at least 4 samples for a spectrum")
     sigma = turbulence_sigma(mean_speed, turbulence_class)
@@ -440,7 +455,7 @@ def kaimal(mean_speed, duration, dt, *, seed, turbulence_class="B", hub_height=9
     fluctuation -= fluctuation.mean()                # 0 up to round-off already
     if rescale:
         fluctuation *= sigma / fluctuation.std()
-    speed = mean_speed + np.append(fluctuation, fluctuation[0])  # periodic: u(T) = u(0)
+    speed = (mean_speed + np.append(fluctuation, fluctuation[0]))[:m + 1]  # periodic: u(T) = u(0)
     if np.any(speed < 0):
         # NTM at a low mean speed: the Gaussian model allows negative values; a wind speed cannot be
         k = int(np.argmax(speed < 0))

@@ -75,7 +75,7 @@ def test_kaimal_periodogram_follows_the_spectrum():
     expected = spectrum(f[1:-1], v, cat, z)
     periodograms = []
     for seed in range(4):
-        u = kaimal(v, T, dt, seed=seed, turbulence_class=cat, hub_height=z, rescale=False).speed[:-1] - v
+        u = kaimal(v, T, dt, seed=seed, turbulence_class=cat, hub_height=z, rescale=False, period=None).speed[:-1] - v
         p = 2 * np.abs(np.fft.rfft(u)) ** 2 * dt / n             # one-sided periodogram, (m/s)^2/Hz
         assert p[0] < 1e-20 and p[-1] < 1e-20                    # no mean, no Nyquist bin
         periodograms.append(p[1:-1])
@@ -88,7 +88,7 @@ def test_kaimal_periodogram_follows_the_spectrum():
             assert mean[band].mean() == pytest.approx(expected[band].mean(), rel=1e-6), (lo, hi)
     assert np.allclose(mean, expected, rtol=1e-6)
     # rescaled: the same shape, scaled to sigma1^2 in all
-    u = kaimal(v, T, dt, seed=0, turbulence_class=cat, hub_height=z).speed[:-1] - v
+    u = kaimal(v, T, dt, seed=0, turbulence_class=cat, hub_height=z, period=None).speed[:-1] - v
     ratio = (2 * np.abs(np.fft.rfft(u)) ** 2 * dt / n)[1:-1] / expected
     assert np.ptp(ratio) < 1e-6 * ratio.mean()
     assert ratio.mean() == pytest.approx(sigma1(v, cat) ** 2 / np.sum(expected / T), rel=1e-9)
@@ -96,9 +96,9 @@ def test_kaimal_periodogram_follows_the_spectrum():
 
 def test_kaimal_phases_are_uniform_and_seeded():
     v, T, dt = 11.4, 300.0, 0.05
-    a = kaimal(v, T, dt, seed=11)
-    b = kaimal(v, T, dt, seed=11)
-    c = kaimal(v, T, dt, seed=12)
+    a = kaimal(v, T, dt, seed=11, period=None)
+    b = kaimal(v, T, dt, seed=11, period=None)
+    c = kaimal(v, T, dt, seed=12, period=None)
     assert np.array_equal(a.speed, b.speed)                      # reproducible
     assert not np.allclose(a.speed, c.speed)                     # another seed, another series
     phase_a = np.angle(np.fft.rfft(a.speed[:-1])[1:-1])
@@ -122,7 +122,7 @@ def test_kaimal_spectrum_integrates_to_sigma1_squared():
 
 def test_class_s_values_are_taken_as_given():
     # a number for the turbulence category is I_ref, for the wind class V_ref (class S)
-    wind = kaimal(9.0, 120.0, 0.1, seed=2, turbulence_class=0.1)
+    wind = kaimal(9.0, 600.0, 0.1, seed=2, turbulence_class=0.1)
     assert wind.speed[:-1].std() == pytest.approx(0.1 * (0.75 * 9.0 + 5.6), rel=1e-12)
     gust = extreme_operating_gust(30.0, 1.0, 12.0, 0.05, wind_class=30.0, turbulence_class=0.1)
     assert gust.speed.max() == pytest.approx(30.0 + 0.74 * 1.35 * (0.8 * 1.4 * 30.0 - 30.0), rel=1e-9)
@@ -311,3 +311,18 @@ def test_write_wind_round_trips_through_read_wind(tmp_path):
     back = read_wind(path)
     for name in ("time", "speed", "direction"):
         assert np.allclose(getattr(back, name), getattr(wind, name), rtol=1e-9, atol=1e-12), name
+
+
+def test_a_short_kaimal_run_is_the_start_of_a_ten_minute_realisation():
+    """sigma1 is a 10-minute figure: a 30 s run is the first 30 s of the 600 s realisation of its seed, so its
+    step-to-step changes (the high frequencies that load the blades) are the spectrum's; a realisation as
+    short as the run (period=None), scaled to sigma1, has the whole variance above 1/(30 s) and larger ones."""
+    v, dt = 13.0, 0.01
+    full = kaimal(v, 600.0, dt, seed=5)
+    short = kaimal(v, 30.0, dt, seed=5)
+    assert short.time[-1] == pytest.approx(30.0) and short.time.size == 3001
+    assert np.array_equal(short.speed, full.speed[:short.speed.size])
+    rms = lambda u: float(np.sqrt(np.mean(np.diff(u) ** 2)))        # noqa: E731
+    reference = rms(full.speed)
+    assert rms(short.speed) == pytest.approx(reference, rel=0.1)
+    assert rms(kaimal(v, 30.0, dt, seed=5, period=None).speed) > 1.3 * reference
