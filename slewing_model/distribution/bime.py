@@ -74,13 +74,8 @@ from ..rings.compliance import contact_compliance, product_operands, ring_compli
 
 #: the flexible solver refreshes its reduced Newton operator when an iteration reduced the
 #: residual by less than this factor (with a new operator spread over two steps, 0.4 measures better
-#: than 0.25: pitch mean -3 %, yaw 95th percentile -35 %). 0.5 where the loads jump at every step (the
-#: turbine loop's pitch bearings in turbulent wind, 10 s, 2850 steps): new operators 0.224 -> 0.182 a step
-#: for 6.35 -> 6.86 Newton iterations (an operator formed and inverted: 3-7 ms; an iteration: 0.05-0.08 ms),
-#: the bearings' CPU time -5 to -20 % (a loaded machine); the ``fmu`` benchmark's pitch case 0.107 -> 0.092
-#: new operators a step for 4.59 -> 4.83 iterations. 0.6 and 0.7 give fewer still (0.154, 0.131), but a
-#: moment growing 15 % a solve then goes 40 solves with no new operator (tests/test_flexible_solver.py needs one)
-REFRESH = 0.5
+#: than 0.25: pitch mean -3 %, yaw 95th percentile -35 %)
+REFRESH = 0.4
 #: ... unless, at the rate of that iteration, the residual reaches the tolerance within this many
 #: more iterations, which cost less than a new operator (pitch bearing: 3 of 0.1 ms against
 #: one operator of 2.5 ms)
