@@ -8,8 +8,9 @@ harmonic; ``M`` combines both rings as the contacts feel them: the operator thro
 the flexible solver (:mod:`slewing_model.distribution.bime`, :mod:`slewing_model.rings.reduced_operator`)
 eliminates the ring displacements.
 
-Both are kept as :class:`BlockCirculant`: dense for their entries (the reduced operator takes
-rows and columns of ``M``), multiplied harmonic by harmonic (numpy's FFT) on large bearings, or
+Both are kept as :class:`BlockCirculant`: their blocks (the entries the reduced operator takes of
+``M``, :meth:`BlockCirculant.entries`), the dense matrix formed when first asked for (numpy's loops
+take rows and columns of it), multiplied harmonic by harmonic (numpy's FFT) on large bearings, or
 by a compiled real DFT (:func:`product_operands`, :mod:`slewing_model.distribution.kernel`) at any size.
 
 Run-time module: numpy.
@@ -35,6 +36,11 @@ class BlockCirculant:
     ``R_j = conj(C^_j) Y_j`` with ``C^ = DFT(C)`` (real ``C``): O(B m^2 + B log B m)
     instead of O(B^2 m^2), used from :data:`FFT_FROM_BALLS` balls on.
 
+    :meth:`from_blocks` makes one from its blocks alone: the dense matrix (2.9 MB for the pitch
+    bearing, about 8 ms to form in a fresh process) is then formed when first used (:attr:`dense`,
+    an entry or slice, ``np.asarray``, a dense product below :data:`FFT_FROM_BALLS` balls), which
+    the compiled loops never do.
+
     Parameters
     ----------
     dense : ndarray (B m, B m)
@@ -43,16 +49,36 @@ class BlockCirculant:
     """
 
     def __init__(self, dense: np.ndarray, block: int):
-        self.dense = dense
-        self.shape = dense.shape
-        self.block = block
-        self.balls = dense.shape[0] // block
-        first_row = dense[:block].reshape(block, self.balls, block).transpose(1, 0, 2)   # C_k, (B, m, m)
+        self._dense = dense
+        balls = dense.shape[0] // block
+        first_row = dense[:block].reshape(block, balls, block).transpose(1, 0, 2)   # C_k, (B, m, m)
+        self._set_blocks(np.ascontiguousarray(first_row))
+
+    @classmethod
+    def from_blocks(cls, blocks: np.ndarray) -> "BlockCirculant":
+        """The matrix of the blocks ``C_k`` (B, m, m) (its first block row), its dense form not yet formed."""
+        matrix = cls.__new__(cls)
+        matrix._dense = None
+        matrix._set_blocks(np.ascontiguousarray(blocks))
+        return matrix
+
+    def _set_blocks(self, blocks: np.ndarray) -> None:
         #: the blocks ``C_k`` (B, m, m), contiguous: ``dense[b m + r, c m + s] = blocks[(c - b) mod B, r, s]``,
         #: 19 kB for the pitch bearing against the dense matrix's 2.9 MB (entries gathered from it stay in cache)
-        self.blocks = np.ascontiguousarray(first_row)
-        self.harmonics = np.conj(np.fft.rfft(first_row, axis=0))
+        self.blocks = blocks
+        self.balls, self.block = blocks.shape[0], blocks.shape[1]
+        self.shape = (self.balls * self.block, self.balls * self.block)
+        self.harmonics = np.conj(np.fft.rfft(blocks, axis=0))
         self.by_harmonics = self.balls >= FFT_FROM_BALLS
+
+    @property
+    def dense(self) -> np.ndarray:
+        """The matrix (B m, B m), formed from :attr:`blocks` when first asked for."""
+        if self._dense is None:
+            n, m = self.balls, self.block
+            k = (np.arange(n)[None, :] - np.arange(n)[:, None]) % n          # block (b, c) is C_(c - b)
+            self._dense = self.blocks[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
+        return self._dense
 
     def __matmul__(self, y: np.ndarray) -> np.ndarray:
         if not self.by_harmonics:
@@ -95,24 +121,29 @@ def product_operands(matrix: BlockCirculant) -> tuple:
 
 def _pseudo_inverse_circulant(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
     """Pseudo-inverse of a symmetric block-circulant matrix given by its first
-    block row (B, m, m), returned dense. Inverts block by block in the harmonic
-    (DFT) basis, dropping the null space (a free ring's rigid-body modes)."""
-    n, m, _ = first_row.shape
+    block row (B, m, m), returned dense (:func:`_pseudo_inverse_blocks`, the dense form
+    :attr:`BlockCirculant.dense` makes of them)."""
+    return BlockCirculant.from_blocks(_pseudo_inverse_blocks(first_row, rcond)).dense
+
+
+def _pseudo_inverse_blocks(first_row: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
+    """First block row (B, m, m) of the pseudo-inverse of a symmetric block-circulant matrix given by
+    its first block row (B, m, m). Inverts block by block in the harmonic (DFT) basis, dropping the
+    null space (a free ring's rigid-body modes)."""
     blocks = np.fft.fft(first_row, axis=0)  # block j = sum_k C_k exp(-2 pi i j k / B)
     w, v = np.linalg.eigh(0.5 * (blocks + blocks.conj().transpose(0, 2, 1)))   # all blocks at once
     keep = np.abs(w) > rcond * np.abs(w).max()
     inverse_w = np.divide(1.0, w, out=np.zeros_like(w), where=keep)          # the null space dropped
     inv = (v * inverse_w[:, None, :]) @ v.conj().transpose(0, 2, 1)
-    row = np.fft.ifft(inv, axis=0).real  # first block row of the pseudo-inverse
-    k = (np.arange(n)[None, :] - np.arange(n)[:, None]) % n
-    return row[k].transpose(0, 2, 1, 3).reshape(n * m, n * m)
+    return np.fft.ifft(inv, axis=0).real  # first block row of the pseudo-inverse
 
 
 def ring_compliances(superelement) -> dict[str, BlockCirculant]:
     """``G`` (4B, 4B) of each ring: its compliance at its groove centres, the
-    pseudo-inverse of its superelement (a free ring's rigid modes dropped)."""
-    return {name: BlockCirculant(_pseudo_inverse_circulant(np.asarray(getattr(superelement, name).first_row,
-                                                                      dtype=float)), 4)
+    pseudo-inverse of its superelement (a free ring's rigid modes dropped), from its blocks
+    (:meth:`BlockCirculant.from_blocks`)."""
+    return {name: BlockCirculant.from_blocks(_pseudo_inverse_blocks(np.asarray(getattr(superelement, name).first_row,
+                                                                               dtype=float)))
             for name in ("outer", "inner")}
 
 
@@ -120,13 +151,14 @@ def contact_compliance(rings: dict[str, BlockCirculant]) -> BlockCirculant:
     """``M`` (4B, 4B): the combined compliance of both rings seen by the contacts,
     ordered like the relative vectors ``e`` (ball, diagonal, (r, z)).
 
-    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` from :func:`ring_compliances`."""
-    n = rings["outer"].shape[0] // 4
+    ``M = P_out G_out P_out^T + P_in G_in P_in^T`` with ``G`` from :func:`ring_compliances`: block-circulant
+    too, each ``P`` ordering the DOFs within each ball (:func:`ring_index`), so formed block by block
+    (the same sums as of the dense matrices)."""
     total = 0.0
     for name, slots in (("outer", OUTER_SLOT), ("inner", INNER_SLOT)):
-        index = ring_index(n, slots)
-        total = total + rings[name][np.ix_(index, index)]
-    return BlockCirculant(total, 4)
+        index = ring_index(1, slots)                           # the ball's 4 DOFs in the order of e
+        total = total + rings[name].blocks[:, index[:, None], index[None, :]]
+    return BlockCirculant.from_blocks(total)
 
 
 def ring_index(n: int, slots: np.ndarray) -> np.ndarray:
