@@ -21,7 +21,6 @@ ball file
 """
 from __future__ import annotations
 
-import csv
 import functools
 import math
 import os
@@ -165,6 +164,8 @@ class ManufacturingErrors:
 def _csv_rows(path: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """The header and the data rows of a CSV file, each row with its line number in the file
     (1-based, comment and blank lines counted)."""
+    import csv                      # here: a bearing without error tables (the FMU's) never reads one
+
     rows = []
     try:
         with open(path, newline="") as fh:
@@ -253,6 +254,8 @@ def write_ring_csv(path: str | os.PathLike, ring: str, error_map: RingErrorMap) 
     header = ["angle_deg"] + [f"{q}_um_{c}" for c in contacts for q in ("radial", "axial")]
     if error_map.groove_radius is not None:
         header += [f"groove_radius_mm_{c}" for c in contacts]
+    import csv
+
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(header)

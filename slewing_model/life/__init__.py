@@ -11,15 +11,40 @@
 
 The method, its sources and its checks are on the user guide's life and wear page.
 Run-time part: numpy only (``rainflow`` is imported by the cycle counting of a finished run).
+
+The names below are imported from their modules when first asked for (``from slewing_model.life import
+LifeAccumulator``; PEP 562): the contact loops import :mod:`.kernel` alone, and a run without the life
+accumulators imports nothing else of this package.
 """
-from .rating import (LifeInputError, Raceway, RacewayLife, axial_rating, combined_life, equivalent_load,
-                     four_point_capacities, iso281_axial_rating, raceway_capacity, raceway_life,
-                     radial_bearing_life, radial_raceway_capacities)
-from .oscillation import critical_angle, dg03_rating_factor, equivalent_revolutions, rainflow_cycles
-from .raceway_map import RacewayMap, default_slices, track_damage
-from .wear import rolling_travel, relubrication_gap
-from .dg03 import DG03Life, dg03_life, equivalent_axial_load
-from .duty import LifeAccumulator, LifeModel, LifeResult, LifeSettings, analyse_run
+from importlib import import_module as _import_module
+
+#: the names this package exports, by the module that defines them
+_MODULES = {
+    "rating": ("LifeInputError", "Raceway", "RacewayLife", "axial_rating", "combined_life", "equivalent_load",
+               "four_point_capacities", "iso281_axial_rating", "raceway_capacity", "raceway_life",
+               "radial_bearing_life", "radial_raceway_capacities"),
+    "oscillation": ("critical_angle", "dg03_rating_factor", "equivalent_revolutions", "rainflow_cycles"),
+    "raceway_map": ("RacewayMap", "default_slices", "track_damage"),
+    "wear": ("rolling_travel", "relubrication_gap"),
+    "dg03": ("DG03Life", "dg03_life", "equivalent_axial_load"),
+    "duty": ("LifeAccumulator", "LifeModel", "LifeResult", "LifeSettings", "analyse_run"),
+}
+_LAZY = {name: module for module, names in _MODULES.items() for name in names}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        value = getattr(_import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    if name in _MODULES:                 # a module of the package, as an attribute (slewing_model.life.duty)
+        return _import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted((set(globals()) - {"_LAZY", "_MODULES", "_import_module"}) | set(_LAZY) | set(_MODULES))
+
 
 __all__ = [
     "LifeInputError", "Raceway", "RacewayLife", "axial_rating", "combined_life", "equivalent_load",
