@@ -108,6 +108,30 @@ def _ball_description(array: str, ball: int, column: int, label: str) -> str:
     return f"interference of ball {ball}, diagonal {label[-2]}-{label[-1]} (< 0: gap)"
 
 
+class _BallVariables(dict):
+    """pythonfmu's table of the slave's variables (value reference -> variable, ``Fmi2Slave.vars``), whose
+    last ``count`` entries, the per-ball outputs, are made by ``make(index)`` (index 0 for the first) when
+    first looked up: a host's getReal of one, or :meth:`make_all`."""
+
+    def __init__(self, registered: dict, make, count: int):
+        super().__init__(registered)
+        self._first, self._make, self._count = len(registered), make, count
+
+    def __missing__(self, vr):
+        if not (isinstance(vr, int) and 0 <= vr - self._first < self._count):
+            raise KeyError(vr)
+        var = self._make(vr - self._first)
+        var.value_reference = vr
+        self[vr] = var
+        return var
+
+    def make_all(self) -> None:
+        """Every variable, in the order of their value references (the model description's)."""
+        made = [self[vr] for vr in range(self._first + self._count)]
+        self.clear()
+        self.update((var.value_reference, var) for var in made)
+
+
 class SlewingBearing(Fmi2Slave):
     author = "slewing_model"
     description = "Four-point contact slewing bearing: load distribution (Flexible-BIME) and friction torque"
@@ -147,30 +171,43 @@ class SlewingBearing(Fmi2Slave):
                                        variability=Fmi2Variability.discrete, initial=Fmi2Initial.calculated,
                                        description=COUNT_OUTPUT[1]), nested=False)
         # per-ball outputs: the result's arrays themselves (replaced each step, never changed in
-        # place), read one value at a time by the host's getReal
+        # place), read one value at a time by the host's getReal. Their variables (8 a ball: 1200 for
+        # 150 balls, about 10 ms to make) follow the others' value references, ball by ball, and are
+        # made when first asked for (_BallVariables); the model description (to_xml) makes them all
         self._arrays = {name: np.zeros((n, len(columns))) for name, _, columns, _, _ in BALL_ARRAYS}
-        for i in range(1, n + 1):
-            for name, unit, columns, _, _ in BALL_ARRAYS:
-                for c, label in enumerate(columns):
-                    self._real(f"ball[{i}].{label}", unit, _ball_description(name, i, c, label),
-                               Fmi2Causality.output, Fmi2Variability.continuous,
-                               getter=lambda name=name, i=i, c=c: float(self._arrays[name][i - 1, c]))
+        self._ball_columns = [(name, unit, c, label) for name, unit, columns, _, _ in BALL_ARRAYS
+                              for c, label in enumerate(columns)]
+        self.vars = _BallVariables(self.vars, self._ball_variable, n * len(self._ball_columns))
         self.simulator: BearingSimulator | None = None
         self._refused = None  # (time, inputs, tunables) of the last refused step
 
     # ---- variables ------------------------------------------------------------------
     def _real(self, name, unit, description, causality, variability, getter=None):
+        self.register_variable(self._real_variable(name, unit, description, causality, variability, getter),
+                               nested=False)
+
+    def _real_variable(self, name, unit, description, causality, variability, getter=None) -> Real:
         initial = None
         if causality == Fmi2Causality.parameter:
             initial = Fmi2Initial.exact
         elif causality == Fmi2Causality.output:
             initial = Fmi2Initial.calculated
         self._units[name] = unit
-        self.register_variable(Real(name, causality=causality, variability=variability, initial=initial,
-                                    description=description, getter=getter), nested=False)
+        return Real(name, causality=causality, variability=variability, initial=initial,
+                    description=description, getter=getter)
+
+    def _ball_variable(self, index: int) -> Real:
+        """The per-ball output ``index`` (0 for ball 1's first column): ``ball[i].label``, what
+        register_variable would have made of it (a getter, no setter)."""
+        ball, column = divmod(index, len(self._ball_columns))
+        name, unit, c, label = self._ball_columns[column]
+        return self._real_variable(f"ball[{ball + 1}].{label}", unit, _ball_description(name, ball + 1, c, label),
+                                   Fmi2Causality.output, Fmi2Variability.continuous,
+                                   getter=lambda: float(self._arrays[name][ball, c]))
 
     def to_xml(self, model_options=dict()) -> Element:
         """pythonfmu's model description plus units, dependencies and initial unknowns."""
+        self.vars.make_all()
         root = super().to_xml(model_options)
         definitions = Element("UnitDefinitions")
         for name, (kg, m, s, rad) in UNITS.items():
