@@ -8,6 +8,7 @@ it uses this package's modules:
 * :mod:`fmu_build.runtime`: the Python runtime a standalone FMU carries;
 * :mod:`fmu_build.win64`: the FMU's standalone Windows (win64) binary and runtime, built on Linux;
 * :mod:`fmu_build.aot`: the loops compiled ahead of time (``build_fmu.py --aot``);
+* :mod:`fmu_build.bytecode`: the modules' bytecode the FMU carries beside their sources;
 * :mod:`fmu_build.drive`: the drive FMU and the time-table FMUs
   (``.venv/bin/python -m fmu_build.drive DRIVE.toml``).
 """

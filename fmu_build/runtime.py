@@ -24,7 +24,9 @@ What is done to the copied files, so that nothing inside names the building mach
   now name ``/`` (they are fallbacks and error-message texts, never used to find a file);
 * the glibc and libstdc++ versions every ELF file needs are read from its ``.gnu.version_r``,
   so that the FMU can state its floor (``glibc=`` in ``resources/python_runtime.txt``) and the
-  layer can refuse an older system with a message instead of a loader error.
+  layer can refuse an older system with a message instead of a loader error;
+* every module's bytecode is compiled beside its source (:mod:`fmu_build.bytecode`: hash-based files
+  that a freshly unpacked FMU reads instead of compiling its runtime at its first instantiation).
 
 The staged tree is cached (``$SLEWING_CACHE_DIR/fmu_runtime``) per interpreter, package
 versions and platform folder, as a zip whose entries are appended to each FMU.
@@ -45,10 +47,12 @@ import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fmu_build.bytecode import compile_tree
+
 #: the folder of the runtime inside ``binaries/<platform>/``
 RUNTIME_FOLDER = "python"
 #: version of this file's layout: part of the cache key
-LAYOUT = 4
+LAYOUT = 5
 
 #: standard-library folders and modules a numpy model never imports (tests, GUIs, installers, build files)
 STDLIB_EXCLUDED = {"test", "tkinter", "idlelib", "turtledemo", "ensurepip", "lib2to3", "pydoc_data",
@@ -489,6 +493,8 @@ def stage_runtime(target: Path, numba: bool, python=None, trim: bool = True) -> 
     for f in target.rglob("*"):
         if f.is_file():
             scrub_paths(f, paths)
+    if minor == "%d.%d" % sys.version_info[:2]:     # the modules' bytecode (fmu_build.bytecode), for its Python
+        compile_tree(stdlib_target, target)
     needs = [version_needs(elf) for elf in elves]
     return {"python": python["version"], "packages": packages, "library": library.name,
             "glibc": newest_version(needs, "GLIBC_"), "glibcxx": newest_version(needs, "GLIBCXX_")}
@@ -496,10 +502,12 @@ def stage_runtime(target: Path, numba: bool, python=None, trim: bool = True) -> 
 
 def runtime_key(numba: bool, platform_folder: str, python=None, trim: bool = True) -> str:
     """Cache key of a runtime: interpreter (``python``, a path or :func:`interpreter`'s answer; default this
-    one), package versions, platform folder and this file's layout."""
+    one), package versions, platform folder, this file's layout and this file's and :mod:`fmu_build.bytecode`'s
+    contents."""
     python = interpreter(python) if python is None or isinstance(python, (str, os.PathLike)) else python
     text = json.dumps([LAYOUT, python["sys_version"], python["base_prefix"], bundled_packages(numba, python),
-                       platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()]
+                       platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest(),
+                       hashlib.sha256((Path(__file__).parent / "bytecode.py").read_bytes()).hexdigest()]
                       + ([] if trim or numba else ["untrimmed"]))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

