@@ -67,9 +67,13 @@ def pair_figure(rows: list, axes: list, png: str) -> list:
                 points = a.scatter(p[:, 0], p[:, 1], c=p[:, 2], cmap="viridis", s=18)
                 lo, hi = float(np.min(p[:, :2])), float(np.max(p[:, :2]))
                 a.plot([lo, hi], [lo, hi], "k:", lw=0.8)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    ratio = np.mean(p[:, 1] / p[:, 0])
-                lines.append(f"{switch_label} on / off, {label}: {ratio:.3g} (mean of {len(p)} pairs)")
+                some = p[:, 0] != 0.0                    # a ratio needs the figure without the switch
+                if some.any():
+                    ratio = np.mean(p[some, 1] / p[some, 0])
+                    lines.append(f"{switch_label} on / off, {label}: {ratio:.3g} (mean of {some.sum()} pairs)")
+                else:
+                    lines.append(f"{switch_label} on / off, {label}: 0 in every case without it, "
+                                 f"{np.max(p[:, 1]):.3g} at most with it")
                 if j == len(columns) - 1:
                     fig.colorbar(points, ax=a, label="mean wind [m/s]")
             a.set_xlabel(f"{switch_label} off", fontsize=8)
