@@ -6,7 +6,9 @@ studies of minutes, cluster set-up, placeholders). The cheap ones run in a copy 
 repository (its tracked and new files, committed into a fresh git repository, and numba's cache of
 the loops), with ``.venv/bin/`` pointing at this checkout's environment and ``../shared`` at the real one; each
 must exit 0, and afterwards ``git status`` of the copy must show nothing: the commands write
-only to ignored folders (``results/``), never into the repository.
+only to ignored folders (``results/``), never into the repository. A command shown twice, or again with
+only another ``-o``, runs once (:func:`_once`); the commands take the loops compiled ahead of time where
+``make test`` compiled them (:func:`_aot_path`).
 """
 import os
 import re
@@ -32,6 +34,8 @@ SKIPPED = (
     (r"\.venv/bin/python examples/", "a full example (seconds to a minute); examples/timings.py times each"),
     (r"\.venv/bin/python (-m )?benchmarks", "a benchmark (minutes)"),
     (r"\.venv/bin/slewing batch examples/studies/", "a study of minutes (2,000 or 10 long cases); tests/test_study.py"),
+    (r"\.venv/bin/slewing turbine examples/studies/", "a turbine study of minutes (24 cases of 60 s); "
+                                                     "tests/test_turbine_study.py"),
     (r"OMP_NUM_THREADS=1 nice ", "runs a CalculiX reference again (minutes, needs ccx); its results are stored in "
                                  "references/validation/data/, from which the redraw commands run here"),
     (r"ECOS=|chmod \+x \"\$ECOS\"|mkdir -p results && cd results", "ecos needs the SSP built (minutes)"),
@@ -122,11 +126,69 @@ def _needs_shared(command: str) -> bool:
     return "../shared/" in command or any(out in command.split() for out in _shared_outputs())
 
 
+_OUTPUT = re.compile(r"(?:^|\s)(?:-o|--output)\s+(\S+)")
+
+
+def _once(commands) -> list[tuple[str | None, str | None, str | None]]:
+    """``commands`` as (command to run, or None where its work is already done; its output path; the output
+    path of the command that did that work).
+
+    Two pages show the same command (``slewing solve`` of table1 in the README and the CLI guide), or the
+    same command writing to another path (``slewing life ... -o results/life_pitch`` and ``-o
+    results/life_pitch_series``): the second is the same work, with the same arguments, as the first, and
+    exits as the first did, so it runs once (a command that differs in anything but its ``-o`` is run); the
+    output of the first is copied to the second's path, where a later command may read it."""
+    seen, out = {}, []
+    for command in commands:
+        output = (_OUTPUT.findall(command) or [None])[-1]
+        key = _OUTPUT.sub(" -o OUTPUT", command)
+        if key in seen:
+            out.append((None, output, seen[key]))
+        else:
+            seen[key] = output
+            out.append((command, output, None))
+    return out
+
+
+def test_a_command_differing_only_in_its_output_runs_once():
+    once = _once(["a x -o r/1", "a x", "a x -o r/2", "a x --output r/3 --mu 1", "a x", "a y -o r/1"])
+    assert [(c, o, first) for c, o, first in once] == [
+        ("a x -o r/1", "r/1", None), ("a x", None, None), (None, "r/2", "r/1"),
+        ("a x --output r/3 --mu 1", "r/3", None), (None, None, None), ("a y -o r/1", "r/1", None)]
+
+
+def _aot_path() -> dict:
+    """The environment that puts the loops compiled ahead of time on the commands' import path, where the
+    cache `make test` fills (the Makefile's COMPILE_LOOPS; conftest's ``SLEWING_AOT_CACHE_DIR``) holds them
+    for these sources: the library then takes its loops from them (numerics/compiled.py's ``aot_kernels``,
+    which checks their sources' hash), as an FMU does, instead of loading each from numba's cache (1.5 s
+    of CPU a command that solves; the answers are the same: tests/test_aot.py). Where they are not there:
+    numba's cache."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    try:
+        from fmu_build.aot import aot_cache_dir, cache_key, module_file_name
+        from slewing_model.numerics.compiled import AOT_MODULES
+
+        folder = aot_cache_dir() / cache_key()
+        if not all((folder / module_file_name(target)).is_file() for target in AOT_MODULES):
+            return {}
+    except (ImportError, OSError):
+        return {}
+    return {"PYTHONPATH": os.pathsep.join(filter(None, (str(folder), os.environ.get("PYTHONPATH"))))}
+
+
 def _run_commands(copy, commands) -> None:
     """Each command exits 0 in the copy, which is left as it was."""
-    for command in commands:
+    env = {**os.environ, **_aot_path()}
+    for command, output, first in _once(commands):
+        if command is None:
+            if output is not None and first != output and (copy / first).exists():
+                copy_output = shutil.copytree if (copy / first).is_dir() else shutil.copy2
+                copy_output(copy / first, copy / output)
+            continue
         line = command.replace(".venv/bin/", f"{VENV_BIN}/")
-        done = subprocess.run(["bash", "-c", line], cwd=copy, capture_output=True, text=True, timeout=300)
+        done = subprocess.run(["bash", "-c", line], cwd=copy, capture_output=True, text=True, timeout=300, env=env)
         assert done.returncode == 0, f"{command}\n{done.stderr[-2000:]}"
     status = subprocess.run(["git", "status", "--porcelain", "--untracked-files=all"], cwd=copy,
                             capture_output=True, text=True, check=True).stdout
@@ -170,5 +232,6 @@ def test_python_examples_run(copy, example_fmus):
         for name in EXAMPLE_FMUS:
             if name in block:
                 block = block.replace(name, str(example_fmus(name)))
-        done = subprocess.run([sys.executable, "-c", block], cwd=copy, capture_output=True, text=True, timeout=300)
+        done = subprocess.run([sys.executable, "-c", block], cwd=copy, capture_output=True, text=True, timeout=300,
+                              env={**os.environ, **_aot_path()})
         assert done.returncode == 0, f"{block}\n{done.stderr[-2000:]}"
