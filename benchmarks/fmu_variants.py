@@ -27,7 +27,9 @@ superelement is cached in both (built before the timing). Instantiation: loading
 (VmRSS) after the initialisation less before loading the FMU's binary.
 
 ``--pair``: the default and the ``--numba`` FMU only, with their builds cached (no cold build), the
-``--numba`` FMU the baseline: the two alternating, as the instantiation and step goals compare them.
+``--numba`` FMU the baseline: the two alternating, as the instantiation and step goals compare them, and
+the ``--numba`` FMU a second time (``standalone + numba, again``: the same unpacked folder, run as a third
+variant): its ratio to the first is the run's noise floor, what a ratio of two identical FMUs scatters by.
 
 Run: .venv/bin/python -m benchmarks fmu_variants [--steps 1000] [--runs 3] [--pair]
 """
@@ -116,6 +118,8 @@ def run_host(host: Path, folder: Path, refs: dict, inputs: Path, parameters: dic
 
 
 PAIR = ("standalone + aot (default)", "standalone + numba")
+#: with --pair: the --numba FMU run again as a third variant (its own folder), the run's noise floor
+AGAIN = "standalone + numba, again"
 
 
 def add_arguments(parser) -> None:
@@ -155,6 +159,11 @@ def main(args) -> None:
             refs = {v.name: v.valueReference for v in md.modelVariables}
             refs["guid"] = md.guid
             built[name] = (folder, refs)
+        if args.pair:                   # the noise floor: the same FMU again (a copy of its unpacked folder)
+            folder, refs = built["standalone + numba"]
+            shutil.copytree(folder, folder.with_name(folder.name + "_again"))
+            built[AGAIN] = (folder.with_name(folder.name + "_again"), refs)
+            variants = {**variants, AGAIN: variants["standalone + numba"]}
             rows_build.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB", f"{raw / 1e6:.0f} MB",
                                f"{cold:.1f} s" if variant["runtime"] == "standalone" and name not in DROPPED
                                and not args.pair else "—",
@@ -189,7 +198,7 @@ def main(args) -> None:
                 ["FMU", "instantiation", "memory after instantiation", "median", "95th pct", "99th pct",
                  f"median / {reference}"], rows)
     numba_median = np.median(np.concatenate(times["standalone + numba"]))
-    for name in ("standalone + aot (default)", "standalone"):
+    for name in ("standalone + aot (default)", "standalone", AGAIN):
         if name not in times:
             continue
         note(f"median step of {name} / standalone + numba: "
