@@ -566,14 +566,20 @@ def drive_energies(axes, pitch, rate, motor_torque, friction, load_moment, param
     moment drives it); the change of the drive's kinetic energy (ring side); and what is left of
     ``ring work - friction - load - kinetic`` (the mean torque over a step stands for the inner steps'
     torques: a small residual)."""
+    return drive_work(np.array([a.drive.state.motor_energy for a in axes]), pitch, rate, motor_torque, friction,
+                      load_moment, params)
+
+
+def drive_work(motor, pitch, rate, motor_torque, friction, load_moment, params) -> dict:
+    """:func:`drive_energies`' terms over the samples given (``pitch`` ... from the window's first sample on,
+    ``motor`` the motors' delivered energy over it)."""
     dpitch = np.diff(pitch, axis=0)
     ring_work = np.nansum(params.torque_gain * motor_torque[1:] * dpitch, axis=0)
     fric = np.nansum(friction[1:] * np.abs(dpitch), axis=0)
     load = np.nansum(load_moment[1:] * dpitch, axis=0)
     kinetic = 0.5 * params.inertia * (rate[-1] ** 2 - rate[0] ** 2)
-    return {"motor": np.array([a.drive.state.motor_energy for a in axes]), "ring_work": ring_work,
-            "friction": fric, "load_moment": load, "drive_kinetic_change": kinetic,
-            "drive_residual": ring_work - fric - load - kinetic}
+    return {"motor": motor, "ring_work": ring_work, "friction": fric, "load_moment": load,
+            "drive_kinetic_change": kinetic, "drive_residual": ring_work - fric - load - kinetic}
 
 
 # ---- the figures -------------------------------------------------------------------------------------
@@ -597,17 +603,11 @@ def window_energies(result: TurbineResult, i0: int) -> dict:
     out = rotor_energies(r.time[i0:], r.rotor_speed[i0:], r.aero_torque[i0:], r.generator_torque[i0:],
                          r.drivetrain)
     if r.drives == "electric":
-        p = r.drive_params
-        dpitch = np.diff(r.pitch[i0:], axis=0)
-        steps = slice(i0 + 1, None)
-        ring_work = np.nansum(p.torque_gain * r.motor_torque[steps] * dpitch, axis=0)
-        fric = np.nansum(r.friction_torque[steps] * np.abs(dpitch), axis=0)
-        load = np.nansum(r.load_moment[steps] * dpitch, axis=0)
-        kinetic = 0.5 * p.inertia * (r.pitch_rate[-1] ** 2 - r.pitch_rate[i0] ** 2)
         motor = (r.motor_energy[-1] - r.motor_energy[i0] if r.motor_energy is not None
                  else np.asarray(r.energies["motor"]))
-        out.update(motor=motor, ring_work=ring_work, friction=fric, load_moment=load,
-                   drive_kinetic_change=kinetic, drive_residual=ring_work - fric - load - kinetic)
+        w = slice(i0, None)
+        out.update(drive_work(motor, r.pitch[w], r.pitch_rate[w], r.motor_torque[w], r.friction_torque[w],
+                              r.load_moment[w], r.drive_params))
     return out
 
 
