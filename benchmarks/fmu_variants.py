@@ -159,15 +159,15 @@ def main(args) -> None:
             refs = {v.name: v.valueReference for v in md.modelVariables}
             refs["guid"] = md.guid
             built[name] = (folder, refs)
+            rows_build.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB", f"{raw / 1e6:.0f} MB",
+                               f"{cold:.1f} s" if variant["runtime"] == "standalone" and name not in DROPPED
+                               and not args.pair else "—",
+                               f"{warm:.1f} s"])
         if args.pair:                   # the noise floor: the same FMU again (a copy of its unpacked folder)
             folder, refs = built["standalone + numba"]
             shutil.copytree(folder, folder.with_name(folder.name + "_again"))
             built[AGAIN] = (folder.with_name(folder.name + "_again"), refs)
             variants = {**variants, AGAIN: variants["standalone + numba"]}
-            rows_build.append([name, f"{fmu.stat().st_size / 1e6:.1f} MB", f"{raw / 1e6:.0f} MB",
-                               f"{cold:.1f} s" if variant["runtime"] == "standalone" and name not in DROPPED
-                               and not args.pair else "—",
-                               f"{warm:.1f} s"])
         times = {name: [] for name in variants}
         starts = {name: [] for name in variants}
         memory = {name: [] for name in variants}
