@@ -96,7 +96,7 @@ def _private_tmpdir(tmp_path_factory):
 def _cache_dir(tmp_path_factory):
     # superelements built by the tests go to a private cache, not the user's; the loops compiled ahead of time
     # are taken from the user's (keyed by their sources, numba and the Python ABI), which `make test` fills
-    # first (the Makefile's COMPILE_LOOPS), so that the test workers do not each compile them (a minute a target)
+    # first (the Makefile's COMPILE_LOOPS and COMPILE_LOOPS_AOT), so that the test workers do not each compile them (a minute a target)
     import sys
 
     sys.path.insert(0, str(ROOT))

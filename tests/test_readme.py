@@ -159,7 +159,7 @@ def test_a_command_differing_only_in_its_output_runs_once():
 
 def _aot_path() -> dict:
     """The environment that puts the loops compiled ahead of time on the commands' import path, where the
-    cache `make test` fills (the Makefile's COMPILE_LOOPS; conftest's ``SLEWING_AOT_CACHE_DIR``) holds them
+    cache `make test` fills (the Makefile's COMPILE_LOOPS_AOT; conftest's ``SLEWING_AOT_CACHE_DIR``) holds them
     for these sources: the library then takes its loops from them (numerics/compiled.py's ``aot_kernels``,
     which checks their sources' hash), as an FMU does, instead of loading each from numba's cache (1.5 s
     of CPU a command that solves; the answers are the same: tests/test_aot.py). Where they are not there:
