@@ -588,10 +588,7 @@ def settle_index(result: TurbineResult, settle: float | None = None) -> int:
     """The first sample of the figures' window: the first at or after ``time[0] + settle`` (None: the run's
     ``result.settle``)."""
     r = result
-    settle = r.settle if settle is None else float(settle)
-    duration = float(r.time[-1] - r.time[0])
-    if not (math.isfinite(settle) and 0.0 <= settle < duration):
-        raise ValueError(f"settle = {settle!r} s: must be >= 0 and shorter than the run ({duration:g} s)")
+    settle = resolve_settle(r.settle if settle is None else settle, float(r.time[-1] - r.time[0]))
     return int(np.searchsorted(r.time, r.time[0] + settle - 1e-9 * r.dt))
 
 
