@@ -46,7 +46,7 @@ ROOT = Path(__file__).resolve().parent
 from fmu_build.runtime import building_machine_paths, scrub_paths, version_needs  # noqa: E402
 from fmu_build.shim import (  # noqa: E402,F401  (the FMU's Linux layer, shared with fmu_build.drive)
     LINUX_BINARIES, PYTHON_HOME_VARIABLE, PYTHON_RUNTIME_FILE, RUNTIMES, compile_shim, install_python_shim,
-    python_runtime)
+    installed_builder, python_runtime)
 from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing_model the FMU runs with)
 
 
@@ -127,8 +127,6 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
                          "(it needs glibc 2.14 and GCC 5's libstdc++ already)")
     if runtime_python is not None and runtime != "standalone":
         raise ValueError("runtime_python is the Python a standalone FMU carries: it needs runtime='standalone'")
-    from pythonfmu import FmuBuilder
-
     from slewing_model import load_bearing
     from slewing_model.rings.superelement import build_superelement
 
@@ -166,11 +164,12 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
             built = _build_fmi3(output, files)
         else:
-            built = FmuBuilder.build_FMU(
-                ROOT / "fmu_src" / "SlewingBearing.py", dest=output, project_files=files,
-                canGetAndSetFMUstate=True, canSerializeFMUstate=True,
-                needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
-            )
+            with installed_builder("pythonfmu") as FmuBuilder:
+                built = FmuBuilder.build_FMU(
+                    ROOT / "fmu_src" / "SlewingBearing.py", dest=output, project_files=files,
+                    canGetAndSetFMUstate=True, canSerializeFMUstate=True,
+                    needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
+                )
     deflate(built)
     install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64,
                         win64_numba=win64_numba, stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
@@ -316,9 +315,8 @@ def ship_compiled_kernels(fmu, win64: bool = False) -> list[Path]:
 
 def _build_fmi3(output: Path, project_files) -> Path:
     """Package ``fmu_src/SlewingBearing3.py`` with pythonfmu3 (which writes ``<modelName>.fmu`` into a folder)."""
-    from pythonfmu3 import FmuBuilder as Fmu3Builder
-
-    with tempfile.TemporaryDirectory(prefix="slewing_fmu3_") as folder:
+    with tempfile.TemporaryDirectory(prefix="slewing_fmu3_") as folder, \
+            installed_builder("pythonfmu3") as Fmu3Builder:
         built = Fmu3Builder.build_FMU(ROOT / "fmu_src" / "SlewingBearing3.py", dest=folder,
                                       project_files=project_files, needsExecutionTool=True,
                                       canGetAndSetFMUState=True, canSerializeFMUState=True,

@@ -9,6 +9,7 @@ binary) or, for a host FMU, the building Python. It also writes ``resources/fmi_
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -47,6 +48,38 @@ RUN_TIME_INITS = ("resources/pythonfmu/__init__.py", "resources/pythonfmu3/__ini
 FMI2_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
 #: the default causality and variability of a variable that states none (FMI 2.0 and 3.0)
 DEFAULT_CAUSALITY, DEFAULT_VARIABILITY = "local", "continuous"
+
+
+@contextlib.contextmanager
+def installed_builder(package: str = "pythonfmu"):
+    """pythonfmu's (``package="pythonfmu3"``: pythonfmu3's) ``FmuBuilder`` from the installed package, for the
+    length of a build.
+
+    An FMU loaded in this process (fmpy runs one in-process) puts its own copy of the package first on
+    ``sys.path`` and in ``sys.modules``: a copy without the builder (:data:`BUILDER_IMPORT`), whose binaries are
+    the FMU's. The build then imports the installed package, and the FMU's copy comes back after it."""
+    import importlib
+    import importlib.metadata
+
+    def own(name):
+        return name == package or name.startswith(package + ".")
+
+    loaded = sys.modules.get(package)
+    if loaded is None or hasattr(loaded, "FmuBuilder"):
+        yield importlib.import_module(package).FmuBuilder
+        return
+    site = str(importlib.metadata.distribution(package).locate_file(""))
+    saved = {name: module for name, module in sys.modules.items() if own(name)}
+    for name in saved:
+        del sys.modules[name]
+    sys.path.insert(0, site)
+    try:
+        yield importlib.import_module(package).FmuBuilder
+    finally:
+        sys.path.remove(site)
+        for name in [name for name in sys.modules if own(name)]:
+            del sys.modules[name]
+        sys.modules.update(saved)
 
 
 def c_compiler() -> str:

@@ -439,3 +439,41 @@ def test_array_setter_reshapes_without_numpy_2_refusal(fmu3, tmp_path):
     slave.set_float64([var.value_reference], values.tolist())
     assert slave._arrays["contact_load"].shape == (BALLS, 4)
     assert slave.get_float64([var.value_reference]) == values.tolist()
+
+
+INPROCESS_THEN_BUILD = """
+import sys
+from fmpy import simulate_fmu
+from fmu_build.shim import installed_builder
+fmu, package = sys.argv[1], sys.argv[2]
+simulate_fmu(fmu, stop_time=0.02, output_interval=0.01)  # in this process: its package copy comes first
+copy = sys.modules[package]
+try:
+    __import__(package, fromlist=["FmuBuilder"]).FmuBuilder
+    print("plain import found the builder")
+except AttributeError:
+    print("plain import: the FMU's copy, no builder")
+with installed_builder(package) as builder:
+    print("installed:", sys.modules[builder.__module__].__file__)
+print("after:", sys.modules[package] is copy)
+"""
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_build_after_an_fmu_ran_in_process_uses_the_installed_builder(version, table3_fmu, fmu3):
+    """fmpy runs an FMU in the calling process, where the FMU's own copy of pythonfmu (pythonfmu3), without its
+    builder, then comes first: a build in that process still takes the installed package's builder, and the
+    FMU's copy is back after it."""
+    import subprocess
+    import sysconfig
+
+    fmu, package = {2: (table3_fmu, "pythonfmu"), 3: (fmu3, "pythonfmu3")}[version]
+    run = subprocess.run([sys.executable, "-c", INPROCESS_THEN_BUILD, str(fmu), package], capture_output=True,
+                         text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr[-3000:]
+    lines = run.stdout.splitlines()
+    assert "plain import: the FMU's copy, no builder" in lines, run.stdout
+    installed = Path(next(line for line in lines if line.startswith("installed:")).split(": ", 1)[1])
+    assert installed.is_relative_to(Path(sysconfig.get_paths()["purelib"]).resolve()) or \
+        installed.is_relative_to(Path(sysconfig.get_paths()["purelib"])), installed
+    assert "after: True" in lines, run.stdout
