@@ -156,6 +156,24 @@ def table3_fmu3(tmp_path_factory):
     return _build_table3(tmp_path_factory, "SlewingBearing3_table3.fmu", fmi_version=3, numba=False)
 
 
+#: the platform tests in full (every FMU under every Windows host, the SSP under wine): tests/win64/run_all.sh sets
+#: SLEWING_TEST_PLATFORMS_FULL=1; `make test` runs each host on one or two FMUs, so that every platform is
+#: covered within the CI's 20 minutes
+PLATFORMS_FULL = os.environ.get("SLEWING_TEST_PLATFORMS_FULL") == "1"
+
+
+def platform_cases(cases, make_test):
+    """``cases`` in full with SLEWING_TEST_PLATFORMS_FULL=1, else those in ``make_test``."""
+    return list(cases) if PLATFORMS_FULL else [case for case in cases if case in make_test]
+
+
+def needs_numba_fmu_opt_in():
+    """Skip unless SLEWING_TEST_NUMBA_FMU=1: the FMUs with numba's loops compile them for three CPUs."""
+    if os.environ.get("SLEWING_TEST_NUMBA_FMU") != "1":
+        pytest.skip("SKIPPED: the --numba FMU's tests are opt-in (numba's loops compiled for three CPUs, about 3 "
+                    "minutes): set SLEWING_TEST_NUMBA_FMU=1")
+
+
 def _needs_numba():
     from slewing_model.numerics import compiled
 
@@ -170,9 +188,7 @@ def table3_numba_fmu(tmp_path_factory):
     compiling numba's loops for the two other CPUs takes about 3 minutes of the CI's 20, for a build that
     is no longer the default."""
     _needs_numba()
-    if os.environ.get("SLEWING_TEST_NUMBA_FMU") != "1":
-        pytest.skip("SKIPPED: the --numba FMU's tests are opt-in (numba's loops compiled for three CPUs, about 3 "
-                    "minutes): set SLEWING_TEST_NUMBA_FMU=1")
+    needs_numba_fmu_opt_in()
     return _build_table3(tmp_path_factory, "SlewingBearing_table3_numba.fmu", numba=True)
 
 

@@ -7,7 +7,10 @@ Each FMU (the FMI 2.0 and 3.0 bearing FMUs and the drive FMU) runs in
 (b) fmpy 0.3.32 on the official embeddable CPython 3.11.9 (a Python host: the FMU uses its interpreter);
 (c) fmusim v0.0.39 cross-compiled with mingw-w64 (tests/win64/build_fmusim.sh; skipped where it is not built);
 ``SLEWING_WINE_RUNS`` times each (1 in ``make test``, 5 in ``tests/win64/run_all.sh``); every run exits 0 and gives
-fmpy's outputs on Linux within 1e-9 relative. These FMUs run numpy's loops (``--no-numba``); the default build's
+fmpy's outputs on Linux within 1e-9 relative. ``make test`` runs every FMU in (a), the FMI 3.0 bearing in (b), the FMI
+2.0 bearing in (c) and the drive beside a bearing in one process; ``tests/win64/run_all.sh``
+(``SLEWING_TEST_PLATFORMS_FULL=1``) runs every FMU in every host, the SSP's four FMUs together and, with
+``SLEWING_TEST_NUMBA_FMU=1``, the ``--win64-numba`` FMU. These FMUs run numpy's loops (``--no-numba``); the default build's
 (``--aot``) win64 half runs the loops compiled ahead of time for Windows, in our C host too. The runtime carries
 what the FMU imports (the import audit's lists in fmu_build/win64.py): these runs show that nothing is missing.
 
@@ -37,7 +40,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import win64_tools as w  # noqa: E402
-from conftest import has_x86_64_v3  # noqa: E402
+from conftest import has_x86_64_v3, needs_numba_fmu_opt_in, platform_cases, PLATFORMS_FULL  # noqa: E402
 from host_output import parse_host_output  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -163,7 +166,7 @@ def test_our_c_host_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus
             assert values["deserialized"][k] == values["run"][k]
 
 
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", platform_cases(CASES, make_test=["bearing3"]))
 def test_fmpy_on_the_embeddable_windows_python_runs_the_win64_binary_under_wine(case, fmus):
     python = w.windows_python()
     _, _, inputs, outputs = CASES[case]
@@ -185,6 +188,7 @@ def numba_fmu(tmp_path_factory):
     loops (the Windows ones compiled under wine at build time, kept beside the tests' wine prefix once per
     version of the loops). That compilation takes about five minutes under wine (two CPUs): until it is
     kept, the test is skipped, saying so (run tests/win64/run_all.sh, or set SLEWING_BUILD_WIN64_NUMBA=1)."""
+    needs_numba_fmu_opt_in()
     sys.path.insert(0, str(ROOT))
     import fmu_build.win64
     from build_fmu import build_fmu
@@ -374,7 +378,7 @@ def fmusim():
     return binary
 
 
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", platform_cases(CASES, make_test=["bearing2"]))
 def test_fmusim_built_with_mingw_runs_the_win64_binary_under_wine(case, fmus, fmusim, tmp_path):
     from fmpy import simulate_fmu
 
@@ -430,7 +434,7 @@ def fmpy_single(fmu, input_name, output_name, values):
     return out
 
 
-@pytest.mark.parametrize("first", ["bearing2", "drive"])
+@pytest.mark.parametrize("first", platform_cases(["bearing2", "drive"], make_test=["drive"]))
 def test_two_of_our_fmus_in_one_windows_c_process(first, fmus, tmp_path):
     # the first FMU starts its Python; the second finds it running and uses it (its own folders appended)
     program = w.mingw(tmp_path / "two_fmus.exe", [ROOT / "tests" / "win64" / "two_fmus.c"])
@@ -454,6 +458,8 @@ def test_two_of_our_fmus_in_one_windows_c_process(first, fmus, tmp_path):
         assert [rows[label, k] for k in range(4)] == pytest.approx(expected, rel=REL, abs=1e-300), case
 
 
+@pytest.mark.skipif(not PLATFORMS_FULL, reason="SKIPPED in make test (about a minute under wine): the SSP's four "
+                    "FMUs together under wine run in tests/win64/run_all.sh (SLEWING_TEST_PLATFORMS_FULL=1)")
 def test_the_ssps_four_fmus_carry_win64_and_run_together_in_fmpy_on_windows(table3_fmu, drive_fmu, tmp_path):
     # the pitch system SSP of test_ssp.py (bearing, drive, two time tables), built as build_ssp.py builds it:
     # every FMU carries its win64 binary; fmpy's simulate_ssp on the embeddable Windows Python runs all four

@@ -8,4 +8,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 nice -n 10 bash tests/linux_floor/build.sh
-SLEWING_FLOOR_FMUSIM_RUNS=${SLEWING_FLOOR_FMUSIM_RUNS:-20} nice -n 10 .venv/bin/python -m pytest -q tests/test_linux_floor.py "$@"
+SLEWING_TEST_NUMBA_FMU=1 SLEWING_FLOOR_FMUSIM_RUNS=${SLEWING_FLOOR_FMUSIM_RUNS:-20} nice -n 10 .venv/bin/python -m pytest -q tests/test_linux_floor.py "$@"

@@ -8,4 +8,4 @@
 #   bash tests/win64/run_all.sh [pytest options]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-SLEWING_WINE_RUNS=${SLEWING_WINE_RUNS:-5} SLEWING_BUILD_FMUSIM=1 SLEWING_BUILD_WIN64_NUMBA=1 SLEWING_BUILD_WIN64_AOT=1 nice -n 10 .venv/bin/python -m pytest -q tests/test_win64.py "$@"
+SLEWING_TEST_PLATFORMS_FULL=1 SLEWING_TEST_NUMBA_FMU=1 SLEWING_WINE_RUNS=${SLEWING_WINE_RUNS:-5} SLEWING_BUILD_FMUSIM=1 SLEWING_BUILD_WIN64_NUMBA=1 SLEWING_BUILD_WIN64_AOT=1 nice -n 10 .venv/bin/python -m pytest -q tests/test_win64.py "$@"
