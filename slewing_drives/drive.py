@@ -39,6 +39,26 @@ except ModuleNotFoundError:  # pragma: no cover
     import tomli as tomllib
 
 
+#: the drive file's keys: (table, key, DriveParameters attribute, factor to SI, rule, default or None if required)
+DRIVE_FILE_KEYS = (
+    ("drive", "ring_inertia_kgm2", "ring_inertia", 1.0, "a finite number > 0", None),
+    ("drive", "motor_inertia_kgm2", "motor_inertia", 1.0, "a finite number > 0", None),
+    ("drive", "motor_count", "motor_count", 1, "a whole number >= 1", 1),
+    ("drive", "gear_ratio", "gear_ratio", 1.0, "a finite number > 0", None),
+    ("drive", "efficiency", "efficiency", 1.0, "in (0, 1]", None),
+    ("drive", "motor_torque_limit_nm", "torque_limit", 1.0, "a finite number > 0", None),
+    ("drive", "torque_time_constant_s", "torque_time_constant", 1.0, "a finite number > 0", None),
+    ("drive", "rate_limit_deg_s", "rate_limit", math.pi / 180.0, "a finite number > 0", None),
+    ("control", "position_gain_per_s", "position_gain", 1.0, "a finite number > 0", None),
+    ("control", "position_integral_gain_per_s2", "position_integral_gain", 1.0, "a finite number >= 0", None),
+    ("control", "speed_gain_nm_s_per_rad", "speed_gain", 1.0, "a finite number > 0", None),
+    ("control", "speed_integral_gain_nm_per_rad", "speed_integral_gain", 1.0, "a finite number >= 0", None),
+    ("control", "speed_setpoint_weight", "speed_setpoint_weight", 1.0, "a finite number >= 0", 1.0),
+)
+_RULES = {"a finite number > 0": lambda v: v > 0, "a finite number >= 0": lambda v: v >= 0,
+          "a whole number >= 1": lambda v: v >= 1 and v == int(v), "in (0, 1]": lambda v: 0 < v <= 1}
+
+
 @dataclass(frozen=True)
 class DriveParameters:
     """Electric slewing drive (SI units, angles in rad on the ring side).
@@ -132,31 +152,32 @@ class DriveParameters:
         Raises
         ------
         ValueError
-            If a value is not a finite positive number or the efficiency is not in (0, 1].
+            Naming the table, the key, the value and the rule: a required key missing, a value that is not a
+            finite number within its rule (gains, inertias and limits > 0, integral gains and the setpoint
+            weight >= 0, the efficiency in (0, 1], the motor count a whole number >= 1), or an unknown table
+            or key.
         """
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
-        d, c = data["drive"], data["control"]
-        deg = math.pi / 180.0
-        values = dict(
-            name=d.get("name", "drive"),
-            ring_inertia=d["ring_inertia_kgm2"], motor_inertia=d["motor_inertia_kgm2"],
-            motor_count=d.get("motor_count", 1), gear_ratio=d["gear_ratio"], efficiency=d["efficiency"],
-            torque_limit=d["motor_torque_limit_nm"], torque_time_constant=d["torque_time_constant_s"],
-            rate_limit=d["rate_limit_deg_s"] * deg,
-            position_gain=c["position_gain_per_s"], position_integral_gain=c["position_integral_gain_per_s2"],
-            speed_gain=c["speed_gain_nm_s_per_rad"], speed_integral_gain=c["speed_integral_gain_nm_per_rad"],
-            speed_setpoint_weight=c.get("speed_setpoint_weight", 1.0),
-            sources=data.get("sources", {}),
-        )
-        for key, value in values.items():
-            if key not in ("name", "sources") and (not isinstance(value, (int, float)) or not math.isfinite(value)
-                                                   or value < 0 or (value == 0 and key not in (
-                                                       "position_integral_gain", "speed_integral_gain",
-                                                       "speed_setpoint_weight"))):
-                raise ValueError(f"{path}: {key} = {value!r}: must be a finite number > 0")
-        if not 0 < values["efficiency"] <= 1:
-            raise ValueError(f"{path}: efficiency = {values['efficiency']!r}: must lie in (0, 1]")
+        unknown = sorted(set(data) - {"drive", "control", "sources"})
+        if unknown:
+            raise ValueError(f"{path}: unknown table [{unknown[0]}]: the tables are [drive], [control] and [sources]")
+        for table in ("drive", "control"):
+            known = {key for section, key, *_ in DRIVE_FILE_KEYS if section == table} | ({"name"} if table == "drive"
+                                                                                         else set())
+            unknown = sorted(set(data.get(table, {})) - known)
+            if unknown:
+                raise ValueError(f"{path}: [{table}] {unknown[0]}: unknown key; [{table}] takes "
+                                 + ", ".join(sorted(known)))
+        values = {"name": data.get("drive", {}).get("name", "drive"), "sources": data.get("sources", {})}
+        for table, key, attribute, to_si, rule, default in DRIVE_FILE_KEYS:
+            value = data.get(table, {}).get(key, default)
+            if value is None:
+                raise ValueError(f"{path}: [{table}] {key} is missing")
+            number = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            if not number or not _RULES[rule](value):
+                raise ValueError(f"{path}: [{table}] {key} = {value!r}: must be {rule}")
+            values[attribute] = int(value) if key == "motor_count" else value * to_si
         return cls(**values)
 
 

@@ -4,7 +4,7 @@ import control
 import numpy as np
 import pytest
 
-from slewing_drives.drive import DriveParameters, ElectricDrive, linear_model
+from slewing_drives.drive import DRIVE_FILE_KEYS, DriveParameters, ElectricDrive, linear_model
 
 DRIVES = ["examples/drives/pitch_drive.toml", "examples/drives/yaw_drive.toml"]
 
@@ -82,8 +82,53 @@ def test_friction_holds_a_ring_the_drive_does_not_push(tmp_path):
     assert drive.state.speed == 0.0 and drive.state.angle == 0.0
 
 
-def test_bad_drive_file_is_refused(tmp_path):
-    text = open(DRIVES[0]).read().replace("efficiency = 0.90", "efficiency = 1.5")
-    (tmp_path / "d.toml").write_text(text)
-    with pytest.raises(ValueError, match=r"efficiency = 1.5: must lie in \(0, 1\]"):
-        DriveParameters.from_toml(tmp_path / "d.toml")
+def _drive_file(tmp_path, drop=None, change=None, extra=None) -> str:
+    """examples/drives/pitch_drive.toml with one line dropped, one value changed or one line added."""
+    lines = []
+    for line in open(DRIVES[0]).read().splitlines():
+        key = line.split("=")[0].strip()
+        if key == drop:
+            continue
+        if change and key == change[0]:
+            line = f"{key} = {change[1]}"
+        lines.append(line)
+        if extra and line.strip() == f"[{extra[0]}]":
+            lines.append(extra[1])
+    path = tmp_path / "drive.toml"
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+@pytest.mark.parametrize("table, key, _attribute, _to_si, rule, default", DRIVE_FILE_KEYS,
+                         ids=[k[1] for k in DRIVE_FILE_KEYS])
+def test_a_bad_drive_file_is_refused_naming_the_table_the_key_the_value_and_the_rule(
+        tmp_path, table, key, _attribute, _to_si, rule, default):
+    # a value just outside the rule, a non-number, a missing key (where required): each message names the file's key
+    outside = {"a finite number > 0": "0.0", "a finite number >= 0": "-1e-9", "a whole number >= 1": "1.5",
+               "in (0, 1]": "1.01"}[rule]
+    for value in (outside, '"fast"', "nan"):
+        with pytest.raises(ValueError) as refused:
+            DriveParameters.from_toml(_drive_file(tmp_path, change=(key, value)))
+        assert f"[{table}] {key} = " in str(refused.value) and f"must be {rule}" in str(refused.value)
+    if default is None:
+        with pytest.raises(ValueError, match=rf"\[{table}\] {key} is missing"):
+            DriveParameters.from_toml(_drive_file(tmp_path, drop=key))
+    else:
+        assert getattr(DriveParameters.from_toml(_drive_file(tmp_path, drop=key)), _attribute) == default
+
+
+def test_an_unknown_key_or_table_of_a_drive_file_is_refused(tmp_path):
+    with pytest.raises(ValueError, match=r"\[control\] speed_gain: unknown key"):
+        DriveParameters.from_toml(_drive_file(tmp_path, extra=("control", "speed_gain = 900.0")))
+    with pytest.raises(ValueError, match=r"unknown table \[motor\]"):
+        path = _drive_file(tmp_path)
+        with open(path, "a") as fh:
+            fh.write("[motor]\nkt = 1.5\n")
+        DriveParameters.from_toml(path)
+
+
+def test_the_drive_file_keys_convert_to_si():
+    # the rate limit is the one key in other units than SI: deg/s in the file, rad/s in DriveParameters
+    p = DriveParameters.from_toml(DRIVES[0])
+    assert p.rate_limit == pytest.approx(np.radians(8.0), rel=1e-15)
+    assert p.torque_limit == 120.0 and p.motor_count == 1 and isinstance(p.motor_count, int)
