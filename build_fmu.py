@@ -7,7 +7,9 @@
 Builds (or takes from the cache) the ring superelement, then packages with
 pythonfmu (FMI 2.0) or pythonfmu3 (FMI 3.0): the slave ``fmu_src/SlewingBearing.py``,
 the run-time modules of ``slewing_model`` (numpy only: no scipy, no scikit-fem),
-``bearing.json`` (the definition in SI units) and ``superelement.npz``. It then
+``bearing.json`` (the definition in SI units), the ring superelement (the folder
+``superelement``: :meth:`slewing_model.rings.stiffness.Superelement.save_folder`) and the
+methods of ``slewing_model``'s dataclasses compiled (``fmu_src/dataclass_code.py``). It then
 compiles the FMU's Linux binary (``fmu_src/shim/``, needs a C compiler), a layer in
 front of pythonfmu's that starts Python in a C host:
 
@@ -43,6 +45,7 @@ import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
+from fmu_build.bytecode import dataclass_code  # noqa: E402
 from fmu_build.runtime import building_machine_paths, scrub_paths, version_needs  # noqa: E402
 from fmu_build.shim import (  # noqa: E402,F401  (the FMU's Linux layer, shared with fmu_build.drive)
     LINUX_BINARIES, PYTHON_HOME_VARIABLE, PYTHON_RUNTIME_FILE, RUNTIMES, compile_shim, install_python_shim,
@@ -147,11 +150,14 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
             if source.exists():
                 (package / name).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(source, package / f"{name}.py")
+        # the methods of its dataclasses compiled (fmu_src/dataclass_code.py), for all the modules an FMU may import
+        dataclass_code(tmp, [runtime_module_name(name) for name in RUNTIME_MODULES], tmp / DATACLASS_CODE_FILE)
         (tmp / "bearing.json").write_text(json.dumps(bearing.to_dict()))
-        superelement.save(tmp / "superelement.npz")
+        superelement.save_folder(tmp / SUPERELEMENT_FOLDER)     # .npy files: read without zipfile
         (tmp / KERNELS_FILE).write_text("auto\n" if numba or aot else "numpy\n")
-        files = [package, tmp / "bearing.json", tmp / "superelement.npz", tmp / KERNELS_FILE,
-                 ROOT / "fmu_src" / "bearing_variables.py"]
+        files = [package, tmp / "bearing.json", tmp / SUPERELEMENT_FOLDER, tmp / KERNELS_FILE,
+                 ROOT / "fmu_src" / "bearing_variables.py", tmp / DATACLASS_CODE_FILE,
+                 ROOT / "fmu_src" / "dataclass_code.py"]
         extra_needs = []
         if aot:                                       # beside slewing_model in resources/, on the slave's path
             import fmu_build.aot
@@ -164,7 +170,7 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
             built = _build_fmi3(output, files)
         else:
-            with installed_builder("pythonfmu") as FmuBuilder:
+            with installed_builder("pythonfmu", ROOT / "fmu_src" / "SlewingBearing.py") as FmuBuilder:
                 built = FmuBuilder.build_FMU(
                     ROOT / "fmu_src" / "SlewingBearing.py", dest=output, project_files=files,
                     canGetAndSetFMUstate=True, canSerializeFMUstate=True,
@@ -198,10 +204,21 @@ def deflate(fmu) -> None:
     os.replace(partial, fmu)
 
 
+#: the file of the FMU's resources that holds its dataclasses' compiled methods (fmu_src/dataclass_code.py reads it)
+DATACLASS_CODE_FILE = "dataclass_code.bin"
+#: the folder of the FMU's resources that holds the ring superelement (fmu_src/SlewingBearing.py reads it)
+SUPERELEMENT_FOLDER = "superelement"
 #: the file of the FMU's resources that names the loops it runs (fmu_src/bearing_variables.py reads it)
 KERNELS_FILE = "kernels.txt"
 #: the CPU of the compiled loops besides the portable ones (fmu_src/bearing_variables.py reads it)
 NUMBA_TARGET_FILE = "numba_target.txt"
+
+
+def runtime_module_name(name: str) -> str:
+    """The dotted name of a module of :data:`slewing_model.RUNTIME_MODULES`: ``life/duty`` ->
+    ``slewing_model.life.duty``, ``bearing/__init__`` -> ``slewing_model.bearing``."""
+    parts = ["slewing_model", *name.split("/")]
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
 def resolve_loops(runtime: str, numba=None, aot=None) -> str:
@@ -316,7 +333,7 @@ def ship_compiled_kernels(fmu, win64: bool = False) -> list[Path]:
 def _build_fmi3(output: Path, project_files) -> Path:
     """Package ``fmu_src/SlewingBearing3.py`` with pythonfmu3 (which writes ``<modelName>.fmu`` into a folder)."""
     with tempfile.TemporaryDirectory(prefix="slewing_fmu3_") as folder, \
-            installed_builder("pythonfmu3") as Fmu3Builder:
+            installed_builder("pythonfmu3", ROOT / "fmu_src" / "SlewingBearing3.py") as Fmu3Builder:
         built = Fmu3Builder.build_FMU(ROOT / "fmu_src" / "SlewingBearing3.py", dest=folder,
                                       project_files=project_files, needsExecutionTool=True,
                                       canGetAndSetFMUState=True, canSerializeFMUState=True,

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import importlib.util
 import marshal
+import subprocess
 import sys
 from pathlib import Path, PurePosixPath
 
@@ -69,3 +70,37 @@ def compile_tree(root: Path, names_from: Path | None = None, checked: bool = Fal
         target.write_bytes(data)
         written += 1
     return written
+
+
+#: run in a child Python: imports the modules named by argv[3:] from the folder argv[1] with every source
+#: that ``dataclasses`` executes compiled on the way, and writes them to argv[2] (:func:`dataclass_code`)
+_DATACLASS_RECORDER = """
+import builtins, dataclasses, importlib, importlib.util, marshal, sys
+codes = {}
+def exec_(source, globals=None, locals=None, /):
+    if isinstance(source, str):
+        if source not in codes:
+            codes[source] = compile(source, '<string>', 'exec', dont_inherit=True)
+        source = codes[source]
+    builtins.exec(source, globals, locals)
+dataclasses.exec = exec_
+sys.path.insert(0, sys.argv[1])
+for name in sys.argv[3:]:
+    importlib.import_module(name)
+with open(sys.argv[2], 'wb') as fh:
+    fh.write(importlib.util.MAGIC_NUMBER + marshal.dumps(codes))
+"""
+
+
+def dataclass_code(folder: Path, modules, output: Path) -> int:
+    """Write to ``output`` the compiled methods of the dataclasses that importing ``modules`` (dotted names,
+    found in ``folder`` first) creates, for ``fmu_src/dataclass_code.py``: :data:`importlib.util.MAGIC_NUMBER`,
+    then the marshalled dict of the sources ``dataclasses`` executes to the code objects compiled from them
+    (as ``exec`` compiles them: file name ``<string>``, no future features). Imported in a child of this
+    Python, which writes no bytecode; returns the number of sources."""
+    run = subprocess.run([sys.executable, "-B", "-c", _DATACLASS_RECORDER, str(folder), str(output), *modules],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        raise RuntimeError(f"compiling the dataclasses' methods of {', '.join(modules)} failed:\n{run.stderr[-3000:]}")
+    data = Path(output).read_bytes()
+    return len(marshal.loads(data[len(importlib.util.MAGIC_NUMBER):]))

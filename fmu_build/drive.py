@@ -53,7 +53,7 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5, wi
         (package / "__init__.py").write_text('"""The drive model alone (the FMU runs with numpy only)."""\n')
         shutil.copy2(ROOT / "slewing_drives" / "drive.py", package / "drive.py")
         (tmp / "drive.json").write_text(json.dumps(definition))
-        with installed_builder("pythonfmu") as FmuBuilder:
+        with installed_builder("pythonfmu", ROOT / "fmu_src" / "SlewingDrive.py") as FmuBuilder:
             built = FmuBuilder.build_FMU(ROOT / "fmu_src" / "SlewingDrive.py", dest=output,
                                          project_files=[package, tmp / "drive.json"],
                                          canGetAndSetFMUstate=True, canSerializeFMUstate=True,
@@ -97,7 +97,7 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
         (tmp / "table.json").write_text(json.dumps({
             "name": name, "interpolation": interpolation, "time": time.tolist(),
             "columns": [list(c) for c in columns], "values": values.tolist()}))
-        with installed_builder("pythonfmu") as FmuBuilder:
+        with installed_builder("pythonfmu", ROOT / "fmu_src" / "TimeTable.py") as FmuBuilder:
             built = FmuBuilder.build_FMU(ROOT / "fmu_src" / "TimeTable.py", dest=output,
                                          project_files=[tmp / "table.json"], canGetAndSetFMUstate=True,
                                          canSerializeFMUstate=True, needsExecutionTool=True,

@@ -44,6 +44,45 @@ VARIABLES_FILE = "fmi_variables.tsv"
 #: the line is left out of their ``__init__.py`` in the FMU
 BUILDER_IMPORT = b"from .builder import FmuBuilder\n"
 RUN_TIME_INITS = ("resources/pythonfmu/__init__.py", "resources/pythonfmu3/__init__.py")
+#: their slave modules import pathlib, which they do not use, and xml for the model description, which a running
+#: FMU never writes (with pathlib's urllib and ipaddress, about 10 ms of every instantiation): in the FMU the
+#: first is left out and the second made lazy, ``Element`` and ``SubElement`` importing xml when first called
+PATHLIB_IMPORT = b"from pathlib import Path\n"
+XML_IMPORTS = {name: b"from xml.etree.ElementTree import " + name + b"\n"
+               for name in (b"Element, SubElement", b"Element")}
+
+
+def _lazy_xml(names: bytes) -> bytes:
+    """What replaces ``from xml.etree.ElementTree import <names>`` in the FMU's copy of pythonfmu: functions of
+    those names that import xml when first called."""
+    return b"".join(b"def %s(*args, **kwargs):  # build_fmu.py: xml is imported where a model description is written\n"
+                    b"    from xml.etree.ElementTree import %s as made\n"
+                    b"    return made(*args, **kwargs)\n\n\n" % (name, name) for name in names.split(b", "))
+
+
+#: the FMU's copies of pythonfmu's and pythonfmu3's modules: the lines left out or replaced (a line that is not
+#: there, in another version of theirs, is left as it is)
+RUN_TIME_EDITS = {
+    **{init: ((BUILDER_IMPORT, b""),) for init in RUN_TIME_INITS},
+    "resources/pythonfmu/fmi2slave.py": ((PATHLIB_IMPORT, b""), (XML_IMPORTS[b"Element, SubElement"],
+                                                                 _lazy_xml(b"Element, SubElement"))),
+    "resources/pythonfmu3/fmi3slave.py": ((PATHLIB_IMPORT, b""), (XML_IMPORTS[b"Element, SubElement"],
+                                                                  _lazy_xml(b"Element, SubElement"))),
+    **{f"resources/{module}": ((line, _lazy_xml(names)),)
+       for module, names in (("pythonfmu/variables.py", b"Element, SubElement"),
+                             ("pythonfmu3/variables.py", b"Element, SubElement"),
+                             ("pythonfmu3/unit.py", b"Element"), ("pythonfmu3/variable_types.py", b"Element"))
+       for line in (XML_IMPORTS[names],)},
+}
+
+
+def run_time_copy(name: str, data: bytes) -> bytes:
+    """The FMU's copy of the file ``name`` (its path in the FMU): :data:`RUN_TIME_EDITS` made."""
+    for line, replacement in RUN_TIME_EDITS.get(name, ()):
+        data = data.replace(line, replacement)
+    return data
+
+
 #: FMI 2.0's type elements of a ScalarVariable
 FMI2_TYPES = ("Real", "Integer", "Boolean", "String", "Enumeration")
 #: the default causality and variability of a variable that states none (FMI 2.0 and 3.0)
@@ -51,33 +90,41 @@ DEFAULT_CAUSALITY, DEFAULT_VARIABILITY = "local", "continuous"
 
 
 @contextlib.contextmanager
-def installed_builder(package: str = "pythonfmu"):
+def installed_builder(package: str = "pythonfmu", script=None):
     """pythonfmu's (``package="pythonfmu3"``: pythonfmu3's) ``FmuBuilder`` from the installed package, for the
-    length of a build.
+    length of a build of the slave ``script``.
 
-    An FMU loaded in this process (fmpy runs one in-process) puts its own copy of the package first on
-    ``sys.path`` and in ``sys.modules``: a copy without the builder (:data:`BUILDER_IMPORT`), whose binaries are
-    the FMU's. The build then imports the installed package, and the FMU's copy comes back after it."""
+    An FMU loaded in this process (fmpy runs one in-process) leaves its own modules in ``sys.modules``: its
+    copy of the package, without the builder (:data:`BUILDER_IMPORT`) and with the FMU's binaries, first on
+    ``sys.path`` too; and its copy of the slave, under the name the builder imports ``script`` by. For the
+    build both are set aside, the installed package and ``script`` imported, and the FMU's modules come back
+    after it."""
     import importlib
     import importlib.metadata
 
-    def own(name):
-        return name == package or name.startswith(package + ".")
-
     loaded = sys.modules.get(package)
-    if loaded is None or hasattr(loaded, "FmuBuilder"):
-        yield importlib.import_module(package).FmuBuilder
-        return
-    site = str(importlib.metadata.distribution(package).locate_file(""))
-    saved = {name: module for name, module in sys.modules.items() if own(name)}
+    foreign = loaded is not None and not hasattr(loaded, "FmuBuilder")       # an FMU's copy of the package
+    slave = Path(script).stem if script is not None else None
+
+    def an_fmus(name):
+        if foreign and (name == package or name.startswith(package + ".")):
+            return True
+        module_file = getattr(sys.modules[name], "__file__", None) or ""
+        return name == slave and os.path.realpath(module_file) != os.path.realpath(script)
+
+    saved = {name: sys.modules[name] for name in list(sys.modules) if an_fmus(name)}
     for name in saved:
         del sys.modules[name]
-    sys.path.insert(0, site)
+    site = str(importlib.metadata.distribution(package).locate_file("")) if foreign else None
+    if site:
+        sys.path.insert(0, site)
     try:
         yield importlib.import_module(package).FmuBuilder
     finally:
-        sys.path.remove(site)
-        for name in [name for name in sys.modules if own(name)]:
+        if site:
+            sys.path.remove(site)
+        for name in [name for name in sys.modules if name in saved or (foreign and (
+                name == package or name.startswith(package + ".")))]:
             del sys.modules[name]
         sys.modules.update(saved)
 
@@ -271,9 +318,7 @@ def install_python_shim(fmu, model_identifier, fmi_version=2, runtime="standalon
                     elif win64 and info.filename in windows:
                         continue                          # pythonfmu's DLL: written below, behind our layer
                     elif not info.filename.endswith((PYTHON_RUNTIME_FILE, VARIABLES_FILE)):
-                        data = src.read(info.filename)
-                        if info.filename in RUN_TIME_INITS:
-                            data = data.replace(BUILDER_IMPORT, b"")
+                        data = run_time_copy(info.filename, src.read(info.filename))
                         dst.writestr(info, data)
                         if info.filename.startswith("resources/") and info.filename.endswith(".py"):
                             # its bytecode, naming the module by its path in resources/ (fmu_build.bytecode)

@@ -2,8 +2,9 @@
 
 A thin wrapper: it maps FMI variables onto :class:`slewing_model.simulation.simulator.BearingSimulator`
 and holds no physics. ``build_fmu.py`` packages it with the run-time part of
-``slewing_model``, the bearing definition (``bearing.json``) and the ring
-superelement (``superelement.npz``) in the FMU's resources.
+``slewing_model``, the bearing definition (``bearing.json``), the ring
+superelement (the folder ``superelement``) and the compiled methods of
+``slewing_model``'s dataclasses (``dataclass_code.py``) in the FMU's resources.
 
 What pythonfmu 0.7.0 does not write, :meth:`SlewingBearing.to_xml` adds:
 units and ``UnitDefinitions``, ``ModelStructure/Outputs`` dependencies and
@@ -82,17 +83,17 @@ def _find_numpy() -> None:
 
 
 _find_numpy()
-from xml.etree.ElementTree import Element, SubElement
-
 import numpy as np
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Initial, Fmi2Status
 from pythonfmu.default_experiment import DefaultExperiment
 
+from dataclass_code import precompiled
 
-from slewing_model import Bearing
-from slewing_model.simulation.simulator import BearingSimulator, decode_state, encode_state
+with precompiled():     # the dataclasses' methods as compiled when the FMU was built (dataclass_code.py)
+    from slewing_model import Bearing
+    from slewing_model.simulation.simulator import BearingSimulator, decode_state, encode_state
 
 from bearing_variables import (  # the variable tables, shared with the FMI 3.0 slave
     BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
@@ -141,7 +142,7 @@ class SlewingBearing(Fmi2Slave):
         resources = self.resources or os.path.dirname(os.path.abspath(__file__))
         with open(os.path.join(resources, "bearing.json")) as fh:
             self.bearing = Bearing.from_si_dict(json.load(fh))
-        self.superelement_path = os.path.join(resources, "superelement.npz")
+        self.superelement_path = os.path.join(resources, "superelement")
         self.kernels = kernels_of(resources)
         self.default_experiment = DefaultExperiment(start_time=0.0, stop_time=10.0, step_size=0.01)
         self.modelName = "SlewingBearing"
@@ -207,6 +208,8 @@ class SlewingBearing(Fmi2Slave):
 
     def to_xml(self, model_options=dict()) -> Element:
         """pythonfmu's model description plus units, dependencies and initial unknowns."""
+        from xml.etree.ElementTree import Element, SubElement     # the build's: an instance never needs xml
+
         self.vars.make_all()
         root = super().to_xml(model_options)
         definitions = Element("UnitDefinitions")

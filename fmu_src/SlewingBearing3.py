@@ -39,8 +39,11 @@ from pythonfmu3 import (DefaultExperiment, Dimension, Fmi3Causality, Fmi3Initial
 from bearing_variables import (BALL_ARRAYS, COUNT_OUTPUT, INPUTS, INTEGER_PARAMETERS, OUTPUTS, REAL_PARAMETERS,
                                UNITS, build_simulator, choice_description, integer_default, kernels_of,
                                scalar_outputs, step_or_refuse)
-from slewing_model import Bearing
-from slewing_model.simulation.simulator import BearingSimulator, decode_state, encode_state
+from dataclass_code import precompiled
+
+with precompiled():     # the dataclasses' methods as compiled when the FMU was built (dataclass_code.py)
+    from slewing_model import Bearing
+    from slewing_model.simulation.simulator import BearingSimulator, decode_state, encode_state
 
 
 class SlewingBearing3(Fmi3Slave):
@@ -51,7 +54,7 @@ class SlewingBearing3(Fmi3Slave):
         resources = self.resources or os.path.dirname(os.path.abspath(__file__))
         with open(os.path.join(resources, "bearing.json")) as fh:
             self.bearing = Bearing.from_si_dict(json.load(fh))
-        self.superelement_path = os.path.join(resources, "superelement.npz")
+        self.superelement_path = os.path.join(resources, "superelement")
         self.kernels = kernels_of(resources)
         self.author = "slewing_model"
         self.description = ("Four-point contact slewing bearing: load distribution (Flexible-BIME) and friction "

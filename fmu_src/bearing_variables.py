@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 import sys
-import traceback
+
+from dataclass_code import precompiled
 
 #: SI units of the variables, as FMI UnitDefinitions: name -> exponents of (kg, m, s, rad)
 UNITS = {
@@ -233,7 +234,8 @@ def build_simulator(slave, error) -> bool:
         superelement = None
         if settings.ring_model == "flexible":
             superelement = Superelement.load(slave.superelement_path, slave.bearing)
-        slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
+        with precompiled():         # the life accumulators' modules, imported where life is on
+            slave.simulator = BearingSimulator(slave.bearing, superelement, settings)
         from slewing_model.numerics.compiled import aot_target, use_compiled
 
         target = aot_target()
@@ -244,6 +246,8 @@ def build_simulator(slave, error) -> bool:
     except ValueError as exc:
         slave.log(f"{slave.instance_name}: {exc}", error)
     except Exception:
+        import traceback
+
         slave.log(f"{slave.instance_name}: internal error:\n{traceback.format_exc()}", error)
     return False
 
@@ -281,6 +285,8 @@ def step_or_refuse(slave, current_time, discard, error, warning=None):
         slave._refused = key
         return None
     except Exception:
+        import traceback
+
         slave.log(f"{slave.instance_name}: internal error:\n{traceback.format_exc()}", error)
         return None
     slave._refused = None

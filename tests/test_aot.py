@@ -171,3 +171,27 @@ def test_fmu_with_loops_compiled_ahead_of_time_runs_in_a_c_host_without_numba(ao
     for label, steps in values["aot"].items():           # compiled loops against numpy's: round-off
         for k, outputs in steps.items():
             assert np.allclose(outputs, values["numpy"][label][k], rtol=1e-9, atol=1e-15), (label, k)
+
+
+def test_the_compiled_modules_key_covers_every_module_the_loops_take_code_from():
+    """A compiled module is used only where its key, the hash of KERNEL_SOURCES, is the sources' now: so every
+    module of slewing_model that a kernel module imports from (constants and functions the loops compile in)
+    must be one of KERNEL_SOURCES, or an edit there would leave a stale module in use."""
+    import ast
+
+    package = Path(compiled.__file__).resolve().parents[1]
+    listed = set(compiled.KERNEL_SOURCES)
+    kernels = [name for name in listed if name.endswith("kernel.py")]
+    assert kernels, listed
+    for name in kernels:
+        tree = ast.parse((package / name).read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.level > 0:
+                base = Path(name).parent
+                for _ in range(node.level - 1):
+                    base = base.parent
+                target = base.joinpath(*node.module.split(".")) if node.module else base
+                source = f"{target.as_posix()}.py"
+                if not (package / source).exists():
+                    source = f"{target.as_posix()}/__init__.py"
+                assert source in listed, f"{name} imports from {source}, which KERNEL_SOURCES leaves out"

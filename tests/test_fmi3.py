@@ -477,3 +477,32 @@ def test_a_build_after_an_fmu_ran_in_process_uses_the_installed_builder(version,
     assert installed.is_relative_to(Path(sysconfig.get_paths()["purelib"]).resolve()) or \
         installed.is_relative_to(Path(sysconfig.get_paths()["purelib"])), installed
     assert "after: True" in lines, run.stdout
+
+
+TABLE_AFTER_TABLE = """
+import sys
+from fmpy import simulate_fmu
+folder, step = sys.argv[1], sys.argv[2]
+if step == "first":
+    from fmu_build.drive import build_table_fmu
+    build_table_fmu(folder + "/a.fmu", "a", [0.0, 1.0], [("Fz", "N", "axial force")], [[1.0], [3.0]], win64=False)
+    sys.exit()
+ran = simulate_fmu(folder + "/a.fmu", stop_time=0.5, output_interval=0.5)   # in process, before any build here
+from fmu_build.drive import build_table_fmu
+second = build_table_fmu(folder + "/b.fmu", "b", [0.0, 1.0], [("Fz", "N", "axial force")], [[10.0], [30.0]],
+                         win64=False)
+print(float(ran["Fz"][-1]), float(simulate_fmu(str(second), stop_time=0.5, output_interval=0.5)["Fz"][-1]))
+"""
+
+
+def test_an_fmu_built_where_one_of_the_same_slave_ran_in_process_is_built_from_the_slave_script(tmp_path):
+    """A time-table FMU run in a process leaves its copies of pythonfmu and of its slave module (``TimeTable``)
+    in ``sys.modules``: a second time-table FMU built then in that process is built from the installed builder
+    and ``fmu_src/TimeTable.py``, and gives its own table (linear interpolation at 0.5 s)."""
+    import subprocess
+
+    for step in ("first", "second"):
+        run = subprocess.run([sys.executable, "-c", TABLE_AFTER_TABLE, str(tmp_path), step], capture_output=True,
+                             text=True, cwd=ROOT, timeout=300)
+        assert run.returncode == 0, run.stderr[-3000:]
+    assert [float(v) for v in run.stdout.split()[-2:]] == [2.0, 20.0]

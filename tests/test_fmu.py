@@ -56,14 +56,55 @@ def test_runtime_is_numpy_only(table3_fmu, tmp_path):
     assert not any("import scipy" in s or "from scipy" in s or "skfem" in s for s in sources)
 
 
+#: the modules of pythonfmu's package that build FMUs (an FMU never imports them)
+BUILDER_MODULES = ("builder.py", "csvbuilder.py", "deploy.py", "__main__.py")
+
+
 def test_the_fmus_pythonfmu_does_not_import_its_builder(table3_fmu, table3_fmu3):
     """pythonfmu's FMU builder (argparse, zipfile, xml: 30-40 ms of each instantiation) is not imported by the
     FMU's copy of pythonfmu, FMI 2.0 and 3.0; its slave classes are (the FMU runs: the tests above)."""
     for fmu, package in ((table3_fmu, "pythonfmu"), (table3_fmu3, "pythonfmu3")):
         with zipfile.ZipFile(fmu) as z:
             init = z.read(f"resources/{package}/__init__.py").decode()
+            modules = {n: z.read(n).decode() for n in z.namelist() if n.startswith(f"resources/{package}/")
+                       and n.endswith(".py") and n.rsplit("/", 1)[1] not in BUILDER_MODULES}
         assert "from .builder import" not in init, init
         assert re.search(r"^from \.fmi[23]slave import", init, flags=re.M), init
+        # nor pathlib (unused) and xml (the model description's) at import: fmu_build/shim.py's RUN_TIME_EDITS
+        assert modules and not [n for n, text in modules.items()
+                                if re.search(r"^(from|import) (pathlib|xml)", text, flags=re.M)], list(modules)
+
+
+#: run with an unpacked FMU's resources (argv[1]) first on the path: instantiates the slave as pythonfmu does,
+#: initialises it, takes a step and prints the modules that imported (not those this Python starts with)
+_INSTANTIATE = """
+import sys
+started = set(sys.modules)
+sys.path.insert(0, sys.argv[1])
+import SlewingBearing
+slave = SlewingBearing.SlewingBearing(instance_name='x', resources=sys.argv[1], visible=False)
+slave.enter_initialization_mode()
+slave.exit_initialization_mode()
+slave.Fz = 3e4
+assert slave.do_step(0.0, 0.01)
+print(' '.join(sorted(set(sys.modules) - started)))
+"""
+
+
+def test_an_instance_imports_no_xml_pathlib_zipfile_or_traceback(table3_fmu, tmp_path):
+    """What an instance's start and step leave out: xml (the model description's, written when the FMU is built),
+    pathlib (imported by pythonfmu, unused; made lazy or left out in the FMU's copy), zipfile and shutil (an .npz
+    file's: the FMU carries the superelement as .npy files), traceback (an error's) and the connected structures'
+    module (a bearing without them)."""
+    with zipfile.ZipFile(table3_fmu) as z:
+        z.extractall(tmp_path, [n for n in z.namelist() if n.startswith("resources/")])
+    run = subprocess.run([sys.executable, "-c", _INSTANTIATE, str(tmp_path / "resources")], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    modules = set(run.stdout.split())
+    assert {"SlewingBearing", "pythonfmu.fmi2slave", "slewing_model.simulation.simulator"} <= modules
+    assert not modules & {"xml", "xml.etree.ElementTree", "pathlib", "zipfile", "shutil", "traceback",
+                          "slewing_model.bearing.connection"}, sorted(modules)
 
 
 LOADS = {"Fx": 8e3, "Fy": -3e3, "Fz": 3e4, "Mx": 1.5e3, "My": -2.5e3, "psi": 0.4, "omega": 0.05}

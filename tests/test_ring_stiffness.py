@@ -108,6 +108,30 @@ def test_save_and_load_round_trip(table3, tmp_path):
     json.dumps(back.metadata)   # JSON-serialisable
 
 
+def test_a_folder_holds_the_same_superelement_as_a_file_bit_for_bit(table3, tmp_path):
+    """The FMU's form (:meth:`Superelement.save_folder`: .npy files and a JSON text, read without zipfile) and the
+    file's give the same arrays, bit for bit, and the same metadata; the folder is checked against the bearing
+    and refused where it is not a superelement, as a file is."""
+    se = _superelement(table3)
+    se.save(tmp_path / "se.npz")
+    se.save_folder(tmp_path / "se")
+    assert sorted(p.name for p in (tmp_path / "se").iterdir()) == ["inner_first_row.npy", "metadata.json",
+                                                                   "outer_first_row.npy"]
+    a, b = Superelement.load(tmp_path / "se.npz", table3), Superelement.load(tmp_path / "se", table3)
+    assert a.metadata == b.metadata
+    for r in ("outer", "inner"):
+        x, y = a.ring(r), b.ring(r)
+        assert (x.first_row.dtype, x.first_row.shape, x.first_row.tobytes()) == (y.first_row.dtype, y.first_row.shape,
+                                                                                 y.first_row.tobytes())
+        assert (x.removed_modes, x.boundary_condition, x.ball_count) == (y.removed_modes, y.boundary_condition,
+                                                                         y.ball_count)
+    with pytest.raises(SuperelementMismatchError, match="youngs_modulus"):
+        Superelement.load(tmp_path / "se", dataclasses.replace(table3, youngs_modulus=210e9))
+    (tmp_path / "se" / "metadata.json").unlink()
+    with pytest.raises(ValueError, match="not a superelement"):
+        Superelement.load(tmp_path / "se")
+
+
 def test_load_refuses_another_bearing_naming_the_field(table3, tmp_path):
     path = tmp_path / "se.npz"
     _superelement(table3).save(path)

@@ -28,7 +28,14 @@ import numpy as np
 from .conventions import (BEARING_TABLES, CONTACTS, DIAGONALS, RING_CONTACTS,  # noqa: F401  (the conventions
                           BearingDefinitionError, check_known_keys, fail as _fail)  # belong to this interface)
 from .manufacturing import ManufacturingErrors, errors_from_table
-from .connection import connection_from_dict, connections_from_table
+
+
+def _connection_from_dict(d: dict) -> dict:
+    """``{ring: Adapter or ImportedStiffness}`` from their dicts (:func:`.connection.connection_from_dict`;
+    the module is imported for a connected bearing only)."""
+    from .connection import connection_from_dict
+
+    return {r: connection_from_dict(c) for r, c in d.items()}
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:
@@ -312,8 +319,7 @@ class Bearing:
             outer_section=RingSection(**d["outer_section"]),
             inner_section=RingSection(**d["inner_section"]),
             errors=errors,
-            connection={r: connection_from_dict(c) for r, c in d["connection"].items()} if d.get("connection")
-            else None,
+            connection=_connection_from_dict(d["connection"]) if d.get("connection") else None,
         )
         validate(b)
         return b
@@ -505,6 +511,8 @@ def bearing_from_dict(data: Mapping[str, Any], base_dir: str | os.PathLike = "."
         errors = errors_from_table(_subtable(data, "errors"), base_dir=base_dir, ball_count=n)
     connection = None
     if "connection" in data:
+        from .connection import connections_from_table     # imported for a connected bearing only
+
         connection = connections_from_table(data["connection"], {"outer": outer, "inner": inner},
                                             base_dir=base_dir) or None
 

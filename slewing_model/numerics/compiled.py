@@ -17,7 +17,7 @@ import functools
 import hashlib
 import importlib
 import importlib.util
-from pathlib import Path
+import os
 
 #: the extension module of the loops compiled ahead of time (fmu_build/aot.py) for any x86-64 CPU
 AOT_MODULE = "slewing_kernels"
@@ -26,15 +26,16 @@ AOT_MODULE = "slewing_kernels"
 AOT_MODULES = {"x86-64-v3": "slewing_kernels_v3", "generic": AOT_MODULE}
 #: the sources the loops are compiled from: the kernels, what they take from other modules, this registry
 KERNEL_SOURCES = ("distribution/kernel.py", "friction/kernel.py", "life/kernel.py", "bearing/contact.py",
-                  "numerics/compiled.py")
+                  "rings/reduced_operator.py", "numerics/compiled.py")
 
 
 def kernel_source_hash() -> int:
     """A 62-bit hash of :data:`KERNEL_SOURCES`: what an ahead-of-time module was compiled from."""
     digest = hashlib.sha256()
-    package = Path(__file__).resolve().parents[1]
+    package = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))      # slewing_model/
     for name in KERNEL_SOURCES:
-        digest.update((package / name).read_bytes().replace(b"\r\n", b"\n"))
+        with open(os.path.join(package, name), "rb") as fh:
+            digest.update(fh.read().replace(b"\r\n", b"\n"))
     return int.from_bytes(digest.digest()[:8], "little") >> 2
 
 

@@ -197,19 +197,34 @@ class Superelement:
     def save(self, path) -> None:
         """Write one ``.npz``: the two first rows and the metadata as a JSON string."""
         path = os.fspath(path)
+        tmp = f"{path}.{os.getpid()}.tmp.npz"   # a file of this process: two saving the same path do not collide
+        np.savez(tmp, outer_first_row=self.outer.first_row, inner_first_row=self.inner.first_row,
+                 metadata=np.array(self._stored_metadata()))
+        os.replace(tmp, path)
+
+    def save_folder(self, folder) -> None:
+        """Write the same content as :meth:`save` into a folder: ``metadata.json`` and one ``.npy`` per
+        ring's first row (``outer_first_row.npy``, ``inner_first_row.npy``). An FMU carries its
+        superelement so: reading it needs no ``zipfile``, which an instance would import for an ``.npz``."""
+        folder = os.fspath(folder)
+        os.makedirs(folder, exist_ok=True)
+        for ring in (self.outer, self.inner):
+            np.save(os.path.join(folder, f"{ring.ring}_first_row.npy"), ring.first_row, allow_pickle=False)
+        with open(os.path.join(folder, "metadata.json"), "w") as fh:
+            fh.write(self._stored_metadata())
+
+    def _stored_metadata(self) -> str:
+        """The metadata as stored, a JSON text: with the format version and each ring's size and support."""
         meta = dict(self.metadata)
         meta["format_version"] = FORMAT_VERSION
         meta["ring_stiffness"] = {r.ring: {"ball_count": r.ball_count, "removed_modes": list(r.removed_modes),
                                   "boundary_condition": r.boundary_condition}
                          for r in (self.outer, self.inner)}
-        tmp = f"{path}.{os.getpid()}.tmp.npz"   # a file of this process: two saving the same path do not collide
-        np.savez(tmp, outer_first_row=self.outer.first_row, inner_first_row=self.inner.first_row,
-                 metadata=np.array(json.dumps(meta, sort_keys=True, default=_json_default)))
-        os.replace(tmp, path)
+        return json.dumps(meta, sort_keys=True, default=_json_default)
 
     @classmethod
     def load(cls, path, bearing=None) -> "Superelement":
-        """Read a file written by :meth:`save`.
+        """Read a file written by :meth:`save`, or a folder written by :meth:`save_folder`.
 
         Parameters
         ----------
@@ -227,9 +242,15 @@ class Superelement:
         """
         path = os.fspath(path)
         try:
-            with np.load(path, allow_pickle=False) as f:
-                meta = json.loads(str(f["metadata"]))
-                rows = {r: np.array(f[f"{r}_first_row"]) for r in ("outer", "inner")}
+            if os.path.isdir(path):
+                with open(os.path.join(path, "metadata.json")) as fh:
+                    meta = json.load(fh)
+                rows = {r: np.load(os.path.join(path, f"{r}_first_row.npy"), allow_pickle=False)
+                        for r in ("outer", "inner")}
+            else:
+                with np.load(path, allow_pickle=False) as f:
+                    meta = json.loads(str(f["metadata"]))
+                    rows = {r: np.array(f[f"{r}_first_row"]) for r in ("outer", "inner")}
         except (KeyError, ValueError, OSError) as exc:
             raise ValueError(f"{path}: not a superelement file ({exc})") from None
         if meta.get("format_version") != FORMAT_VERSION:
