@@ -7,6 +7,7 @@
 * :mod:`slewing_turbine.blade_loads` -- blade-root loads (aerodynamics, gravity, centrifugal) and the pitch
   bearing's inputs from them
 * :mod:`slewing_turbine.loop` -- the closed loop: controller, rotor, three pitch drives and pitch bearings
+* :mod:`slewing_turbine.fmu_bearing` -- the loop's pitch bearings as bearing FMUs (fmpy; not imported here)
 """
 from .controller import Commands, Measurements, RoscoController, RoscoError, read_discon
 from .rotor import CpTable, Drivetrain, RotorSimResult, aerodynamic_torque, euler_step, simulate_like_rosco_sim

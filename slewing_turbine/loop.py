@@ -10,7 +10,8 @@ Every step ``dt`` (10 ms by default), in the order of ROSCO's ``Sim`` (so that i
 2. **rotor**: one explicit Euler step of the 1-DOF drivetrain (:func:`slewing_turbine.rotor.euler_step`), the
    azimuth advanced by the step's start speed;
 3. **pitch axes** (``drives="electric"``): each blade's pitch bearing (an in-process
-   :class:`~slewing_model.simulation.BearingSimulator`, ``bearings="flexible"`` or ``"rigid"``) steps under the
+   :class:`~slewing_model.simulation.BearingSimulator`, ``bearings="flexible"`` or ``"rigid"``; or a bearing FMU,
+   :mod:`slewing_turbine.fmu_bearing`) steps under the
    blade's root loads ``Fx, Fy, Fz, Mx, My`` (the blade frame is the moving ring's frame: ``load_frame``
    ``"rotating"``, the bearing's +z towards the tip) at the ring angle ``psi = -pitch`` and speed
    ``omega = -pitch rate`` (the blade turns by minus its pitch about the tip-wards axis, as
@@ -165,7 +166,8 @@ class TurbineResult:
     ``step_seconds`` (wall time of the step), ``motor_energy`` (each drive's delivered motor energy so far,
     cumulative, J). With bearings: ``contact_b`` (n, 3, 4), the widest contact patch's semi-axis ``b`` of
     each contact 1..4 of each blade's bearing at the step (m; 0: unloaded), and ``contact_angle`` at it
-    (rad); ``bearing_geometry`` ``(pitch_diameter, ball_diameter)`` (m). ``settle``: the s left out of the
+    (rad), None where the bearings give no load distribution (bearing FMUs); ``bearing_geometry``
+    ``(pitch_diameter, ball_diameter)`` (m). ``settle``: the s left out of the
     figures (:func:`summary`); ``emergency_stop``: the time of the emergency stop (None: none).
     """
 
@@ -217,8 +219,9 @@ class PitchAxis:
     Parameters
     ----------
     drive : DriveParameters
-    bearing : BearingSimulator or None
-        The blade's pitch bearing (``load_frame`` "rotating"); None: no bearing, no friction.
+    bearing : BearingSimulator, FmuBearing or None
+        The blade's pitch bearing (``load_frame`` "rotating"; a bearing FMU:
+        :class:`slewing_turbine.fmu_bearing.FmuBearing`); None: no bearing, no friction.
     pitch : float
         The start angle, rad.
     substeps : int
@@ -256,10 +259,23 @@ class PitchAxis:
         return self.drive.step(demand, dt, load_torque=load_moment, friction_torque=self.friction)
 
 
+def bearing_settings(config: TurbineConfig, ring_model: str, friction: bool):
+    """The pitch bearings' :class:`~slewing_model.simulation.SimulatorSettings`: ``ring_model``, loads in the
+    blade frame (``load_frame`` "rotating"), the config's friction (``friction``: its coefficient and seal
+    torque, else both 0), ``life`` and ``step_work``; the rest the defaults."""
+    from slewing_model.simulation.simulator import SimulatorSettings
+
+    return SimulatorSettings(ring_model=ring_model, load_frame="rotating",
+                             friction_coefficient=config.friction_coefficient if friction else 0.0,
+                             seal_torque=config.seal_torque if friction else 0.0, life=config.life,
+                             step_work=config.step_work)
+
+
 def make_bearings(config: TurbineConfig, ring_model: str, friction: bool, count: int = 3) -> list:
-    """``count`` pitch bearing simulators (loads in the blade frame: ``load_frame`` "rotating")."""
+    """``count`` pitch bearing simulators (:func:`bearing_settings`; loads in the blade frame). The same as
+    FMUs: :func:`slewing_turbine.fmu_bearing.fmu_bearings`."""
     from slewing_model import load_bearing
-    from slewing_model.simulation.simulator import BearingSimulator, SimulatorSettings
+    from slewing_model.simulation.simulator import BearingSimulator
 
     bearing = config.bearing if not isinstance(config.bearing, (str, Path)) else load_bearing(config.bearing)
     superelement = None
@@ -267,10 +283,7 @@ def make_bearings(config: TurbineConfig, ring_model: str, friction: bool, count:
         from slewing_model.rings.superelement import build_superelement
 
         superelement = build_superelement(bearing, mesh=config.mesh, bc="free")
-    settings = SimulatorSettings(ring_model=ring_model, load_frame="rotating",
-                                 friction_coefficient=config.friction_coefficient if friction else 0.0,
-                                 seal_torque=config.seal_torque if friction else 0.0, life=config.life,
-                                 step_work=config.step_work)
+    settings = bearing_settings(config, ring_model, friction)
     return [BearingSimulator(bearing, superelement, settings) for _ in range(count)]
 
 
@@ -360,7 +373,11 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
         carry no load moment).
     bearing_simulators : list of 3 BearingSimulator, optional
         Use these (built by :func:`make_bearings` once for several runs) instead of building them; they must
-        match ``bearings`` and ``friction``, and carry on from their last state.
+        match ``bearings`` and ``friction``, and carry on from their last state. Bearing FMUs in their place
+        (:class:`slewing_turbine.fmu_bearing.FmuBearing`, :func:`~slewing_turbine.fmu_bearing.fmu_bearings`)
+        give no load distribution: the result then has no contact patches (``contact_b`` None, no ``x/2b``
+        figure), and with ``config.life`` its ``life`` holds the FMUs' damage only
+        (:class:`~slewing_turbine.fmu_bearing.FmuLife`).
     progress : bool
         A progress bar on stderr.
     emergency_stop : float or None, s
@@ -427,6 +444,7 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
     step_seconds = np.zeros(n)
     motor_energy = np.zeros((n, 3)) if drives == "electric" else None
     stepped = sims[0] is not None
+    patches = stepped              # the bearings give their load distribution (bearing FMUs do not)
     contact_b = np.zeros((n, 3, 4)) if stepped else None
     contact_angle = np.zeros((n, 3, 4)) if stepped else None
     rot[0], azimuth[0], gen_torque[0] = config.rotor_speed_init, config.azimuth_init, config.generator_torque_init
@@ -474,8 +492,10 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
                     pitch[i, k], rate[i, k], motor[i, k] = s.angle, s.speed, s.mean_motor_torque
                     fric[i, k], mz[i, k] = axis.friction, load_moment
                     motor_energy[i, k] = axis.drive.state.motor_energy
-                    if stepped:
+                    if patches and axis.result.distribution is not None:
                         contact_b[i, k], contact_angle[i, k] = widest_contacts(axis.result.distribution)
+                    elif patches:
+                        patches = False
             # 4. controller: the new speed, the measured pitch
             m = Measurements(time=time[i], rotor_speed=rot[i], generator_speed=rot[i] * drivetrain.gear_ratio,
                              generator_torque=gen_torque[i - 1], blade_pitch=pitch[i].copy(), wind_speed=ws[i],
@@ -495,6 +515,8 @@ def run_turbine(config: TurbineConfig | None, wind, *, t_end: float | None = Non
     life = None
     if sims[0] is not None and sims[0].life is not None:
         life = [s.life for s in sims]
+    if not patches:
+        contact_b = contact_angle = None
     geometry = None
     if stepped:
         b = sims[0].bearing
@@ -626,7 +648,8 @@ def wear_cycles(result: TurbineResult, blade: int, i0: int = 0) -> tuple:
 
     r = result
     if r.contact_b is None:
-        raise ValueError("x/2b needs the bearings' contact patches: a run with bearings")
+        raise ValueError("x/2b needs the bearings' contact patches: a run with bearings that give their load "
+                         "distribution (bearing FMUs do not)")
     psi = -r.pitch[i0:, blade]                       # the ring angle (the blade turns by minus its pitch)
     cyc = rainflow_cycles(psi, min_swing=DEFAULT_REVERSAL_TOLERANCE)
     b, angle = r.contact_b[i0:, blade], r.contact_angle[i0:, blade]
