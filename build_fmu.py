@@ -49,7 +49,7 @@ from fmu_build.bytecode import dataclass_code  # noqa: E402
 from fmu_build.runtime import building_machine_paths, scrub_paths, version_needs  # noqa: E402
 from fmu_build.shim import (  # noqa: E402,F401  (the FMU's Linux layer, shared with fmu_build.drive)
     LINUX_BINARIES, PYTHON_HOME_VARIABLE, PYTHON_RUNTIME_FILE, RUNTIMES, compile_shim, install_python_shim,
-    installed_builder, python_runtime)
+    python_runtime, pythonfmu_build)
 from slewing_model import RUNTIME_MODULES  # noqa: E402  (the modules of slewing_model the FMU runs with)
 
 
@@ -170,12 +170,11 @@ def build_fmu(bearing_file, output=None, *, bc="free", mesh="fine", progress=Fal
         if fmi_version == 3:  # the variable tables are shared with the FMI 2.0 slave (bearing_variables.py)
             built = _build_fmi3(output, files)
         else:
-            with installed_builder("pythonfmu", ROOT / "fmu_src" / "SlewingBearing.py") as FmuBuilder:
-                built = FmuBuilder.build_FMU(
-                    ROOT / "fmu_src" / "SlewingBearing.py", dest=output, project_files=files,
-                    canGetAndSetFMUstate=True, canSerializeFMUstate=True,
-                    needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
-                )
+            built = pythonfmu_build(
+                ROOT / "fmu_src" / "SlewingBearing.py", dest=output, project_files=files,
+                canGetAndSetFMUstate=True, canSerializeFMUstate=True,
+                needsExecutionTool=True, canHandleVariableCommunicationStepSize=True,
+            )
     deflate(built)
     install_python_shim(built, stem, fmi_version=fmi_version, runtime=runtime, numba=numba, win64=win64,
                         win64_numba=win64_numba, stage=say, extra_needs=extra_needs, runtime_python=runtime_python,
@@ -332,12 +331,11 @@ def ship_compiled_kernels(fmu, win64: bool = False) -> list[Path]:
 
 def _build_fmi3(output: Path, project_files) -> Path:
     """Package ``fmu_src/SlewingBearing3.py`` with pythonfmu3 (which writes ``<modelName>.fmu`` into a folder)."""
-    with tempfile.TemporaryDirectory(prefix="slewing_fmu3_") as folder, \
-            installed_builder("pythonfmu3", ROOT / "fmu_src" / "SlewingBearing3.py") as Fmu3Builder:
-        built = Fmu3Builder.build_FMU(ROOT / "fmu_src" / "SlewingBearing3.py", dest=folder,
-                                      project_files=project_files, needsExecutionTool=True,
-                                      canGetAndSetFMUState=True, canSerializeFMUState=True,
-                                      canHandleVariableCommunicationStepSize=True)
+    with tempfile.TemporaryDirectory(prefix="slewing_fmu3_") as folder:
+        built = pythonfmu_build(ROOT / "fmu_src" / "SlewingBearing3.py", "pythonfmu3", dest=folder,
+                                project_files=project_files, needsExecutionTool=True,
+                                canGetAndSetFMUState=True, canSerializeFMUState=True,
+                                canHandleVariableCommunicationStepSize=True)
         shutil.move(str(built), output)
     return output
 

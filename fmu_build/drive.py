@@ -18,7 +18,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from fmu_build.shim import install_python_shim, installed_builder  # the FMU's Linux layer: no LD_PRELOAD in C hosts
+from fmu_build.shim import install_python_shim, pythonfmu_build  # the FMU's Linux layer: no LD_PRELOAD in C hosts
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -53,11 +53,10 @@ def build_drive_fmu(drive_file, output=None, *, torque_constant: float = 1.5, wi
         (package / "__init__.py").write_text('"""The drive model alone (the FMU runs with numpy only)."""\n')
         shutil.copy2(ROOT / "slewing_drives" / "drive.py", package / "drive.py")
         (tmp / "drive.json").write_text(json.dumps(definition))
-        with installed_builder("pythonfmu", ROOT / "fmu_src" / "SlewingDrive.py") as FmuBuilder:
-            built = FmuBuilder.build_FMU(ROOT / "fmu_src" / "SlewingDrive.py", dest=output,
-                                         project_files=[package, tmp / "drive.json"],
-                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True,
-                                         needsExecutionTool=True, canHandleVariableCommunicationStepSize=True)
+        built = pythonfmu_build(ROOT / "fmu_src" / "SlewingDrive.py", dest=output,
+                                project_files=[package, tmp / "drive.json"],
+                                canGetAndSetFMUstate=True, canSerializeFMUstate=True,
+                                needsExecutionTool=True, canHandleVariableCommunicationStepSize=True)
     install_python_shim(built, "SlewingDrive", win64=win64)  # runs in C hosts without LD_PRELOAD (fmu_build/shim.py)
     return Path(built)
 
@@ -97,11 +96,9 @@ def build_table_fmu(output, name: str, time, columns, values, *, interpolation: 
         (tmp / "table.json").write_text(json.dumps({
             "name": name, "interpolation": interpolation, "time": time.tolist(),
             "columns": [list(c) for c in columns], "values": values.tolist()}))
-        with installed_builder("pythonfmu", ROOT / "fmu_src" / "TimeTable.py") as FmuBuilder:
-            built = FmuBuilder.build_FMU(ROOT / "fmu_src" / "TimeTable.py", dest=output,
-                                         project_files=[tmp / "table.json"], canGetAndSetFMUstate=True,
-                                         canSerializeFMUstate=True, needsExecutionTool=True,
-                                         canHandleVariableCommunicationStepSize=True)
+        built = pythonfmu_build(ROOT / "fmu_src" / "TimeTable.py", dest=output, project_files=[tmp / "table.json"],
+                                canGetAndSetFMUstate=True, canSerializeFMUstate=True, needsExecutionTool=True,
+                                canHandleVariableCommunicationStepSize=True)
     install_python_shim(built, "TimeTable", win64=win64)
     return Path(built)
 

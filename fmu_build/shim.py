@@ -129,6 +129,13 @@ def installed_builder(package: str = "pythonfmu", script=None):
         sys.modules.update(saved)
 
 
+def pythonfmu_build(script, package: str = "pythonfmu", **options):
+    """``package``'s ``FmuBuilder.build_FMU(script, **options)`` with the installed builder
+    (:func:`installed_builder`): the path it returns."""
+    with installed_builder(package, script) as builder:
+        return builder.build_FMU(script, **options)
+
+
 def c_compiler() -> str:
     """The C compiler that builds the FMU's Linux binary: ``$CC``, else ``cc`` or ``gcc``.
 

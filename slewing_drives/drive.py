@@ -163,8 +163,9 @@ class DriveParameters:
         if unknown:
             raise ValueError(f"{path}: unknown table [{unknown[0]}]: the tables are [drive], [control] and [sources]")
         for table in ("drive", "control"):
-            known = {key for section, key, *_ in DRIVE_FILE_KEYS if section == table} | ({"name"} if table == "drive"
-                                                                                         else set())
+            known = {key for section, key, *_ in DRIVE_FILE_KEYS if section == table}
+            if table == "drive":
+                known.add("name")
             unknown = sorted(set(data.get(table, {})) - known)
             if unknown:
                 raise ValueError(f"{path}: [{table}] {unknown[0]}: unknown key; [{table}] takes "

@@ -231,9 +231,7 @@ def check_build(fmu_path, config, ring_model: str) -> None:
     flexible rings, not with ``config.mesh`` and free rings (its superelement's metadata)."""
     import zipfile
 
-    from slewing_model import load_bearing
-
-    bearing = config.bearing if not isinstance(config.bearing, (str, Path)) else load_bearing(config.bearing)
+    bearing = config.bearing_definition()
     with zipfile.ZipFile(fmu_path) as z:
         built = json.loads(z.read("resources/bearing.json"))
         if built != json.loads(json.dumps(bearing.to_dict())):

@@ -145,6 +145,12 @@ class TurbineConfig:
 
         return self.drive if isinstance(self.drive, DriveParameters) else DriveParameters.from_toml(self.drive)
 
+    def bearing_definition(self):
+        """The pitch bearing: ``bearing`` itself, or the bearing file it names read."""
+        from slewing_model import load_bearing
+
+        return self.bearing if not isinstance(self.bearing, (str, Path)) else load_bearing(self.bearing)
+
     def the_drivetrain(self):
         from .rotor import Drivetrain
 
@@ -274,10 +280,9 @@ def bearing_settings(config: TurbineConfig, ring_model: str, friction: bool):
 def make_bearings(config: TurbineConfig, ring_model: str, friction: bool, count: int = 3) -> list:
     """``count`` pitch bearing simulators (:func:`bearing_settings`; loads in the blade frame). The same as
     FMUs: :func:`slewing_turbine.fmu_bearing.fmu_bearings`."""
-    from slewing_model import load_bearing
     from slewing_model.simulation.simulator import BearingSimulator
 
-    bearing = config.bearing if not isinstance(config.bearing, (str, Path)) else load_bearing(config.bearing)
+    bearing = config.bearing_definition()
     superelement = None
     if ring_model == "flexible":
         from slewing_model.rings.superelement import build_superelement

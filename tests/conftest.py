@@ -167,9 +167,13 @@ def platform_cases(cases, make_test):
     return list(cases) if PLATFORMS_FULL else [case for case in cases if case in make_test]
 
 
+#: the FMUs with numba's loops are tested (opt-in: they compile numba's loops for three CPUs)
+NUMBA_FMU_OPT_IN = os.environ.get("SLEWING_TEST_NUMBA_FMU") == "1"
+
+
 def needs_numba_fmu_opt_in():
-    """Skip unless SLEWING_TEST_NUMBA_FMU=1: the FMUs with numba's loops compile them for three CPUs."""
-    if os.environ.get("SLEWING_TEST_NUMBA_FMU") != "1":
+    """Skip unless SLEWING_TEST_NUMBA_FMU=1 (:data:`NUMBA_FMU_OPT_IN`)."""
+    if not NUMBA_FMU_OPT_IN:
         pytest.skip("SKIPPED: the --numba FMU's tests are opt-in (numba's loops compiled for three CPUs, about 3 "
                     "minutes): set SLEWING_TEST_NUMBA_FMU=1")
 

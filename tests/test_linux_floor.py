@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import NUMBA_FMU_OPT_IN  # the FMI 2.0 floor FMU with numba's loops: opt-in
 from test_standalone import (CHROOTS, HOST_RUNS, _readelf_glibc_needs, above, assert_fmusim_runs_as_fmpy, bare_system,
                              fmpy_steps, glibc_of, hosts, run_host, runtime_of)
 
@@ -31,8 +32,6 @@ GLIBCXX_FLOOR = "3.4.22"     # GCC 6's libstdc++ (llvmlite's wheel; the export l
 RTOL = 1e-9
 #: fmusim runs per FMU: 20 in tests/linux_floor/run_all.sh, 5 in `make test` (a run of the numba FMU takes 4-5 s)
 FMUSIM_RUNS = int(os.environ.get("SLEWING_FLOOR_FMUSIM_RUNS", "5"))
-#: the FMI 2.0 floor FMU with numba's loops (opt-in, as the --numba FMU's tests: tests/linux_floor/run_all.sh)
-NUMBA_FLOOR = os.environ.get("SLEWING_TEST_NUMBA_FMU") == "1"
 
 __all__ = ["hosts"]          # the C host fixture of test_standalone, used here
 
@@ -81,7 +80,7 @@ def floor_fmus(floor_dir, tmp_path_factory):
 
     folder = tmp_path_factory.mktemp("floor")
     bearing = ROOT / "examples" / "bearings" / "table3_errors.toml"
-    return {2: build_fmu(bearing, folder / "floor2.fmu", mesh="coarse", numba=compiled.AVAILABLE and NUMBA_FLOOR,
+    return {2: build_fmu(bearing, folder / "floor2.fmu", mesh="coarse", numba=compiled.AVAILABLE and NUMBA_FMU_OPT_IN,
                          win64=False,
                          **floor_dir),
             3: build_fmu(bearing, folder / "floor3.fmu", mesh="coarse", fmi_version=3, numba=False, win64=False,
