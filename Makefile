@@ -56,10 +56,10 @@ demo: $(STAMP)
 # fixtures built once). The loops are compiled first, once, into their caches, which the tests then load:
 # numba's for this CPU and the FMU's modules compiled ahead of time (fmu_build/aot.py, the tests take them
 # from the user's cache). The --numba FMU's tests, which compile numba's loops for two more CPUs, are opt-in
-# (SLEWING_TEST_NUMBA_FMU=1). The win64 half's module (fmu_build/win64.py, under wine, 2.5
-# minutes) is taken from that cache only: tests/win64/run_all.sh compiles it and runs the win64 tests in full
-# numba's loops compile on one core (about 3 minutes) beside the FMU's two modules on two (1.5 minutes each):
-# 3 minutes of wall time on 2 cores instead of 4
+# (SLEWING_TEST_NUMBA_FMU=1). numba's loops compile on one core (about 3 minutes) beside the FMU's two modules
+# on two (1.5 minutes each): 3 minutes of wall time on 2 cores instead of 4. Then, as root, tests/platform_builds.py
+# makes what the win64 and Debian 11 floor tests need where it is missing (the floor runtime, mingw's fmusim,
+# the win64 half's loops: about 8 minutes once, kept in /var/cache and the aot cache; seconds after)
 TEST_WORKERS ?= 2
 COMPILE_LOOPS := from slewing_model.friction import kernel; kernel.compile_all()
 COMPILE_LOOPS_AOT := import fmu_build.aot; fmu_build.aot.prepare_cache()
@@ -67,6 +67,7 @@ COMPILE_LOOPS_AOT := import fmu_build.aot; fmu_build.aot.prepare_cache()
 test: $(STAMP)
 	$(call debian_packages,$(TEST_PACKAGES))
 	$(PY) -c "$(COMPILE_LOOPS)" & numba=$$!; $(PY) -c "$(COMPILE_LOOPS_AOT)"; aot=$$?; wait $$numba && [ $$aot = 0 ]
+	$(PY) tests/platform_builds.py
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
 # the benchmark suite's main set (python -m benchmarks --list names them all; tables printed and written as

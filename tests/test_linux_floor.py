@@ -5,10 +5,10 @@ numpy, numba and llvmlite wheels, pythonfmu's FMI 2.0 export library and fmusim;
 carries them. Here the FMUs built so run in the *bare* Debian 11 system (glibc 2.31, no Python, no compiler) of
 tests/test_standalone.py: fmusim and our C host, against fmpy on this machine.
 
-Building CPython takes minutes: in ``make test`` these tests run where the build is cached already and are
-skipped otherwise, saying so, with 5 fmusim runs per FMU and numpy's loops in both FMUs;
-``bash tests/linux_floor/run_all.sh`` builds it and runs them with 20 and the FMI 2.0 FMU with numba's loops;
-``SLEWING_BUILD_LINUX_FLOOR=1`` builds it from pytest.
+Building CPython takes minutes: ``make test`` builds it once as root before the tests (tests/platform_builds.py,
+kept in /var/cache) and runs these tests with 5 fmusim runs per FMU and numpy's loops in both FMUs; without
+root they are skipped, saying so. ``bash tests/linux_floor/run_all.sh`` runs them with 20 and the FMI 2.0 FMU
+with numba's loops; ``SLEWING_BUILD_LINUX_FLOOR=1`` builds it from pytest.
 """
 import os
 import shutil
@@ -56,7 +56,8 @@ def floor_dir():
         found = linux_floor(FLOOR_DIR)
     except RuntimeError:
         pytest.skip(f"SKIPPED: the floor-lowered runtime is not built in {FLOOR_DIR} (CPython in a Debian 11 "
-                    "chroot, 2 to 4 minutes): run tests/linux_floor/run_all.sh, or set SLEWING_BUILD_LINUX_FLOOR=1")
+                    "chroot, 2 to 4 minutes; make test builds it as root): run tests/platform_builds.py, or set "
+                    "SLEWING_BUILD_LINUX_FLOOR=1")
     from importlib.metadata import version
     import fmu_build.runtime
 

@@ -5,7 +5,8 @@ Each FMU (the FMI 2.0 and 3.0 bearing FMUs and the drive FMU) runs in
 (a) our C host (tests/c_host/host.c) cross-compiled with mingw-w64: steps, state get/set/serialize,
     free, FreeLibrary and reload;
 (b) fmpy 0.3.32 on the official embeddable CPython 3.11.9 (a Python host: the FMU uses its interpreter);
-(c) fmusim v0.0.39 cross-compiled with mingw-w64 (tests/win64/build_fmusim.sh; skipped where it is not built);
+(c) fmusim v0.0.39 cross-compiled with mingw-w64 (tests/win64/build_fmusim.sh, which `make test` runs once as root:
+    tests/platform_builds.py);
 ``SLEWING_WINE_RUNS`` times each (1 in ``make test``, 5 in ``tests/win64/run_all.sh``); every run exits 0 and gives
 fmpy's outputs on Linux within 1e-9 relative. ``make test`` runs every FMU in (a), the FMI 3.0 bearing in (b), the FMI
 2.0 bearing in (c) and the drive beside a bearing in one process; ``tests/win64/run_all.sh``
@@ -245,8 +246,8 @@ def test_the_win64_half_runs_the_loops_compiled_ahead_of_time(table3_aot_fmu, ho
     with zipfile.ZipFile(table3_aot_fmu) as z:
         if module not in z.namelist() and os.environ.get(fmu_build.win64.AOT_CACHED_ONLY) == "1":
             pytest.skip("SKIPPED: the win64 loops are not compiled yet (about 2.5 minutes under wine, once per "
-                        "version of the loops, kept in the aot cache): run tests/win64/run_all.sh, or set "
-                        "SLEWING_BUILD_WIN64_AOT=1")
+                        "version of the loops, kept in the aot cache; make test compiles them as root): run "
+                        "tests/platform_builds.py, or set SLEWING_BUILD_WIN64_AOT=1")
         assert module in z.namelist()
         (tmp_path / "module.pyd").write_bytes(z.read(module))
     objdump = shutil.which("x86_64-w64-mingw32-objdump")
@@ -345,7 +346,6 @@ def test_without_wines_own_cpp_runtime_the_fmu_brings_its_own(fmus, hosts, tmp_p
 
 
 # ---- fmusim cross-compiled with mingw (tests/win64/build_fmusim.sh) -----------------------------------------
-FMUSIM_SCRIPT = ROOT / "tests" / "win64" / "build_fmusim.sh"
 #: inputs per case for fmusim's CSV, one column each: the values the C host's order leaves (see DRIVE_INPUTS)
 FMUSIM_INPUTS = {"bearing2": BEARING_INPUTS, "bearing3": BEARING_INPUTS, "drive": ["command", "friction_torque",
                                                                                     "load_moment"]}
@@ -358,24 +358,16 @@ def fmusim_inputs(case, k):
 
 @pytest.fixture(scope="module")
 def fmusim():
-    """fmusim.exe, built once per version of the build script and kept in $SLEWING_WINE_DIR. Building it the
-    first time (libxml2, sundials and minizip for mingw from Debian's sources) takes about 5 minutes: in
-    `make test` it is taken only when built already (tests/win64/run_all.sh builds it) or with
-    SLEWING_BUILD_FMUSIM=1."""
-    import hashlib
-
+    """fmusim.exe, built once per version of the build script and kept in $SLEWING_WINE_DIR (about 5 minutes the
+    first time: libxml2, sundials and minizip for mingw from Debian's sources). `make test` builds it before
+    the tests (tests/platform_builds.py); here it is built only with SLEWING_BUILD_FMUSIM=1."""
     if not (ROOT.parent / "shared" / "vendor" / "fmusim-v0.0.39" / "build.sh").exists() \
             and not os.environ.get("SLEWING_FMUSIM_SOURCE"):
         pytest.skip("fmusim's source is not at ../shared/vendor/fmusim-v0.0.39")
-    key = hashlib.sha256(FMUSIM_SCRIPT.read_bytes()).hexdigest()[:12]
-    binary = w.WINE_DIR / f"fmusim-{key}.exe"
-    if not binary.exists():
-        if not os.environ.get("SLEWING_BUILD_FMUSIM"):
-            pytest.skip("SKIPPED: fmusim for mingw is not built yet (about 5 minutes): run tests/win64/run_all.sh, "
-                        "or set SLEWING_BUILD_FMUSIM=1")
-        run = subprocess.run(["bash", str(FMUSIM_SCRIPT), str(binary)], capture_output=True, text=True, timeout=3600)
-        assert run.returncode == 0 and binary.exists(), run.stdout[-3000:] + run.stderr[-3000:]
-    return binary
+    if not w.fmusim_binary().exists() and not os.environ.get("SLEWING_BUILD_FMUSIM"):
+        pytest.skip("SKIPPED: fmusim for mingw is not built yet (about 5 minutes): run tests/platform_builds.py "
+                    "or tests/win64/run_all.sh, or set SLEWING_BUILD_FMUSIM=1")
+    return w.build_fmusim()
 
 
 @pytest.mark.parametrize("case", platform_cases(CASES, make_test=["bearing2"]))

@@ -40,6 +40,27 @@ def missing_tools() -> str:
     return ""
 
 
+#: fmusim v0.0.39 cross-compiled with mingw-w64 (its libraries built from Debian's sources, about 5 minutes once)
+FMUSIM_SCRIPT = ROOT / "tests" / "win64" / "build_fmusim.sh"
+
+
+def fmusim_binary() -> Path:
+    """Where fmusim.exe is kept: one binary per version of its build script."""
+    import hashlib
+
+    return WINE_DIR / f"fmusim-{hashlib.sha256(FMUSIM_SCRIPT.read_bytes()).hexdigest()[:12]}.exe"
+
+
+def build_fmusim() -> Path:
+    """:func:`fmusim_binary`, built first where it is missing (needs root: the build installs its tools)."""
+    binary = fmusim_binary()
+    if not binary.exists():
+        run = subprocess.run(["bash", str(FMUSIM_SCRIPT), str(binary)], capture_output=True, text=True, timeout=3600)
+        if run.returncode != 0 or not binary.exists():
+            raise RuntimeError(f"{FMUSIM_SCRIPT.name} failed:\n{run.stdout[-3000:]}{run.stderr[-3000:]}")
+    return binary
+
+
 def wine_env() -> dict:
     """The environment wine programs run in: this machine's PATH, the kept prefix, no debug output."""
     return fmu_build.win64.wine_env(PREFIX)
