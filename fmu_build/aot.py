@@ -52,12 +52,35 @@ def module_file_name(target: str = "generic") -> str:
     return AOT_MODULES[target] + sysconfig.get_config_var("EXT_SUFFIX")
 
 
+#: the modules' numba_unpickle, which keeps what it unpickled as numba's JIT does (compiled after pycc's C part:
+#: :func:`memoised_mixin`)
+UNPICKLE_SOURCE = Path(__file__).with_name("pycc_unpickle.c")
+
+
+def memoised_mixin(modulemixin, folder) -> Path:
+    """pycc's C part (``modulemixin``: numba's ``pycc/modulemixin.c``) with its ``numba_unpickle`` renamed
+    ``numba_unpickle_each_time`` and :data:`UNPICKLE_SOURCE`'s in its place: a C file written into ``folder``,
+    compiled in place of ``modulemixin`` (here by pycc, for win64 by mingw-w64)."""
+    source = Path(folder) / "modulemixin_memoised.c"
+    source.write_text(f"#define numba_unpickle numba_unpickle_each_time\n#include \"{Path(modulemixin).as_posix()}\"\n"
+                      f"#undef numba_unpickle\n\n{UNPICKLE_SOURCE.read_text()}")
+    return source
+
+
+def c_part_digest() -> str:
+    """8 hex digits of what the modules' C part adds to pycc's (:data:`UNPICKLE_SOURCE`): part of the cache keys."""
+    import hashlib
+
+    return hashlib.sha256(UNPICKLE_SOURCE.read_bytes()).hexdigest()[:8]
+
+
 def cache_key() -> str:
     import numba
 
     from slewing_model.numerics.compiled import kernel_source_hash
 
-    return f"{kernel_source_hash():016x}-numba{numba.__version__}-{sysconfig.get_config_var('SOABI')}"
+    return (f"{kernel_source_hash():016x}-numba{numba.__version__}-{sysconfig.get_config_var('SOABI')}-"
+            f"c{c_part_digest()}")
 
 
 #: the environment variable that names the modules' cache (the tests set it to the user's, which ``make test``
@@ -167,6 +190,10 @@ def _compile(output_dir: str, target: str = "generic") -> None:
         return original(typingctx, targetctx, func, args, return_type, flags, locals, **kwargs)
 
     pycc_compiler.compile_extra = compile_extra
+    # the C part with a numba_unpickle that keeps what it unpickled (pycc_unpickle.c); the paths normalised, since
+    # distutils makes each object's folder from its source's path (numba's ../core/runtime/nrt.cpp)
+    cc._get_mixin_sources = lambda: [str(memoised_mixin(source, output_dir)) if source.endswith("modulemixin.c")
+                                     else os.path.normpath(source) for source in CC._get_mixin_sources(cc)]
     cc.compile()
     print(numba.__version__)
 

@@ -608,12 +608,14 @@ WINDOWS_PYCONFIG = """\
 
 
 def aot_cache_key() -> str:
-    """What the Windows module depends on: the loops' sources, numba's version (the runtime's pin), its target."""
+    """What the Windows module depends on: the loops' sources, numba's version (the runtime's pin), its target,
+    the C part's additions (``fmu_build.aot.c_part_digest``)."""
+    from fmu_build.aot import c_part_digest
     from slewing_model.numerics.compiled import kernel_source_hash
 
     numba_version = PINS["numba"][0].split("==")[1]
     digest = hashlib.sha256(WINDOWS_PYCONFIG.encode() + _AOT_OBJECTS.encode()).hexdigest()[:8]
-    return f"{kernel_source_hash():016x}-numba{numba_version}-win_amd64-{AOT_TARGET}-{digest}"
+    return f"{kernel_source_hash():016x}-numba{numba_version}-win_amd64-{AOT_TARGET}-{digest}-c{c_part_digest()}"
 
 
 #: set to 1, :func:`aot_module` takes the win64 module from its cache only, else raises (the build then warns
@@ -665,6 +667,8 @@ def _compile_aot_module(cached: Path) -> None:
                            "gcc-mingw-w64-x86-64 g++-mingw-w64-x86-64)")
     import sysconfig
 
+    from fmu_build.aot import memoised_mixin
+
     headers = Path(sysconfig.get_paths()["include"])
     if sys.version_info[:2] != (3, 11) or not (headers / "Python.h").exists():
         raise RuntimeError(f"compiling the loops for win64 needs Python 3.11's C headers (Python.h) in {headers} "
@@ -714,7 +718,7 @@ def _compile_aot_module(cached: Path) -> None:
                  *(f"-D{k}={v}" for k, v in link["defines"])]
         numba_src = tmp / "numba_src" / "numba"
         compiled = [out / o for o in link["objects"]]
-        sources = [(MINGW, numba_src / "pycc" / "modulemixin.c")]
+        sources = [(MINGW, memoised_mixin(numba_src / "pycc" / "modulemixin.c", tmp))]   # numba_unpickle kept
         if link["nrt"]:
             sources.append((MINGW_CXX, numba_src / "core" / "runtime" / "nrt.cpp"))
         for compiler, c_source in sources:

@@ -195,3 +195,39 @@ def test_the_compiled_modules_key_covers_every_module_the_loops_take_code_from()
                 if not (package / source).exists():
                     source = f"{target.as_posix()}/__init__.py"
                 assert source in listed, f"{name} imports from {source}, which KERNEL_SOURCES leaves out"
+
+
+#: calls a compiled loop that returns arrays (the life map's widest contacts) ``sys.argv[2]`` times in a process
+#: without numba, and prints how many pickles the module's numba_unpickle loaded (pickle.loads counted before
+#: the module's first call, which takes the function once)
+UNPICKLES = r'''
+import pickle, sys
+import numpy as np
+sys.modules["numba"] = sys.modules["llvmlite"] = None
+sys.path.insert(0, sys.argv[1])
+loads, count = pickle.loads, [0]
+def counted(*args, **kwargs):
+    count[0] += 1
+    return loads(*args, **kwargs)
+pickle.loads = counted
+import slewing_kernels
+semi = np.ascontiguousarray(np.arange(12.0).reshape(3, 4))
+for _ in range(int(sys.argv[2])):
+    first, second = slewing_kernels.life__widest_contacts(semi, semi + 1.0)
+assert first.dtype == np.float64 and first.shape == (4,), (first.dtype, first.shape)
+print(count[0])
+'''
+
+
+def test_a_compiled_loop_unpickles_its_constants_once(aot_folder):
+    """Returning an array, a loop compiled ahead of time boxes it with its dtype, a pickled constant: the
+    module's numba_unpickle (fmu_build/pycc_unpickle.c) loads each constant once and keeps it, as numba's JIT
+    does (pycc's own loads it on every call). 1 call and 50 calls load the same number of pickles."""
+    def unpickles(calls):
+        run = subprocess.run([sys.executable, "-c", UNPICKLES, str(aot_folder), str(calls)], capture_output=True,
+                             text=True, timeout=300)
+        assert run.returncode == 0, run.stderr[-3000:]
+        return int(run.stdout.split()[-1])
+
+    once, many = unpickles(1), unpickles(50)
+    assert 1 <= once == many, (once, many)
