@@ -57,17 +57,19 @@ demo: $(STAMP)
 # numba's for this CPU and the FMU's modules compiled ahead of time (fmu_build/aot.py, the tests take them
 # from the user's cache). The --numba FMU's tests, which compile numba's loops for two more CPUs, are opt-in
 # (SLEWING_TEST_NUMBA_FMU=1). numba's loops compile on one core (about 3 minutes) beside the FMU's two modules
-# on two (1.5 minutes each): 3 minutes of wall time on 2 cores instead of 4. Then, as root, tests/platform_builds.py
-# makes what the win64 and Debian 11 floor tests need where it is missing (the floor runtime, mingw's fmusim,
-# the win64 half's loops: about 8 minutes once, kept in /var/cache and the aot cache; seconds after)
+# on two (1.5 minutes each): 3 minutes of wall time on 2 cores instead of 4. Beside them, as root,
+# tests/platform_builds.py makes what the win64 and Debian 11 floor tests need where it is missing (the floor
+# runtime, mingw's fmusim, the win64 half's loops: 8-14 minutes once, much of it downloads and debootstrap,
+# kept in /var/cache and the aot cache; seconds after)
 TEST_WORKERS ?= 2
 COMPILE_LOOPS := from slewing_model.friction import kernel; kernel.compile_all()
 COMPILE_LOOPS_AOT := import fmu_build.aot; fmu_build.aot.prepare_cache()
 
 test: $(STAMP)
 	$(call debian_packages,$(TEST_PACKAGES))
-	$(PY) -c "$(COMPILE_LOOPS)" & numba=$$!; $(PY) -c "$(COMPILE_LOOPS_AOT)"; aot=$$?; wait $$numba && [ $$aot = 0 ]
-	$(PY) tests/platform_builds.py
+	$(PY) tests/platform_builds.py & platforms=$$!; $(PY) -c "$(COMPILE_LOOPS)" & numba=$$!; \
+	  $(PY) -c "$(COMPILE_LOOPS_AOT)"; aot=$$?; wait $$numba; numba=$$?; wait $$platforms; platforms=$$?; \
+	  [ $$aot = 0 ] && [ $$numba = 0 ] && [ $$platforms = 0 ]
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=15
 
 # the benchmark suite's main set (python -m benchmarks --list names them all; tables printed and written as

@@ -34,7 +34,6 @@ import dataclasses
 import json
 import math
 import os
-import traceback
 from xml.etree.ElementTree import Element, SubElement
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
@@ -169,8 +168,14 @@ class SlewingDrive(Fmi2Slave):
         except ValueError as exc:
             self.log(f"{self.instance_name}: {exc}", Fmi2Status.error)
         except Exception:
-            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
+            self._log_internal_error()
         return False
+
+    def _log_internal_error(self) -> None:
+        """Log the exception being handled, with its traceback, as an error (never raised to the host)."""
+        import traceback                    # only when there is one: not at every instantiation
+
+        self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self.drive is None and not self._build():
@@ -198,7 +203,7 @@ class SlewingDrive(Fmi2Slave):
             self.log(f"{self.instance_name}: step refused: {exc}", Fmi2Status.error)
             return False
         except Exception:
-            self.log(f"{self.instance_name}: internal error:\n{traceback.format_exc()}", Fmi2Status.error)
+            self._log_internal_error()
             return False
         p = self.drive.p
         self.psi, self.omega = s.angle, s.speed
